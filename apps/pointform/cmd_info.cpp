@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "common.h"
+
+#include "pointform/core/parallel.h"
+#include "pointform/io/io.h"
+#include "pointform/spatial/kd_tree.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+namespace pointform::cli {
+namespace {
+
+struct InfoOptions
+{
+    std::string input;
+    bool json = false;
+};
+
+struct Density
+{
+    double mean = 0.0;
+    double median = 0.0;
+};
+
+/// Mean and median distance from each point to its nearest other point.
+Density nearest_neighbor_density(const PointCloud& cloud, const ProgressCallback& progress)
+{
+    Density density;
+    if (cloud.size() < 2)
+        return density;
+    const KdTree tree(cloud.positions);
+    const KnnTable table = knn_batch(tree, cloud.positions, 2, {.progress = progress});
+    std::vector<double> distances(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+    {
+        // The nearest is usually the point itself; with duplicates it may be a twin at distance 0.
+        const auto nbrs = table.neighbors(i);
+        const auto d2 = table.distances2(i);
+        const float other = nbrs[0] == i ? d2[1] : d2[0];
+        distances[i] = std::sqrt(static_cast<double>(other));
+    }
+    double sum = 0.0;
+    for (const double d : distances)
+        sum += d;
+    density.mean = sum / static_cast<double>(distances.size());
+    const auto middle = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
+    std::nth_element(distances.begin(), middle, distances.end());
+    density.median = *middle;
+    return density;
+}
+
+nlohmann::json vec_json(const Vec3d& v)
+{
+    return nlohmann::json::array({v.x(), v.y(), v.z()});
+}
+
+std::string vec_text(const Vec3d& v)
+{
+    return format_number(v.x()) + " " + format_number(v.y()) + " " + format_number(v.z());
+}
+
+void run_info(const InfoOptions& options, const GlobalOptions& global)
+{
+    set_thread_count(global.threads);
+    TerminalProgress progress(!global.quiet && !options.json);
+    const ReadResult read = read_geometry(options.input);
+    const PointCloud& cloud = read.points;
+    const Aabb box = cloud.bounds();
+    const Density density = nearest_neighbor_density(cloud, progress.callback());
+    progress.clear();
+
+    std::vector<std::string> attributes = {"positions"};
+    if (cloud.has_normals())
+        attributes.emplace_back("normals");
+    if (cloud.has_colors())
+        attributes.emplace_back("colors");
+    if (cloud.has_radii())
+        attributes.emplace_back("radii");
+    if (!read.triangles.empty())
+        attributes.emplace_back("faces");
+
+    if (options.json)
+    {
+        nlohmann::json out;
+        out["file"] = options.input;
+        out["format"] = read.description;
+        out["points"] = cloud.size();
+        out["faces"] = read.triangles.size();
+        out["dropped_points"] = read.dropped_points;
+        out["attributes"] = attributes;
+        out["origin"] = vec_json(cloud.origin);
+        if (!box.is_empty())
+            out["bounding_box"] = {{"min", vec_json(box.min)},
+                                   {"max", vec_json(box.max)},
+                                   {"size", vec_json(box.size())},
+                                   {"diagonal", box.diagonal()}};
+        out["nearest_neighbor_distance"] = {{"mean", density.mean}, {"median", density.median}};
+        std::printf("%s\n", out.dump(2).c_str());
+        return;
+    }
+    if (global.quiet)
+        return;
+    std::printf("%s\n", options.input.c_str());
+    print_row("format", read.description);
+    print_row("points", std::to_string(cloud.size()));
+    if (read.dropped_points > 0)
+        print_row("dropped (non-finite)", std::to_string(read.dropped_points));
+    if (!read.triangles.empty())
+        print_row("faces", std::to_string(read.triangles.size()));
+    std::string list;
+    for (const auto& a : attributes)
+        list += (list.empty() ? "" : ", ") + a;
+    print_row("attributes", list);
+    if (!box.is_empty())
+    {
+        print_row("bounding box min", vec_text(box.min));
+        print_row("bounding box max", vec_text(box.max));
+        print_row("size", vec_text(box.size()));
+        print_row("diagonal", format_number(box.diagonal()));
+    }
+    if (cloud.origin != Vec3d::Zero())
+        print_row("storage origin", vec_text(cloud.origin));
+    print_row("nn distance mean", format_number(density.mean));
+    print_row("nn distance median", format_number(density.median));
+}
+
+} // namespace
+
+void register_info(CLI::App& app, const GlobalOptions& global)
+{
+    auto options = std::make_shared<InfoOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "info", "Print point count, bounding box, sampling density and attributes of a file");
+    cmd->add_option("input", options->input,
+                    "Point set or mesh: .ply .xyz .pts .csv .txt .pwn .off .obj .pcd .las")
+        ->required();
+    cmd->add_flag("--json", options->json, "Print the summary as JSON");
+    cmd->callback([options, &global] { run_info(*options, global); });
+}
+
+} // namespace pointform::cli

@@ -1,0 +1,192 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "common.h"
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+#include "pointform/hermite/surfels.h"
+#include "pointform/io/io.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+
+namespace pointform::cli {
+namespace {
+
+struct NormalsCommandOptions
+{
+    std::string input;
+    std::string output;
+    std::size_t k = 16;
+    std::size_t graph_k = 0;
+    double radius_scale = 1.0;
+    std::string radius_regions;
+    std::string orient = "mst";
+    std::string rule = "hoppe";
+    bool ascii = false;
+    bool json = false;
+};
+
+/// Parses --orient into the mode and its target.
+void parse_orient(const std::string& text, SurfelOptions& options)
+{
+    const auto colon = text.find(':');
+    const std::string mode = text.substr(0, colon);
+    const std::string argument = colon == std::string::npos ? "" : text.substr(colon + 1);
+    if ((mode == "towards" || mode == "along") == argument.empty())
+        throw CLI::ValidationError("--orient", "'" + text +
+                                                   "': expected mst, none, flip, "
+                                                   "towards:X,Y,Z or along:X,Y,Z");
+    if (mode == "mst")
+        options.orient = OrientMode::Mst;
+    else if (mode == "none")
+        options.orient = OrientMode::None;
+    else if (mode == "flip")
+        options.orient = OrientMode::Flip;
+    else if (mode == "towards")
+    {
+        options.orient = OrientMode::Towards;
+        options.orient_target = parse_vec3(argument, "--orient towards");
+    }
+    else if (mode == "along")
+    {
+        options.orient = OrientMode::Along;
+        options.orient_target = parse_vec3(argument, "--orient along");
+        if (options.orient_target.squaredNorm() == 0.0)
+            throw CLI::ValidationError("--orient", "the direction must not be zero");
+    }
+    else
+        throw CLI::ValidationError("--orient", "unknown mode '" + mode +
+                                                   "': expected mst, none, flip, towards:X,Y,Z "
+                                                   "or along:X,Y,Z");
+}
+
+void run_normals(const NormalsCommandOptions& options, const GlobalOptions& global)
+{
+    set_thread_count(global.threads);
+    SurfelOptions surfel_options{.k = options.k,
+                                 .graph_k = options.graph_k,
+                                 .rule = options.rule == "reflection" ? OrientationRule::Reflection
+                                                                      : OrientationRule::Hoppe,
+                                 .radius_scale = options.radius_scale};
+    parse_orient(options.orient, surfel_options);
+    if (!options.radius_regions.empty())
+        surfel_options.radius_regions = read_radius_regions(options.radius_regions);
+
+    TerminalProgress progress(!global.quiet && !options.json);
+    surfel_options.progress = progress.callback();
+    Timings timings;
+    PointCloud cloud = read_point_cloud(options.input);
+    cloud.normals.clear(); // estimated afresh; input normals play no part
+    timings.lap("read");
+
+    const SurfelResult result = compute_surfels(cloud, surfel_options);
+    for (const auto& [stage, seconds] : result.stage_seconds)
+        timings.add(stage, seconds);
+    write_point_cloud(options.output, result.surfels, {.ascii = options.ascii});
+    timings.lap("write");
+    progress.clear();
+
+    std::vector<float> radii = result.surfels.radii;
+    std::sort(radii.begin(), radii.end());
+    const auto& orientation = result.orientation;
+
+    if (options.json)
+    {
+        nlohmann::json out;
+        out["input"] = options.input;
+        out["output"] = options.output;
+        out["points"] = result.surfels.size();
+        out["k"] = options.k;
+        out["components"] = orientation.components;
+        out["flipped"] = orientation.flipped;
+        out["degenerate"] = result.degenerate;
+        out["inherited"] = orientation.inherited;
+        out["unoriented"] = orientation.unoriented.size();
+        out["unoriented_indices"] =
+            std::vector<std::uint32_t>(orientation.unoriented.begin(),
+                                       orientation.unoriented.begin() +
+                                           static_cast<std::ptrdiff_t>(std::min<std::size_t>(
+                                               orientation.unoriented.size(), 100)));
+        out["radius"] = {{"min", radii.front()},
+                         {"median", radii[radii.size() / 2]},
+                         {"max", radii.back()}};
+        nlohmann::json stages = nlohmann::json::object();
+        for (const auto& [stage, seconds] : timings.stages())
+            stages[stage] = seconds;
+        stages["total"] = timings.total();
+        out["timings_s"] = stages;
+        out["threads"] = thread_count();
+        out["peak_rss_bytes"] = peak_rss_bytes();
+        std::printf("%s\n", out.dump(2).c_str());
+        return;
+    }
+    if (global.quiet)
+        return;
+    std::printf("%s -> %s\n", options.input.c_str(), options.output.c_str());
+    print_row("points", std::to_string(result.surfels.size()));
+    print_row("components", std::to_string(orientation.components));
+    print_row("normals flipped", std::to_string(orientation.flipped));
+    print_row("degenerate (inherited)", std::to_string(result.degenerate));
+    print_row("unoriented", std::to_string(orientation.unoriented.size()));
+    print_row("radius min/median/max",
+              format_number(radii.front()) + " / " + format_number(radii[radii.size() / 2]) +
+                  " / " + format_number(radii.back()));
+    std::string times;
+    for (const auto& [stage, seconds] : timings.stages())
+        times += (times.empty() ? "" : ", ") + stage + " " + format_number(seconds);
+    print_row("seconds", times + " (total " + format_number(timings.total()) + ")");
+    if (!orientation.unoriented.empty())
+        std::fprintf(stderr,
+                     "pointform: warning: %zu samples could not be oriented (first index %u); "
+                     "their normals are written as zero\n",
+                     orientation.unoriented.size(), orientation.unoriented.front());
+}
+
+} // namespace
+
+void register_normals(CLI::App& app, const GlobalOptions& global)
+{
+    auto options = std::make_shared<NormalsCommandOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "normals",
+        "Level 1 -> 2: estimate, consistently orient and give an influence radius to every "
+        "sample (paper §4); writes PLY with x y z nx ny nz radius");
+    cmd->add_option("input", options->input,
+                    "Point set or mesh: .ply .xyz .pts .csv .txt .pwn .off .obj .pcd .las")
+        ->required();
+    cmd->add_option("-o,--output", options->output, "Output surfels (.ply, or .xyz)")->required();
+    cmd->add_option("-k", options->k, "Neighbours for PCA and radius, the point itself included")
+        ->capture_default_str()
+        ->check(CLI::Range(3, 1000));
+    cmd->add_option("--graph-k", options->graph_k,
+                    "Neighbours a point in the orientation graph (0 = min(k, 10))")
+        ->capture_default_str();
+    cmd->add_option("--radius-scale", options->radius_scale,
+                    "Factor on the automatic influence radius (distance to the k-th neighbour)")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--radius-regions", options->radius_regions,
+                    "JSON file of balls and boxes that set the radius: {\"regions\": [{\"ball\": "
+                    "{\"center\": [x,y,z], \"radius\": R}, \"set\": r}, {\"box\": {\"min\": "
+                    "[..], \"max\": [..]}, \"scale\": s}]}");
+    cmd->add_option("--orient", options->orient,
+                    "mst (consistent, outward on closed surfaces), none, flip (mst, then "
+                    "inward), towards:X,Y,Z (a viewpoint) or along:X,Y,Z (a direction)")
+        ->capture_default_str();
+    cmd->add_option("--rule", options->rule,
+                    "MST propagation rule: hoppe (robust to noise) or reflection (thin walls "
+                    "and creases in clean data)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"hoppe", "reflection"}));
+    cmd->add_flag("--ascii", options->ascii, "Write ascii PLY instead of binary");
+    cmd->add_flag("--json", options->json,
+                  "Print the report (counts, stage timings, peak memory) as JSON");
+    cmd->callback([options, &global] { run_normals(*options, global); });
+}
+
+} // namespace pointform::cli

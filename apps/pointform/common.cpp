@@ -1,0 +1,105 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "common.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+namespace pointform::cli {
+
+TerminalProgress::TerminalProgress(bool enabled)
+    : enabled_(enabled && ::isatty(STDERR_FILENO) == 1)
+{
+    callback_ = [this](std::string_view stage, double fraction) {
+        if (!enabled_)
+            return true;
+        const auto now = std::chrono::steady_clock::now();
+        if (stage != stage_)
+        {
+            clear();
+            stage_ = std::string(stage);
+            stage_start_ = now;
+        }
+        // Only work that lasts more than a second earns a progress line.
+        if (now - stage_start_ < std::chrono::seconds(1))
+            return true;
+        std::fprintf(stderr, "\r%-28s %5.1f%%", stage_.c_str(), 100.0 * fraction);
+        std::fflush(stderr);
+        shown_ = true;
+        return true;
+    };
+}
+
+TerminalProgress::~TerminalProgress()
+{
+    clear();
+}
+
+void TerminalProgress::clear()
+{
+    if (shown_)
+    {
+        std::fprintf(stderr, "\r%40s\r", "");
+        std::fflush(stderr);
+        shown_ = false;
+    }
+}
+
+void Timings::lap(const std::string& stage)
+{
+    const auto now = std::chrono::steady_clock::now();
+    stages_.emplace_back(stage, std::chrono::duration<double>(now - last_).count());
+    last_ = now;
+}
+
+void Timings::add(const std::string& stage, double seconds)
+{
+    stages_.emplace_back(stage, seconds);
+    last_ = std::chrono::steady_clock::now();
+}
+
+double Timings::total() const
+{
+    double sum = 0.0;
+    for (const auto& [stage, seconds] : stages_)
+        sum += seconds;
+    return sum;
+}
+
+std::size_t peak_rss_bytes()
+{
+    rusage usage{};
+    ::getrusage(RUSAGE_SELF, &usage);
+    return static_cast<std::size_t>(usage.ru_maxrss) * 1024U; // Linux reports KiB
+}
+
+Vec3d parse_vec3(const std::string& text, const std::string& what)
+{
+    std::istringstream in(text);
+    Vec3d v;
+    char comma1 = 0;
+    char comma2 = 0;
+    if (!(in >> v.x() >> comma1 >> v.y() >> comma2 >> v.z()) || comma1 != ',' || comma2 != ',' ||
+        !(in >> std::ws).eof() || !v.allFinite())
+        throw CLI::ValidationError(what, "expected three finite numbers X,Y,Z, got '" + text + "'");
+    return v;
+}
+
+std::string format_number(double value)
+{
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, "%.6g", value);
+    return buffer;
+}
+
+void print_row(const std::string& label, const std::string& value)
+{
+    std::printf("  %-22s %s\n", (label + ":").c_str(), value.c_str());
+}
+
+} // namespace pointform::cli

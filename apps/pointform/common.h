@@ -1,0 +1,82 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#pragma once
+
+#include "pointform/core/progress.h"
+#include "pointform/core/types.h"
+
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace pointform::cli {
+
+/// Options every subcommand shares.
+struct GlobalOptions
+{
+    int threads = 0;    ///< 0 = all cores
+    bool quiet = false; ///< no progress, no summary on stdout except requested JSON
+};
+
+/// \brief Renders progress on stderr when it is a terminal and a stage has taken more than a
+/// second; silent when stderr is piped or --quiet is given.
+class TerminalProgress
+{
+public:
+    explicit TerminalProgress(bool enabled);
+    ~TerminalProgress();
+    TerminalProgress(const TerminalProgress&) = delete;
+    TerminalProgress& operator=(const TerminalProgress&) = delete;
+
+    /// The callback to hand to library options.
+    [[nodiscard]] const ProgressCallback& callback() const { return callback_; }
+    /// Clears the progress line, if one is shown.
+    void clear();
+
+private:
+    bool enabled_;
+    bool shown_ = false;
+    std::string stage_;
+    std::chrono::steady_clock::time_point stage_start_;
+    ProgressCallback callback_;
+};
+
+/// \brief Wall-clock stage timings.
+class Timings
+{
+public:
+    void lap(const std::string& stage);
+    void add(const std::string& stage, double seconds);
+    [[nodiscard]] const std::vector<std::pair<std::string, double>>& stages() const
+    {
+        return stages_;
+    }
+    [[nodiscard]] double total() const;
+
+private:
+    std::vector<std::pair<std::string, double>> stages_;
+    std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+/// \brief Peak resident memory of this process so far, in bytes.
+[[nodiscard]] std::size_t peak_rss_bytes();
+
+/// \brief Parses "X,Y,Z" into a vector. \throw CLI::ValidationError on malformed input.
+[[nodiscard]] Vec3d parse_vec3(const std::string& text, const std::string& what);
+
+/// \brief Formats a number compactly for summaries (6 significant digits).
+[[nodiscard]] std::string format_number(double value);
+
+/// \brief Prints a one-line JSON-free summary row "label: value" aligned for humans.
+void print_row(const std::string& label, const std::string& value);
+
+/// \brief Registers the subcommands; each is defined in its own cmd_<verb>.cpp.
+void register_info(CLI::App& app, const GlobalOptions& global);
+void register_normals(CLI::App& app, const GlobalOptions& global);
+void register_sample(CLI::App& app, const GlobalOptions& global);
+
+} // namespace pointform::cli

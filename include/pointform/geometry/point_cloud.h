@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#pragma once
+
+#include "pointform/core/types.h"
+#include "pointform/geometry/aabb.h"
+
+#include <cstddef>
+#include <vector>
+
+namespace pointform {
+
+/// \brief Level 1: unstructured samples S (§3), with the attributes a file may carry.
+///
+/// Positions are float32, stored relative to a double-precision `origin`, so that georeferenced
+/// coordinates (LiDAR, UTM) keep their precision: world position i = origin + positions[i].
+/// Optional attributes are parallel arrays that are either empty or hold one entry a point.
+struct PointCloud
+{
+    Vec3d origin = Vec3d::Zero();
+    std::vector<Vec3f> positions; ///< N, relative to origin
+    std::vector<Vec3f> normals;   ///< empty or N; unit length when read from a file that has them
+    std::vector<Color> colors;    ///< empty or N
+    std::vector<float> radii;     ///< empty or N; influence radius in world units (§4.1)
+
+    [[nodiscard]] std::size_t size() const { return positions.size(); }
+    [[nodiscard]] bool empty() const { return positions.empty(); }
+    [[nodiscard]] bool has_normals() const { return !normals.empty(); }
+    [[nodiscard]] bool has_colors() const { return !colors.empty(); }
+    [[nodiscard]] bool has_radii() const { return !radii.empty(); }
+
+    /// \brief World position of point i, in double precision.
+    [[nodiscard]] Vec3d world(std::size_t i) const
+    {
+        return origin + positions[i].cast<double>();
+    }
+    /// \brief Bounding box in world units.
+    [[nodiscard]] Aabb bounds() const { return bounding_box(positions, origin); }
+};
+
+/// \brief Picks the float storage origin for a cloud whose first point is `first`: the point
+/// rounded to whole units, so that small models (within about ±0.5 unit of zero) keep origin 0
+/// and float inputs round-trip exactly, while georeferenced ones are re-centred.
+[[nodiscard]] Vec3d choose_origin(const Vec3d& first);
+
+/// \brief Checks that every attribute array is empty or of the cloud's size.
+/// \throw InvalidInput naming the offending attribute.
+void validate(const PointCloud& cloud);
+
+} // namespace pointform

@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#pragma once
+
+#include "pointform/geometry/point_cloud.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace pointform {
+
+/// \brief Analytic shapes that can be sampled with their exact outward normals, for tests,
+/// benchmarks and demos.
+enum class Shape
+{
+    Sphere,     ///< radius 1 centred at 0
+    Torus,      ///< major radius 1, minor radius 0.35, axis z
+    TwoSpheres, ///< two disjoint unit spheres centred at (±1.6, 0, 0)
+    Plate,      ///< closed thin box 2 × 2 × thickness, centred at 0
+};
+
+/// \brief Options for sample_shape.
+struct SampleOptions
+{
+    /// Number of samples before holes are cut.
+    std::size_t count = 100000;
+    /// Seed of the pseudo-random generator; the same seed gives the same samples.
+    std::uint64_t seed = 1;
+    /// Standard deviation of isotropic Gaussian position noise, as a fraction of the bounding
+    /// box diagonal (0.002 = 0.2%). Normals stay those of the noiseless surface. 0 = clean.
+    double noise = 0.0;
+    /// Number of holes: balls around random samples whose points are removed. 0 = none.
+    std::size_t holes = 0;
+    /// Radius of each hole as a fraction of the bounding-box diagonal.
+    double hole_radius = 0.05;
+    /// Plate only: thickness of the plate (its side is 2).
+    double thickness = 0.05;
+};
+
+/// \brief Samples a shape area-uniformly and returns positions with exact outward unit normals.
+/// \throw InvalidInput for count == 0 or negative noise, hole radius or thickness.
+[[nodiscard]] PointCloud sample_shape(Shape shape, const SampleOptions& options = {});
+
+/// \brief Parses "sphere", "torus", "two-spheres", "plate". \throw InvalidInput otherwise.
+[[nodiscard]] Shape parse_shape(const std::string& name);
+
+} // namespace pointform

@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#pragma once
+
+#include "pointform/core/progress.h"
+#include "pointform/core/types.h"
+#include "pointform/spatial/neighborhoods.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace pointform {
+
+/// \brief Least-squares plane through a set of points.
+struct PlaneFit
+{
+    Vec3d centroid = Vec3d::Zero();
+    Vec3d normal = Vec3d::Zero(); ///< unit; zero when the points span no plane
+    /// Eigenvalues of the covariance, ascending (units²).
+    Vec3d eigenvalues = Vec3d::Zero();
+    /// True when the points are coincident or collinear, so no normal is defined.
+    bool degenerate = true;
+
+    /// \brief Pauly's surface variation λ0 / (λ0 + λ1 + λ2): 0 on a plane, 1/3 for isotropic noise.
+    [[nodiscard]] double variation() const
+    {
+        const double sum = eigenvalues.sum();
+        return sum > 0.0 ? eigenvalues[0] / sum : 0.0;
+    }
+};
+
+/// \brief Fits a plane to the points `positions[indices[i]]` (§4 step 1): the normal is the
+/// eigenvector of the smallest eigenvalue of their 3×3 covariance, solved in closed form in
+/// double precision. Allocates nothing.
+/// \param positions  N points
+/// \param indices    the subset to fit, each < N; at least one
+[[nodiscard]] PlaneFit fit_plane(std::span<const Vec3f> positions,
+                                 std::span<const std::uint32_t> indices);
+
+/// \brief Options for estimate_normals.
+struct NormalOptions
+{
+    /// Neighbours in each fit, the point itself included. 16 suits most scans; raise it for
+    /// noisy data. Must not exceed the number of points.
+    std::size_t k = 16;
+    /// Optional progress report.
+    ProgressCallback progress;
+};
+
+/// \brief Unoriented normals of a point set (§4 step 1).
+struct Normals
+{
+    /// N unit normals with arbitrary sign; zero for degenerate neighbourhoods.
+    std::vector<Vec3f> normals;
+    /// Indices whose neighbourhood is coincident or collinear, ascending.
+    std::vector<std::uint32_t> degenerate;
+};
+
+/// \brief Estimates a normal for every point by PCA over the given neighbourhoods, in parallel.
+/// \param positions  N points
+/// \param neighbors  an N by k table (e.g. knn_batch of the points against themselves)
+/// \throw InvalidInput if the table does not have N rows
+[[nodiscard]] Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
+                                       const ProgressCallback& progress = {});
+
+/// \brief One-off: builds a kd-tree, finds k neighbours and estimates normals.
+/// \throw InvalidInput if there are fewer than k points or k < 3
+[[nodiscard]] Normals estimate_normals(std::span<const Vec3f> positions,
+                                       const NormalOptions& options = {});
+
+} // namespace pointform

@@ -1,0 +1,132 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#pragma once
+
+#include "pointform/core/progress.h"
+#include "pointform/core/types.h"
+#include "pointform/spatial/neighborhoods.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace pointform {
+
+/// \brief How orientation passes from a sample a to its neighbour b, and what the Riemannian graph
+/// charges for that edge (the less certain the step, the higher the cost).
+enum class OrientationRule
+{
+    /// Hoppe et al., as in the paper (§4 step 2): b agrees with a when n_a·n_b > 0; cost
+    /// 1 − |n_a·n_b|. Fails where two sheets face each other closer than the neighbourhood
+    /// size (thin walls) and is blind at creases, where n_a ⟂ n_b.
+    Hoppe,
+    /// The normal at a, reflected in the bisector plane of the edge e = b − a:
+    /// m = n_a − 2 (n_a·ê) ê, is the normal a circle through a and b would have at b. b agrees
+    /// with a when n_b·m > 0; cost 1 − |n_b·m|. For neighbours in one tangent plane m = n_a, so
+    /// this is Hoppe's rule there; across a thin wall (e along the normals) and around a crease
+    /// it predicts the turned normal correctly, where Hoppe's rule flips a whole side. The cost
+    /// is symmetric in a and b. Measured: on a clean plate half a sampling step thick it orients
+    /// 99.6% of the faces where Hoppe's rule gets 50%, but position noise of a fifth of the
+    /// sampling step tilts short edges towards the normal and breaks it (about 60% on a noisy
+    /// sphere), so it is for clean, thin-walled data only.
+    Reflection,
+};
+
+/// \brief Options for orient_normals_mst.
+struct OrientationOptions
+{
+    /// Neighbours of each point in the Riemannian graph (the symmetrised kNN graph); 0 = every
+    /// column of the table passed in. Fewer neighbours make a sparser, faster graph.
+    std::size_t k = 0;
+    /// Propagation rule and edge cost; see OrientationRule.
+    OrientationRule rule = OrientationRule::Hoppe;
+    /// Optional progress report.
+    ProgressCallback progress;
+};
+
+/// \brief A minimum spanning forest of the Riemannian graph: one tree a connected component,
+/// rooted at the component's seed.
+struct RiemannianForest
+{
+    static constexpr std::uint32_t none = 0xFFFFFFFFU;
+
+    /// N: tree parent of each sample; a root is its own parent; `none` for a sample of a
+    /// component that has no usable normal (it is in no tree).
+    std::vector<std::uint32_t> parent;
+    /// Samples in breadth-first order from the roots; every parent comes before its child.
+    std::vector<std::uint32_t> order;
+    /// N: connected component of each sample, numbered by smallest sample index.
+    std::vector<std::uint32_t> component;
+    /// One root a component (`none` for a component with no usable normal).
+    std::vector<std::uint32_t> roots;
+    /// Sum of the edge costs of all trees.
+    double total_cost = 0.0;
+};
+
+/// \brief Builds the Riemannian graph (the kNN graph made symmetric, with `options.k` columns of
+/// `neighbors`) and its minimum spanning forest by Kruskal's algorithm (edges radix-sorted by
+/// cost, ties in a fixed order, so the forest is deterministic), one tree a component, each
+/// rooted at the component's highest sample with a usable normal. Edge costs (`options.rule`)
+/// depend only on the lines the normals span, not on their signs.
+/// \param positions  N points
+/// \param normals    N normals (unit, or zero where undefined; zero ones are reached last)
+/// \param neighbors  an N by k neighbour table of the points
+[[nodiscard]] RiemannianForest riemannian_spanning_forest(std::span<const Vec3f> positions,
+                                                          std::span<const Vec3f> normals,
+                                                          const KnnTable& neighbors,
+                                                          const OrientationOptions& options = {});
+
+/// \brief Consistently oriented normals and what the orientation did.
+struct OrientedNormals
+{
+    /// N unit normals, consistently oriented; zero where a sample could not be oriented.
+    std::vector<Vec3f> normals;
+    /// Connected components of the Riemannian graph (each oriented from its own seed).
+    std::size_t components = 0;
+    /// Normals whose sign differs from the input's.
+    std::size_t flipped = 0;
+    /// Samples with no usable normal of their own that took one from a graph neighbour.
+    std::size_t inherited = 0;
+    /// Samples that could not be oriented (a component with no usable normal), ascending.
+    std::vector<std::uint32_t> unoriented;
+};
+
+/// \brief Orients normals consistently by propagation along a minimum spanning tree of the
+/// Riemannian graph (§4 step 2, after Hoppe et al. 1992).
+///
+/// Every connected component is handled on its own: its seed is its highest point (largest z),
+/// whose normal is turned to +z, and orientation spreads from it along the minimum spanning
+/// tree, each sample taking the sign that agrees with its tree parent under `options.rule`. Then, so that closed
+/// surfaces come out with outward normals whatever their shape, the component's normals are
+/// flipped if the area-weighted flux Σ a_i n_i·(p_i − c) (3 × the enclosed volume for a closed
+/// surface, by the divergence theorem) is clearly negative; for open, flat components the flux
+/// says little and the seed's +z stands. Samples with a zero normal (degenerate neighbourhoods)
+/// take their tree parent's normal and are counted in `inherited`.
+///
+/// \param positions  N points
+/// \param normals    N unoriented normals (unit, or zero where undefined)
+/// \param neighbors  an N by k neighbour table of the points (self entries are skipped); its
+///                   squared distances weight the flux (area ≈ squared k-th neighbour distance)
+/// \throw InvalidInput if the sizes disagree
+[[nodiscard]] OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
+                                                 std::span<const Vec3f> normals,
+                                                 const KnnTable& neighbors,
+                                                 const OrientationOptions& options = {});
+
+/// \brief Turns every normal towards a viewpoint: n·(viewpoint − p) ≥ 0 (scanner position).
+/// \param viewpoint  in the same frame as positions (subtract the cloud's origin first)
+[[nodiscard]] OrientedNormals orient_normals_towards(std::span<const Vec3f> positions,
+                                                     std::span<const Vec3f> normals,
+                                                     const Vec3d& viewpoint);
+
+/// \brief Turns every normal to agree with a direction: n·direction ≥ 0.
+/// \throw InvalidInput if direction is zero or not finite
+[[nodiscard]] OrientedNormals orient_normals_along(std::span<const Vec3f> normals,
+                                                   const Vec3d& direction);
+
+/// \brief Reverses every normal.
+[[nodiscard]] OrientedNormals flip_normals(std::span<const Vec3f> normals);
+
+} // namespace pointform

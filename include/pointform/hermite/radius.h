@@ -1,0 +1,68 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#pragma once
+
+#include "pointform/core/types.h"
+#include "pointform/geometry/aabb.h"
+#include "pointform/spatial/neighborhoods.h"
+
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace pointform {
+
+/// \brief Automatic influence radius (§4.1): for every point, the radius of the smallest ball
+/// centred at it that holds its k nearest neighbours (the distance to the k-th), times `scale`.
+/// \param neighbors  an N by k table with squared distances
+/// \param scale      user factor, > 0; 1 closes gaps up to about one sampling step, larger values
+///                   close larger holes in the field
+/// \throw InvalidInput if scale is not positive and finite
+[[nodiscard]] std::vector<float> influence_radii(const KnnTable& neighbors, double scale = 1.0);
+
+/// \brief A user region that sets the influence radius of the samples inside it (§4.1,
+/// interactive). Coordinates are world coordinates in the input's units.
+struct RadiusRegion
+{
+    enum class Kind
+    {
+        Ball,
+        Box,
+    };
+    Kind kind = Kind::Ball;
+    Vec3d center = Vec3d::Zero(); ///< Ball
+    double ball_radius = 0.0;     ///< Ball
+    Aabb box;                     ///< Box
+    /// The radius to set, in world units; used when `scale` is 0.
+    double radius = 0.0;
+    /// If > 0, multiplies the automatic radius instead of setting an absolute one.
+    double scale = 0.0;
+
+    [[nodiscard]] bool contains(const Vec3d& p) const;
+};
+
+/// \brief Reads regions from JSON:
+/// `{"regions": [{"ball": {"center": [x,y,z], "radius": R}, "set": r},
+///               {"box": {"min": [x,y,z], "max": [x,y,z]}, "scale": s}]}`.
+/// Each region has "set" (absolute radius) or "scale" (factor on the automatic radius).
+/// Later regions override earlier ones where they overlap.
+/// \throw IoError naming the file and what is wrong (syntax with line and column, a missing
+///        key, a negative or non-finite value)
+[[nodiscard]] std::vector<RadiusRegion> read_radius_regions(const std::filesystem::path& path);
+
+/// \brief Parses the same JSON from a string; `source` names it in error messages.
+[[nodiscard]] std::vector<RadiusRegion> parse_radius_regions(const std::string& json,
+                                                             const std::filesystem::path& source);
+
+/// \brief Applies regions to radii: every sample inside a region gets the region's radius.
+/// \param positions  N points, relative to `origin`
+/// \param radii      N automatic radii
+/// \return the new radii
+[[nodiscard]] std::vector<float> apply_radius_regions(std::span<const Vec3f> positions,
+                                                      const Vec3d& origin,
+                                                      std::vector<float> radii,
+                                                      std::span<const RadiusRegion> regions);
+
+} // namespace pointform

@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#pragma once
+
+#include "pointform/core/progress.h"
+#include "pointform/core/types.h"
+#include "pointform/spatial/neighborhoods.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+
+namespace pointform {
+
+/// \brief Options for building a KdTree.
+struct KdTreeOptions
+{
+    /// Maximum number of points in a leaf. 10 to 20 is a good range for 3-D queries; 0 = 12.
+    std::size_t leaf_size = 12;
+};
+
+/// \brief Options for batch queries.
+struct KnnOptions
+{
+    /// Optional progress report, called from one thread.
+    ProgressCallback progress;
+};
+
+/// \brief A kd-tree over float positions for exact k-nearest and radius queries.
+///
+/// Zero-copy: the tree refers to the caller's positions, which must outlive it and stay
+/// unchanged. Queries are const and may run concurrently. Results are exact (Euclidean, in the
+/// positions' units) and deterministic: ties are broken by the tree's fixed traversal order.
+class KdTree
+{
+public:
+    /// \param positions  N points; N may be 0 (then every query returns nothing)
+    /// \throw InvalidInput if N exceeds 2^32 - 1
+    explicit KdTree(std::span<const Vec3f> positions, const KdTreeOptions& options = {});
+    ~KdTree();
+    KdTree(KdTree&&) noexcept;
+    KdTree& operator=(KdTree&&) noexcept;
+    KdTree(const KdTree&) = delete;
+    KdTree& operator=(const KdTree&) = delete;
+
+    [[nodiscard]] std::size_t size() const;
+    [[nodiscard]] std::span<const Vec3f> positions() const;
+
+    /// \brief The k nearest points to `query` (a point of the tree is its own nearest).
+    /// \param indices, squared_distances  caller buffers of size >= k, filled nearest first
+    /// \return the number found, min(k, size())
+    std::size_t knn(const Vec3f& query, std::size_t k, std::span<std::uint32_t> indices,
+                    std::span<float> squared_distances) const;
+
+    /// \brief The single nearest point; returns its index, or invalid if the tree is empty.
+    [[nodiscard]] PointId nearest(const Vec3f& query, float* squared_distance = nullptr) const;
+
+    /// \brief Appends to the buffers every point within `radius` of `query`, nearest first.
+    /// \return the number appended
+    std::size_t radius_search(const Vec3f& query, float radius,
+                              std::vector<std::uint32_t>& indices,
+                              std::vector<float>& squared_distances) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// \brief k nearest neighbours of every query, in parallel.
+/// \param queries  M query points (may be the tree's own positions)
+/// \param k        neighbours a query, 1 <= k <= tree.size()
+/// \return an M by k table
+/// \throw InvalidInput if k is 0 or larger than the tree
+[[nodiscard]] KnnTable knn_batch(const KdTree& tree, std::span<const Vec3f> queries, std::size_t k,
+                                 const KnnOptions& options = {});
+
+/// \brief All points within `radius` of every query, in parallel, as CSR.
+/// \throw InvalidInput if radius is negative or not finite
+[[nodiscard]] RadiusTable radius_batch(const KdTree& tree, std::span<const Vec3f> queries,
+                                       float radius, const KnnOptions& options = {});
+
+} // namespace pointform

@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace pointform {
+
+/// \brief k nearest neighbours of N query points as a flat N by k table (row i lists the
+/// neighbours of query i, nearest first) with the matching squared distances.
+struct KnnTable
+{
+    KnnTable() = default; // not an aggregate: `{.k = 16}` means options, never a table
+
+    std::size_t k = 0;
+    std::vector<std::uint32_t> indices;  ///< N*k, row-major
+    std::vector<float> squared_distances; ///< N*k, row-major, non-decreasing within a row
+
+    [[nodiscard]] std::size_t rows() const { return k == 0 ? 0 : indices.size() / k; }
+    [[nodiscard]] std::span<const std::uint32_t> neighbors(std::size_t i) const
+    {
+        return {indices.data() + i * k, k};
+    }
+    [[nodiscard]] std::span<const float> distances2(std::size_t i) const
+    {
+        return {squared_distances.data() + i * k, k};
+    }
+};
+
+/// \brief Variable-size neighbourhoods in compressed sparse row form: the neighbours of query i
+/// are indices[offsets[i] .. offsets[i+1]), nearest first.
+struct RadiusTable
+{
+    RadiusTable() = default;
+
+    std::vector<std::size_t> offsets; ///< N+1
+    std::vector<std::uint32_t> indices;
+    std::vector<float> squared_distances;
+
+    [[nodiscard]] std::size_t rows() const { return offsets.empty() ? 0 : offsets.size() - 1; }
+    [[nodiscard]] std::span<const std::uint32_t> neighbors(std::size_t i) const
+    {
+        return {indices.data() + offsets[i], offsets[i + 1] - offsets[i]};
+    }
+    [[nodiscard]] std::span<const float> distances2(std::size_t i) const
+    {
+        return {squared_distances.data() + offsets[i], offsets[i + 1] - offsets[i]};
+    }
+};
+
+} // namespace pointform

@@ -1,0 +1,47 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/geometry/point_cloud.h"
+
+#include "pointform/core/error.h"
+
+#include <cmath>
+#include <string>
+
+namespace pointform {
+
+Aabb bounding_box(std::span<const Vec3f> positions, const Vec3d& origin)
+{
+    Aabb box;
+    if (positions.empty())
+        return box;
+    Eigen::Vector3f lo = positions[0];
+    Eigen::Vector3f hi = positions[0];
+    for (const auto& p : positions)
+    {
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+    }
+    box.min = origin + lo.cast<double>();
+    box.max = origin + hi.cast<double>();
+    return box;
+}
+
+Vec3d choose_origin(const Vec3d& first)
+{
+    return {std::round(first.x()), std::round(first.y()), std::round(first.z())};
+}
+
+void validate(const PointCloud& cloud)
+{
+    const auto check = [&](std::size_t size, const char* name) {
+        if (size != 0 && size != cloud.size())
+            throw InvalidInput(std::string("point cloud has ") + std::to_string(cloud.size()) +
+                               " positions but " + std::to_string(size) + " " + name);
+    };
+    check(cloud.normals.size(), "normals");
+    check(cloud.colors.size(), "colors");
+    check(cloud.radii.size(), "radii");
+}
+
+} // namespace pointform

@@ -1,0 +1,95 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/hermite/normals.h"
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+#include "pointform/spatial/kd_tree.h"
+
+#include <Eigen/Eigenvalues>
+
+#include <string>
+
+namespace pointform {
+namespace {
+
+/// Below this ratio λ1/λ2 the neighbourhood is taken as a line (or a point): its normal is
+/// undefined. Relative, so independent of units.
+constexpr double collinear_ratio = 1e-10;
+
+} // namespace
+
+PlaneFit fit_plane(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices)
+{
+    PF_ASSERT(!indices.empty());
+    PlaneFit fit;
+    // Shift by the first point so the sums do not lose precision far from the origin.
+    const Vec3d shift = positions[indices[0]].cast<double>();
+    Vec3d sum = Vec3d::Zero();
+    Mat3d outer = Mat3d::Zero();
+    for (const auto index : indices)
+    {
+        const Vec3d p = positions[index].cast<double>() - shift;
+        sum += p;
+        outer.noalias() += p * p.transpose();
+    }
+    const double count = static_cast<double>(indices.size());
+    const Vec3d mean = sum / count;
+    const Mat3d covariance = outer / count - mean * mean.transpose();
+    fit.centroid = mean + shift;
+
+    Eigen::SelfAdjointEigenSolver<Mat3d> solver;
+    solver.computeDirect(covariance);
+    fit.eigenvalues = solver.eigenvalues().cwiseMax(0.0);
+    const double largest = fit.eigenvalues[2];
+    fit.degenerate = !(largest > 0.0) || fit.eigenvalues[1] <= collinear_ratio * largest ||
+                     !solver.eigenvectors().allFinite();
+    if (!fit.degenerate)
+        fit.normal = solver.eigenvectors().col(0).normalized();
+    return fit;
+}
+
+Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
+                         const ProgressCallback& progress)
+{
+    if (neighbors.rows() != positions.size())
+        throw InvalidInput("estimate_normals: neighbour table has " +
+                           std::to_string(neighbors.rows()) + " rows for " +
+                           std::to_string(positions.size()) + " points");
+    Normals result;
+    result.normals.resize(positions.size());
+    std::vector<std::uint8_t> degenerate(positions.size(), 0);
+    ProgressReporter reporter(progress, "normals");
+    parallel_blocks(
+        positions.size(), 4096,
+        [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                const PlaneFit fit = fit_plane(positions, neighbors.neighbors(i));
+                result.normals[i] = fit.normal.cast<float>();
+                degenerate[i] = fit.degenerate ? 1 : 0;
+            }
+        },
+        &reporter);
+    reporter.finish();
+    for (std::size_t i = 0; i < degenerate.size(); ++i)
+        if (degenerate[i] != 0)
+            result.degenerate.push_back(static_cast<std::uint32_t>(i));
+    return result;
+}
+
+Normals estimate_normals(std::span<const Vec3f> positions, const NormalOptions& options)
+{
+    if (options.k < 3)
+        throw InvalidInput("estimate_normals: k = " + std::to_string(options.k) +
+                           " is too small; a plane needs at least 3 neighbours");
+    if (positions.size() < options.k)
+        throw InvalidInput("estimate_normals: " + std::to_string(positions.size()) +
+                           " points are fewer than k = " + std::to_string(options.k));
+    const KdTree tree(positions);
+    const KnnTable table = knn_batch(tree, positions, options.k, {.progress = options.progress});
+    return estimate_normals(positions, table, options.progress);
+}
+
+} // namespace pointform

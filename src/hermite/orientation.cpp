@@ -1,0 +1,381 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/hermite/orientation.h"
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+
+#include <algorithm>
+#include <bit>
+#include <numeric>
+#include <utility>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace pointform {
+namespace {
+
+/// The flux test overrides the seed's +z only when |flux| exceeds this fraction of
+/// Σ a_i |p_i − c|. A closed convex surface scores 1, closed non-convex shapes (bunny, torus)
+/// well above 0.3, while open sheets such as terrain or a flat scan score near 0 and keep the
+/// seed's upward orientation.
+constexpr double flux_decision_threshold = 0.1;
+
+/// An undirected edge of the Riemannian graph with its cost. The cost is a non-negative float, so
+/// its bit pattern orders like its value.
+struct WeightedEdge
+{
+    std::uint32_t cost_bits;
+    std::uint32_t a;
+    std::uint32_t b;
+
+    [[nodiscard]] float cost() const { return std::bit_cast<float>(cost_bits); }
+};
+
+bool row_contains(const KnnTable& table, std::size_t row, std::size_t columns, std::uint32_t value)
+{
+    const auto nbrs = table.neighbors(row).first(columns);
+    return std::find(nbrs.begin(), nbrs.end(), value) != nbrs.end();
+}
+
+/// Union-find with path halving and union by size.
+class DisjointSets
+{
+public:
+    explicit DisjointSets(std::size_t n) : parent_(n), size_(n, 1)
+    {
+        std::iota(parent_.begin(), parent_.end(), 0U);
+    }
+
+    std::uint32_t find(std::uint32_t x)
+    {
+        while (parent_[x] != x)
+            x = parent_[x] = parent_[parent_[x]];
+        return x;
+    }
+
+    /// Joins the sets of a and b; false if they were one already.
+    bool unite(std::uint32_t a, std::uint32_t b)
+    {
+        a = find(a);
+        b = find(b);
+        if (a == b)
+            return false;
+        if (size_[a] < size_[b])
+            std::swap(a, b);
+        parent_[b] = a;
+        size_[a] += size_[b];
+        return true;
+    }
+
+private:
+    std::vector<std::uint32_t> parent_;
+    std::vector<std::uint32_t> size_;
+};
+
+/// Stable LSD radix sort of edges by cost (three 11-bit digits): ties keep their order.
+void sort_by_cost(std::vector<WeightedEdge>& edges)
+{
+    constexpr unsigned digit_bits = 11;
+    constexpr std::size_t buckets = std::size_t{1} << digit_bits;
+    std::vector<WeightedEdge> buffer(edges.size());
+    std::vector<std::size_t> count(buckets);
+    for (unsigned shift = 0; shift < 32; shift += digit_bits)
+    {
+        std::fill(count.begin(), count.end(), 0);
+        for (const auto& e : edges)
+            ++count[(e.cost_bits >> shift) & (buckets - 1)];
+        if (count[(edges.front().cost_bits >> shift) & (buckets - 1)] == edges.size())
+            continue; // every key has this digit: the pass would not move anything
+        std::size_t sum = 0;
+        for (auto& c : count)
+            sum += std::exchange(c, sum);
+        for (const auto& e : edges)
+            buffer[count[(e.cost_bits >> shift) & (buckets - 1)]++] = e;
+        edges.swap(buffer);
+    }
+}
+
+bool usable(const Vec3f& n)
+{
+    return n.squaredNorm() > 0.5F;
+}
+
+/// Signed agreement of n_b with the orientation that rule predicts from n_a: its sign says whether
+/// b agrees with a, its magnitude how certain that is.
+float agreement(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
+                OrientationRule rule, std::uint32_t a, std::uint32_t b)
+{
+    const Vec3f& na = normals[a];
+    const Vec3f& nb = normals[b];
+    if (rule == OrientationRule::Reflection)
+    {
+        const Vec3f e = positions[b] - positions[a];
+        const float len2 = e.squaredNorm();
+        if (len2 > 0.0F)
+        {
+            const Vec3f predicted = na - (2.0F * na.dot(e) / len2) * e;
+            return nb.dot(predicted);
+        }
+    }
+    return na.dot(nb);
+}
+
+float edge_cost(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
+                OrientationRule rule, std::uint32_t a, std::uint32_t b)
+{
+    if (!usable(normals[a]) || !usable(normals[b]))
+        return 2.0F; // worst: reach samples without a normal last
+    // Clamped: |n_a·n_b| may round above 1, and a negative cost would sort last as raw bits.
+    return std::max(0.0F, 1.0F - std::abs(agreement(positions, normals, rule, a, b)));
+}
+
+std::size_t count_flipped(std::span<const Vec3f> before, std::span<const Vec3f> after)
+{
+    std::size_t flipped = 0;
+    for (std::size_t i = 0; i < before.size(); ++i)
+        if (before[i].dot(after[i]) < 0.0F)
+            ++flipped;
+    return flipped;
+}
+
+} // namespace
+
+RiemannianForest riemannian_spanning_forest(std::span<const Vec3f> positions,
+                                            std::span<const Vec3f> normals,
+                                            const KnnTable& neighbors,
+                                            const OrientationOptions& options)
+{
+    const std::size_t n = positions.size();
+    if (normals.size() != n || neighbors.rows() != n)
+        throw InvalidInput("orientation: " + std::to_string(n) + " points, " +
+                           std::to_string(normals.size()) + " normals and " +
+                           std::to_string(neighbors.rows()) + " neighbour rows must agree");
+    if (n >= RiemannianForest::none)
+        throw InvalidInput("orientation: too many points for 32-bit indices");
+    RiemannianForest forest;
+    forest.parent.assign(n, RiemannianForest::none);
+    forest.component.assign(n, RiemannianForest::none);
+    if (n == 0)
+        return forest;
+    ProgressReporter progress(options.progress, "orientation");
+    const std::size_t columns = options.k == 0 ? neighbors.k : std::min(options.k, neighbors.k);
+
+    // 1. The Riemannian graph's edges, each once: {i, j} from row i unless row j lists i too and
+    //    j < i. Built in parallel blocks and concatenated in order (deterministic).
+    constexpr std::size_t block = 8192;
+    std::vector<std::vector<WeightedEdge>> parts((n + block - 1) / block);
+    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        auto& part = parts[begin / block];
+        part.reserve((end - begin) * columns);
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            const auto a = static_cast<std::uint32_t>(i);
+            for (const std::uint32_t b : neighbors.neighbors(i).first(columns))
+            {
+                if (b == a || (b < a && row_contains(neighbors, b, columns, a)))
+                    continue;
+                const float cost = edge_cost(positions, normals, options.rule, a, b);
+                part.push_back({std::bit_cast<std::uint32_t>(cost), a, b});
+            }
+        }
+    });
+    std::vector<WeightedEdge> edges;
+    std::size_t total = 0;
+    for (const auto& part : parts)
+        total += part.size();
+    edges.reserve(total);
+    for (auto& part : parts)
+    {
+        edges.insert(edges.end(), part.begin(), part.end());
+        std::vector<WeightedEdge>().swap(part);
+    }
+    progress.update(0.3, 1.0);
+
+    // 2. Kruskal: cheapest edges first, keep those that join two trees.
+    if (!edges.empty())
+        sort_by_cost(edges);
+    progress.update(0.6, 1.0);
+    DisjointSets sets(n);
+    std::vector<std::uint32_t> degree(n + 1, 0);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> tree_edges;
+    tree_edges.reserve(n);
+    for (const auto& e : edges)
+        if (sets.unite(e.a, e.b))
+        {
+            tree_edges.emplace_back(e.a, e.b);
+            forest.total_cost += static_cast<double>(e.cost());
+            ++degree[e.a + 1];
+            ++degree[e.b + 1];
+        }
+    std::vector<WeightedEdge>().swap(edges);
+
+    // 3. Components numbered by smallest sample; root = highest sample with a usable normal.
+    std::vector<std::uint32_t> label_of_set(n, RiemannianForest::none);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+        std::uint32_t& label = label_of_set[sets.find(static_cast<std::uint32_t>(i))];
+        if (label == RiemannianForest::none)
+        {
+            label = static_cast<std::uint32_t>(forest.roots.size());
+            forest.roots.push_back(RiemannianForest::none);
+        }
+        forest.component[i] = label;
+        if (!usable(normals[i]))
+            continue;
+        std::uint32_t& root = forest.roots[label];
+        if (root == RiemannianForest::none || positions[i].z() > positions[root].z())
+            root = static_cast<std::uint32_t>(i);
+    }
+
+    // 4. Each tree walked breadth-first from its root: parents and a parent-first order.
+    for (std::size_t i = 0; i < n; ++i)
+        degree[i + 1] += degree[i];
+    std::vector<std::uint32_t> adjacent(degree[n]);
+    {
+        std::vector<std::uint32_t> fill(degree.begin(), degree.end() - 1);
+        for (const auto& [a, b] : tree_edges)
+        {
+            adjacent[fill[a]++] = b;
+            adjacent[fill[b]++] = a;
+        }
+    }
+    forest.order.reserve(n);
+    for (const std::uint32_t root : forest.roots)
+    {
+        if (root == RiemannianForest::none)
+            continue;
+        forest.parent[root] = root;
+        std::size_t head = forest.order.size();
+        forest.order.push_back(root);
+        while (head < forest.order.size())
+        {
+            const std::uint32_t v = forest.order[head++];
+            for (std::uint32_t e = degree[v]; e < degree[v + 1]; ++e)
+            {
+                const std::uint32_t w = adjacent[e];
+                if (forest.parent[w] == RiemannianForest::none)
+                {
+                    forest.parent[w] = v;
+                    forest.order.push_back(w);
+                }
+            }
+        }
+    }
+    progress.finish();
+    return forest;
+}
+
+OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
+                                   std::span<const Vec3f> normals, const KnnTable& neighbors,
+                                   const OrientationOptions& options)
+{
+    const RiemannianForest forest =
+        riemannian_spanning_forest(positions, normals, neighbors, options);
+    const std::size_t n = positions.size();
+    OrientedNormals result;
+    result.normals.assign(normals.begin(), normals.end());
+    result.components = forest.roots.size();
+
+    // Propagate along the trees: the root turns to +z, every child agrees with its parent.
+    for (const std::uint32_t v : forest.order)
+    {
+        Vec3f& normal = result.normals[v];
+        const std::uint32_t parent = forest.parent[v];
+        if (parent == v)
+        {
+            if (normal.z() < 0.0F)
+                normal = -normal;
+            continue;
+        }
+        const Vec3f& reference = result.normals[parent];
+        if (!usable(normal))
+        {
+            normal = reference;
+            ++result.inherited;
+        }
+        else if (agreement(positions, result.normals, options.rule, parent, v) < 0.0F)
+            normal = -normal;
+    }
+
+    // Flux test per component: Σ a_i n_i·(p_i − c), with a_i ≈ squared k-th neighbour distance.
+    const std::size_t component_count = forest.roots.size();
+    std::vector<Vec3d> centroid(component_count, Vec3d::Zero());
+    std::vector<double> count(component_count, 0.0);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+        centroid[forest.component[i]] += positions[i].cast<double>();
+        count[forest.component[i]] += 1.0;
+    }
+    for (std::size_t c = 0; c < component_count; ++c)
+        centroid[c] /= count[c];
+    std::vector<double> flux(component_count, 0.0);
+    std::vector<double> magnitude(component_count, 0.0);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+        const std::uint32_t c = forest.component[i];
+        const double area = neighbors.distances2(i).back();
+        const Vec3d d = positions[i].cast<double>() - centroid[c];
+        flux[c] += area * result.normals[i].cast<double>().dot(d);
+        magnitude[c] += area * d.norm();
+    }
+    for (std::size_t i = 0; i < n; ++i)
+    {
+        const std::uint32_t c = forest.component[i];
+        if (forest.parent[i] == RiemannianForest::none)
+        {
+            result.normals[i].setZero();
+            result.unoriented.push_back(static_cast<std::uint32_t>(i));
+        }
+        else if (flux[c] < -flux_decision_threshold * magnitude[c])
+            result.normals[i] = -result.normals[i];
+    }
+    result.flipped = count_flipped(normals, result.normals);
+    return result;
+}
+
+OrientedNormals orient_normals_towards(std::span<const Vec3f> positions,
+                                       std::span<const Vec3f> normals, const Vec3d& viewpoint)
+{
+    if (normals.size() != positions.size())
+        throw InvalidInput("orient_normals_towards: sizes of points and normals differ");
+    if (!viewpoint.allFinite())
+        throw InvalidInput("orient_normals_towards: viewpoint must be finite");
+    OrientedNormals result;
+    result.normals.assign(normals.begin(), normals.end());
+    for (std::size_t i = 0; i < positions.size(); ++i)
+    {
+        const Vec3d to_view = viewpoint - positions[i].cast<double>();
+        if (result.normals[i].cast<double>().dot(to_view) < 0.0)
+            result.normals[i] = -result.normals[i];
+    }
+    result.flipped = count_flipped(normals, result.normals);
+    return result;
+}
+
+OrientedNormals orient_normals_along(std::span<const Vec3f> normals, const Vec3d& direction)
+{
+    if (!direction.allFinite() || direction.squaredNorm() == 0.0)
+        throw InvalidInput("orient_normals_along: direction must be finite and non-zero");
+    OrientedNormals result;
+    result.normals.assign(normals.begin(), normals.end());
+    for (auto& n : result.normals)
+        if (n.cast<double>().dot(direction) < 0.0)
+            n = -n;
+    result.flipped = count_flipped(normals, result.normals);
+    return result;
+}
+
+OrientedNormals flip_normals(std::span<const Vec3f> normals)
+{
+    OrientedNormals result;
+    result.normals.reserve(normals.size());
+    for (const auto& n : normals)
+        result.normals.push_back(-n);
+    result.flipped = normals.size();
+    return result;
+}
+
+} // namespace pointform

@@ -1,0 +1,391 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#pragma once
+
+// Private to src/io: the per-format readers and writers, and the helpers they share (a byte
+// cursor that tracks its offset, endian conversion, a line reader that counts lines, number
+// parsing, a point-cloud builder that applies the origin and the non-finite policy, and a
+// buffered output sink).
+
+#include "pointform/core/error.h"
+#include "pointform/io/io.h"
+
+#include <bit>
+#include <charconv>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+namespace pointform::detail
+{
+
+/// Where in a file a problem was found: a 1-based line (text) or a byte offset (binary).
+struct Location
+{
+    std::optional<std::uint64_t> line;
+    std::optional<std::uint64_t> offset;
+
+    static Location at_line(std::uint64_t line) { return {line, std::nullopt}; }
+    static Location at_byte(std::uint64_t offset) { return {std::nullopt, offset}; }
+};
+
+[[noreturn]] inline void fail(const std::filesystem::path& path, const std::string& what,
+                              Location where = {})
+{
+    throw IoError(path, what, where.line, where.offset);
+}
+
+enum class ByteOrder
+{
+    Little,
+    Big,
+};
+
+constexpr ByteOrder native_byte_order =
+    std::endian::native == std::endian::little ? ByteOrder::Little : ByteOrder::Big;
+
+template <typename T>
+[[nodiscard]] T byte_swap(T value)
+{
+    static_assert(std::is_trivially_copyable_v<T>);
+    unsigned char bytes[sizeof(T)];
+    std::memcpy(bytes, &value, sizeof(T));
+    for (std::size_t i = 0; i < sizeof(T) / 2; ++i)
+    {
+        const unsigned char tmp = bytes[i];
+        bytes[i] = bytes[sizeof(T) - 1 - i];
+        bytes[sizeof(T) - 1 - i] = tmp;
+    }
+    std::memcpy(&value, bytes, sizeof(T));
+    return value;
+}
+
+/// Loads a T stored in `order` at `p` (no alignment needed).
+template <typename T>
+[[nodiscard]] T load(const char* p, ByteOrder order)
+{
+    T value;
+    std::memcpy(&value, p, sizeof(T));
+    return order == native_byte_order ? value : byte_swap(value);
+}
+
+/// A read position over a file's bytes that knows its offset, so that every error can name it.
+class ByteCursor
+{
+public:
+    ByteCursor(const std::filesystem::path& path, std::string_view bytes, std::size_t offset = 0)
+        : path_(&path), bytes_(bytes), offset_(offset)
+    {
+    }
+
+    [[nodiscard]] std::size_t offset() const { return offset_; }
+    [[nodiscard]] std::size_t remaining() const { return bytes_.size() - offset_; }
+    [[nodiscard]] const char* data() const { return bytes_.data() + offset_; }
+    [[nodiscard]] const std::filesystem::path& path() const { return *path_; }
+
+    /// Throws a "truncated" IoError at the current offset unless `n` more bytes are available.
+    void require(std::uint64_t n, std::string_view what) const
+    {
+        if (n > remaining())
+            fail(*path_,
+                 "file is truncated: " + std::string(what) + " needs " + std::to_string(n) +
+                     " bytes but only " + std::to_string(remaining()) + " remain",
+                 Location::at_byte(offset_));
+    }
+
+    template <typename T>
+    [[nodiscard]] T read(ByteOrder order, std::string_view what)
+    {
+        require(sizeof(T), what);
+        const T value = load<T>(data(), order);
+        offset_ += sizeof(T);
+        return value;
+    }
+
+    template <typename T>
+    [[nodiscard]] T read_le(std::string_view what)
+    {
+        return read<T>(ByteOrder::Little, what);
+    }
+
+    void skip(std::uint64_t n, std::string_view what)
+    {
+        require(n, what);
+        offset_ += static_cast<std::size_t>(n);
+    }
+
+    void seek(std::size_t offset) { offset_ = offset; }
+
+private:
+    const std::filesystem::path* path_;
+    std::string_view bytes_;
+    std::size_t offset_;
+};
+
+/// Splits text into lines (without '\n' or a trailing '\r') and counts them from 1.
+class LineReader
+{
+public:
+    explicit LineReader(std::string_view text, std::size_t start = 0,
+                        std::uint64_t lines_before = 0)
+        : text_(text), pos_(start), line_(lines_before)
+    {
+    }
+
+    /// Next line, or false at the end of the text.
+    bool next(std::string_view& line)
+    {
+        if (pos_ >= text_.size())
+            return false;
+        const std::size_t end = text_.find('\n', pos_);
+        const std::size_t stop = end == std::string_view::npos ? text_.size() : end;
+        line = text_.substr(pos_, stop - pos_);
+        if (!line.empty() && line.back() == '\r')
+            line.remove_suffix(1);
+        pos_ = end == std::string_view::npos ? text_.size() : end + 1;
+        ++line_;
+        return true;
+    }
+
+    /// 1-based number of the line last returned (0 before the first).
+    [[nodiscard]] std::uint64_t line_number() const { return line_; }
+    /// Byte offset just past the line last returned.
+    [[nodiscard]] std::size_t offset() const { return pos_; }
+    [[nodiscard]] std::size_t remaining() const { return text_.size() - pos_; }
+
+private:
+    std::string_view text_;
+    std::size_t pos_;
+    std::uint64_t line_;
+};
+
+[[nodiscard]] constexpr bool is_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v' || c == '\n';
+}
+
+/// Takes the next token off `rest`. Separators are white space, plus ',' if `commas`.
+/// Returns false when no token is left.
+inline bool next_token(std::string_view& rest, std::string_view& token, bool commas = false)
+{
+    std::size_t i = 0;
+    const std::size_t n = rest.size();
+    while (i < n && (is_space(rest[i]) || (commas && rest[i] == ',')))
+        ++i;
+    if (i == n)
+    {
+        rest = {};
+        return false;
+    }
+    std::size_t j = i;
+    while (j < n && !is_space(rest[j]) && !(commas && rest[j] == ','))
+        ++j;
+    token = rest.substr(i, j - i);
+    rest.remove_prefix(j);
+    return true;
+}
+
+/// Text with leading and trailing white space removed.
+[[nodiscard]] inline std::string_view trim(std::string_view text)
+{
+    while (!text.empty() && is_space(text.front()))
+        text.remove_prefix(1);
+    while (!text.empty() && is_space(text.back()))
+        text.remove_suffix(1);
+    return text;
+}
+
+/// Parses a whole token as a double (accepts a leading '+', "nan" and "inf").
+[[nodiscard]] inline bool parse_double(std::string_view token, double& value)
+{
+    const char* first = token.data();
+    const char* last = token.data() + token.size();
+    if (first != last && *first == '+')
+        ++first;
+    const auto [ptr, ec] = std::from_chars(first, last, value);
+    return ec == std::errc() && ptr == last && first != last;
+}
+
+/// Parses a whole token as an integer of type T (accepts a leading '+' for signed and unsigned).
+template <typename T>
+[[nodiscard]] bool parse_integer(std::string_view token, T& value)
+{
+    const char* first = token.data();
+    const char* last = token.data() + token.size();
+    if (first != last && *first == '+')
+        ++first;
+    const auto [ptr, ec] = std::from_chars(first, last, value);
+    return ec == std::errc() && ptr == last && first != last;
+}
+
+/// Short, printable excerpt of a token for error messages.
+[[nodiscard]] inline std::string quote(std::string_view token)
+{
+    constexpr std::size_t max_length = 40;
+    std::string out = "'";
+    for (const char c : token.substr(0, max_length))
+        out += (c >= 32 && c < 127) ? c : '?';
+    if (token.size() > max_length)
+        out += "...";
+    out += "'";
+    return out;
+}
+
+/// Lower-case ASCII copy.
+[[nodiscard]] std::string to_lower(std::string_view text);
+
+/// Which optional attributes a reader fills.
+struct AttributeSet
+{
+    bool normals = false;
+    bool colors = false;
+    bool radii = false;
+};
+
+/// One point as a reader sees it, in world coordinates.
+struct PointRecord
+{
+    Vec3d position = Vec3d::Zero();
+    Vec3f normal = Vec3f::Zero();
+    Color color;
+    float radius = 0.0F;
+};
+
+/// Resolves NonFinitePolicy::FormatDefault: Drop for PCD, Error for everything else.
+[[nodiscard]] NonFinitePolicy resolve_policy(NonFinitePolicy policy, FileFormat format);
+
+/// Collects points into a PointCloud: chooses the origin from the first kept point, stores
+/// positions as float relative to it, normalizes normals, and applies the non-finite policy.
+class CloudBuilder
+{
+public:
+    /// \param expected  number of points announced by the header (already capped by file size)
+    CloudBuilder(const std::filesystem::path& path, NonFinitePolicy policy, AttributeSet attributes,
+                 std::size_t expected);
+
+    /// Adds a point. Returns false if it was dropped (non-finite coordinates under Drop).
+    /// Throws IoError at `where` for non-finite coordinates under Error.
+    bool add(const PointRecord& point, Location where);
+
+    [[nodiscard]] std::size_t dropped() const { return dropped_; }
+
+    /// Throws if points were dropped from a file that has faces (the indices would be wrong).
+    void check_no_drops_with_faces(bool has_faces) const;
+
+    /// Hands the cloud over; the builder is empty afterwards.
+    [[nodiscard]] PointCloud take();
+
+private:
+    const std::filesystem::path* path_;
+    NonFinitePolicy policy_;
+    AttributeSet attributes_;
+    PointCloud cloud_;
+    bool has_origin_ = false;
+    std::size_t dropped_ = 0;
+    Location first_dropped_;
+};
+
+/// How many elements to reserve when a header announces `declared` items of at least
+/// `min_bytes` each and `available` bytes remain: never more than the file can hold.
+[[nodiscard]] constexpr std::size_t capped_reserve(std::uint64_t declared, std::uint64_t available,
+                                                   std::uint64_t min_bytes)
+{
+    const std::uint64_t fit = available / (min_bytes == 0 ? 1 : min_bytes);
+    return static_cast<std::size_t>(declared < fit ? declared : fit);
+}
+
+/// Fan-triangulates a polygon given by its vertex indices (fewer than 3 adds nothing).
+inline void append_fan(std::vector<Triangle>& triangles, std::span<const std::uint32_t> polygon)
+{
+    for (std::size_t k = 2; k < polygon.size(); ++k)
+        triangles.push_back({polygon[0], polygon[k - 1], polygon[k]});
+}
+
+/// Buffered writer over a FILE*; throws IoError naming the file when a write fails.
+class OutputBuffer
+{
+public:
+    OutputBuffer(std::FILE* file, const std::filesystem::path& path);
+    OutputBuffer(const OutputBuffer&) = delete;
+    OutputBuffer& operator=(const OutputBuffer&) = delete;
+    ~OutputBuffer() = default;
+
+    void write(std::string_view bytes)
+    {
+        if (buffer_.size() + bytes.size() > capacity)
+            flush();
+        buffer_.append(bytes);
+    }
+
+    void put(char c)
+    {
+        if (buffer_.size() + 1 > capacity)
+            flush();
+        buffer_.push_back(c);
+    }
+
+    /// Writes the bytes of `value` little-endian.
+    template <typename T>
+    void write_le(T value)
+    {
+        if constexpr (native_byte_order != ByteOrder::Little)
+            value = byte_swap(value);
+        char bytes[sizeof(T)];
+        std::memcpy(bytes, &value, sizeof(T));
+        write(std::string_view(bytes, sizeof(T)));
+    }
+
+    /// Shortest text that reads back as the same float.
+    void write_number(float value);
+    /// Shortest round-trip text of a double, or `precision` significant digits if > 0.
+    void write_number(double value, int precision);
+    void write_integer(std::uint64_t value);
+
+    /// Writes out everything buffered. Throws IoError on failure.
+    void flush();
+
+private:
+    static constexpr std::size_t capacity = std::size_t{1} << 20;
+
+    std::FILE* file_;
+    const std::filesystem::path* path_;
+    std::string buffer_;
+};
+
+/// Writes the world position of point i as "x y z" text: float shortest when the origin is zero
+/// and no precision is asked, else the double world value.
+void write_world_text(OutputBuffer& out, const PointCloud& cloud, std::size_t i, int precision);
+
+[[nodiscard]] ReadResult read_ply(const std::filesystem::path& path, std::string_view bytes,
+                                  NonFinitePolicy policy);
+/// \param pts_hint  the file name ends in .pts (a 7-column file is x y z intensity r g b)
+[[nodiscard]] ReadResult read_text(const std::filesystem::path& path, std::string_view bytes,
+                                   NonFinitePolicy policy, bool pts_hint);
+[[nodiscard]] ReadResult read_off(const std::filesystem::path& path, std::string_view bytes,
+                                  NonFinitePolicy policy);
+[[nodiscard]] ReadResult read_obj(const std::filesystem::path& path, std::string_view bytes,
+                                  NonFinitePolicy policy);
+[[nodiscard]] ReadResult read_pcd(const std::filesystem::path& path, std::string_view bytes,
+                                  NonFinitePolicy policy);
+[[nodiscard]] ReadResult read_las(const std::filesystem::path& path, std::string_view bytes,
+                                  NonFinitePolicy policy);
+
+/// Decompresses an LZF stream into exactly `output.size()` bytes. Returns false if the stream
+/// is malformed, refers outside the output, or does not fill the output exactly.
+[[nodiscard]] bool lzf_decompress(std::string_view input, std::span<char> output);
+
+void write_ply(OutputBuffer& out, const PointCloud& cloud, std::span<const Triangle> triangles,
+               bool ascii, int precision);
+void write_xyz(OutputBuffer& out, const PointCloud& cloud, int precision);
+void write_off(OutputBuffer& out, const TriMesh& mesh, int precision);
+void write_obj(OutputBuffer& out, const TriMesh& mesh, int precision);
+
+}  // namespace pointform::detail

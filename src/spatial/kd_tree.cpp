@@ -1,0 +1,192 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/spatial/kd_tree.h"
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+
+// Equal distances are ordered by index, so results do not depend on the tree's layout.
+#define NANOFLANN_FIRST_MATCH
+#include <nanoflann.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+
+namespace pointform {
+namespace {
+
+/// nanoflann's dataset adaptor over the caller's positions: no copy.
+struct PositionSpan
+{
+    std::span<const Vec3f> points;
+
+    [[nodiscard]] std::size_t kdtree_get_point_count() const { return points.size(); }
+    [[nodiscard]] float kdtree_get_pt(std::size_t i, std::size_t dim) const
+    {
+        return points[i][static_cast<Eigen::Index>(dim)];
+    }
+    template <class Box>
+    bool kdtree_get_bbox(Box& /*box*/) const
+    {
+        return false;
+    }
+};
+
+using NanoTree = nanoflann::KDTreeSingleIndexAdaptor<
+    nanoflann::L2_Simple_Adaptor<float, PositionSpan, float, std::uint32_t>, PositionSpan, 3,
+    std::uint32_t>;
+
+constexpr std::size_t query_block = 2048;
+
+} // namespace
+
+struct KdTree::Impl
+{
+    PositionSpan data;
+    NanoTree tree;
+
+    Impl(std::span<const Vec3f> points, std::size_t leaf)
+        : data{points}, tree(3, data, nanoflann::KDTreeSingleIndexAdaptorParams(leaf))
+    {
+        if (!points.empty())
+            tree.buildIndex();
+    }
+};
+
+KdTree::KdTree(std::span<const Vec3f> positions, const KdTreeOptions& options)
+{
+    if (positions.size() >= std::numeric_limits<std::uint32_t>::max())
+        throw InvalidInput("kd-tree: " + std::to_string(positions.size()) +
+                           " points exceed the 32-bit index range");
+    impl_ = std::make_unique<Impl>(positions, options.leaf_size == 0 ? 12 : options.leaf_size);
+}
+
+KdTree::~KdTree() = default;
+KdTree::KdTree(KdTree&&) noexcept = default;
+KdTree& KdTree::operator=(KdTree&&) noexcept = default;
+
+std::size_t KdTree::size() const
+{
+    return impl_->data.points.size();
+}
+
+std::span<const Vec3f> KdTree::positions() const
+{
+    return impl_->data.points;
+}
+
+std::size_t KdTree::knn(const Vec3f& query, std::size_t k, std::span<std::uint32_t> indices,
+                        std::span<float> squared_distances) const
+{
+    PF_ASSERT(indices.size() >= k && squared_distances.size() >= k);
+    k = std::min(k, size());
+    if (k == 0)
+        return 0;
+    nanoflann::KNNResultSet<float, std::uint32_t, std::size_t> result(k);
+    result.init(indices.data(), squared_distances.data());
+    impl_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
+    return result.size();
+}
+
+PointId KdTree::nearest(const Vec3f& query, float* squared_distance) const
+{
+    std::uint32_t index = 0;
+    float d2 = 0.0F;
+    if (knn(query, 1, {&index, 1}, {&d2, 1}) == 0)
+        return {};
+    if (squared_distance != nullptr)
+        *squared_distance = d2;
+    return PointId(index);
+}
+
+std::size_t KdTree::radius_search(const Vec3f& query, float radius,
+                                  std::vector<std::uint32_t>& indices,
+                                  std::vector<float>& squared_distances) const
+{
+    if (size() == 0)
+        return 0;
+    std::vector<std::pair<std::uint32_t, float>> found;
+    nanoflann::SearchParams params;
+    params.sorted = false;
+    impl_->tree.radiusSearch(query.data(), radius * radius, found, params);
+    std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) {
+        return a.second < b.second || (a.second == b.second && a.first < b.first);
+    });
+    for (const auto& [index, d2] : found)
+    {
+        indices.push_back(index);
+        squared_distances.push_back(d2);
+    }
+    return found.size();
+}
+
+KnnTable knn_batch(const KdTree& tree, std::span<const Vec3f> queries, std::size_t k,
+                   const KnnOptions& options)
+{
+    if (k == 0 || k > tree.size())
+        throw InvalidInput("k-nearest neighbours: k = " + std::to_string(k) +
+                           " must be between 1 and the number of points (" +
+                           std::to_string(tree.size()) + ")");
+    KnnTable table;
+    table.k = k;
+    table.indices.resize(queries.size() * k);
+    table.squared_distances.resize(queries.size() * k);
+    ProgressReporter progress(options.progress, "k-nearest neighbours");
+    parallel_blocks(
+        queries.size(), query_block,
+        [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i)
+                tree.knn(queries[i], k, {table.indices.data() + i * k, k},
+                         {table.squared_distances.data() + i * k, k});
+        },
+        &progress);
+    progress.finish();
+    return table;
+}
+
+RadiusTable radius_batch(const KdTree& tree, std::span<const Vec3f> queries, float radius,
+                         const KnnOptions& options)
+{
+    if (!(radius >= 0.0F) || !std::isfinite(radius))
+        throw InvalidInput("radius search: radius must be finite and non-negative");
+    const std::size_t blocks = (queries.size() + query_block - 1) / query_block;
+    // Each block gathers its rows locally; blocks are then concatenated in order.
+    std::vector<RadiusTable> parts(blocks);
+    ProgressReporter progress(options.progress, "radius search");
+    parallel_blocks(
+        queries.size(), query_block,
+        [&](std::size_t begin, std::size_t end) {
+            RadiusTable& part = parts[begin / query_block];
+            part.offsets.push_back(0);
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                tree.radius_search(queries[i], radius, part.indices, part.squared_distances);
+                part.offsets.push_back(part.indices.size());
+            }
+        },
+        &progress);
+    progress.finish();
+
+    RadiusTable table;
+    table.offsets.reserve(queries.size() + 1);
+    table.offsets.push_back(0);
+    for (const auto& part : parts)
+    {
+        const std::size_t base = table.indices.size();
+        for (std::size_t r = 1; r < part.offsets.size(); ++r)
+            table.offsets.push_back(base + part.offsets[r]);
+        table.indices.insert(table.indices.end(), part.indices.begin(), part.indices.end());
+        table.squared_distances.insert(table.squared_distances.end(),
+                                       part.squared_distances.begin(),
+                                       part.squared_distances.end());
+    }
+    if (queries.empty())
+        table.offsets.assign(1, 0);
+    return table;
+}
+
+} // namespace pointform

@@ -1,0 +1,186 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+// The command-line tool end to end: exit codes, messages and outputs, on good and bad input.
+
+#include "pointform/io/io.h"
+
+#include "support/test_support.h"
+
+#include <nlohmann/json.hpp>
+
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+namespace pointform {
+namespace {
+
+struct RunResult
+{
+    int exit_code = -1;
+    std::string out; ///< stdout and stderr together
+};
+
+RunResult run(const std::string& arguments)
+{
+    const std::string command = std::string(PF_CLI_PATH) + " " + arguments + " 2>&1";
+    RunResult result;
+    FILE* pipe = ::popen(command.c_str(), "r");
+    if (pipe == nullptr)
+        return result;
+    std::array<char, 4096> buffer{};
+    std::size_t n = 0;
+    while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+        result.out.append(buffer.data(), n);
+    const int status = ::pclose(pipe);
+    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return result;
+}
+
+std::string quoted(const std::filesystem::path& path)
+{
+    return "'" + path.string() + "'";
+}
+
+TEST(Cli, HelpOnEverySubcommand)
+{
+    for (const std::string sub : {"", "info", "normals", "sample"})
+    {
+        const RunResult r = run(sub + " --help");
+        EXPECT_EQ(r.exit_code, 0) << sub;
+        EXPECT_NE(r.out.find("Usage"), std::string::npos) << sub;
+    }
+}
+
+TEST(Cli, NormalsOnBunnyWritesSurfels)
+{
+    test::TempDir dir;
+    const auto out = dir / "bunny.ply";
+    const RunResult r =
+        run("normals " + quoted(test::data_path("bunny/bun_zipper.ply")) + " -o " + quoted(out) +
+            " -k 12 --radius-scale 2 --json");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const auto report = nlohmann::json::parse(r.out);
+    EXPECT_EQ(report["points"], 35947);
+    EXPECT_EQ(report["unoriented"], 0);
+    EXPECT_TRUE(report["timings_s"].contains("orientation"));
+
+    const PointCloud surfels = read_point_cloud(out);
+    ASSERT_EQ(surfels.size(), 35947U);
+    ASSERT_TRUE(surfels.has_normals());
+    ASSERT_TRUE(surfels.has_radii());
+    for (std::size_t i = 0; i < surfels.size(); ++i)
+    {
+        EXPECT_NEAR(surfels.normals[i].norm(), 1.0F, 1e-4F);
+        EXPECT_GT(surfels.radii[i], 0.0F);
+    }
+    // The header says what the issue promises: binary PLY with x y z nx ny nz and radius.
+    const std::string head = test::read_file(out).substr(0, 400);
+    EXPECT_NE(head.find("format binary_little_endian"), std::string::npos);
+    EXPECT_NE(head.find("property float radius"), std::string::npos);
+}
+
+TEST(Cli, OrientTowardsAndRegions)
+{
+    test::TempDir dir;
+    test::write_file(dir / "regions.json",
+                     R"({"regions": [{"box": {"min": [-1,-1,-1], "max": [1,1,1]}, "set": 0.25}]})");
+    const auto out = dir / "s.ply";
+    const RunResult r = run("normals " + quoted(test::data_path("pcl/bunny.pcd")) + " -o " +
+                            quoted(out) + " --orient towards:0,0,1 --radius-regions " +
+                            quoted(dir / "regions.json"));
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const PointCloud surfels = read_point_cloud(out);
+    for (std::size_t i = 0; i < surfels.size(); ++i)
+    {
+        const Vec3d to_view = Vec3d(0, 0, 1) - surfels.world(i);
+        EXPECT_GE(surfels.normals[i].cast<double>().dot(to_view), 0.0);
+        EXPECT_EQ(surfels.radii[i], 0.25F);
+    }
+}
+
+TEST(Cli, InfoReportsDensityAndAttributes)
+{
+    const RunResult r = run("info --json " + quoted(test::data_path("cgal/kitten.xyz")));
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const auto info = nlohmann::json::parse(r.out);
+    EXPECT_EQ(info["points"], 5210);
+    EXPECT_GT(info["nearest_neighbor_distance"]["median"].get<double>(), 0.0);
+    const auto& attributes = info["attributes"];
+    EXPECT_NE(std::find(attributes.begin(), attributes.end(), "normals"), attributes.end());
+}
+
+/// Every bad input: a clear message naming the problem, a non-zero exit, no output file.
+struct BadCase
+{
+    std::string name;
+    std::string content; ///< written to the input file; empty name = missing file
+    std::string extension;
+    std::string extra_arguments;
+    int exit_code;
+    std::string message;
+};
+
+TEST(Cli, BadInputFailsCleanly)
+{
+    const std::string ply_header = "ply\nformat binary_little_endian 1.0\nelement vertex 100\n"
+                                   "property float x\nproperty float y\nproperty float z\n"
+                                   "end_header\n";
+    std::string line_points;
+    for (int i = 0; i < 50; ++i)
+        line_points += std::to_string(i) + " " + std::to_string(2 * i) + " " +
+                       std::to_string(3 * i) + "\n";
+    std::string same_points;
+    for (int i = 0; i < 50; ++i)
+        same_points += "1 2 3\n";
+    const std::vector<BadCase> cases = {
+        {"missing", "", ".ply", "", 3, "missing.ply"},
+        {"empty", "\x01", ".xyz", "", 3, "empty.xyz"},
+        {"truncated", ply_header + std::string(12 * 40, '\0'), ".ply", "", 3, "truncated.ply"},
+        {"nan", "0 0 0\n1 0 0\nnan 1 0\n0 1 1\n", ".xyz", "", 3, "nan.xyz:3"},
+        {"inf", "0 0 0\n1 0 inf\n", ".xyz", "", 3, "inf.xyz:2"},
+        {"few", "0 0 0\n1 0 0\n0 1 0\n1 1 1\n", ".xyz", "", 2, "fewer than k"},
+        {"coincident", same_points, ".xyz", "", 2, "coincide"},
+        {"collinear", line_points, ".xyz", "", 2, "line"},
+        {"badorient", line_points, ".xyz", "--orient sideways", 105, "sideways"},
+    };
+    for (const auto& c : cases)
+    {
+        test::TempDir dir;
+        const auto input = dir / (c.name + c.extension);
+        if (c.name != "missing")
+            test::write_file(input, c.content == "\x01" ? std::string() : c.content);
+        const auto output = dir / "out.ply";
+        const RunResult r =
+            run("normals " + quoted(input) + " -o " + quoted(output) + " " + c.extra_arguments);
+        EXPECT_NE(r.exit_code, 0) << c.name;
+        if (c.exit_code != 105)
+        {
+            EXPECT_EQ(r.exit_code, c.exit_code) << c.name << ": " << r.out;
+        }
+        EXPECT_NE(r.out.find(c.message), std::string::npos) << c.name << ": " << r.out;
+        EXPECT_FALSE(std::filesystem::exists(output)) << c.name;
+        // Nothing else is left behind either (no temporary files).
+        std::size_t files = 0;
+        for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir.path()))
+            ++files;
+        EXPECT_EQ(files, c.name == "missing" ? 0U : 1U) << c.name;
+    }
+}
+
+TEST(Cli, UnwritableOutputFailsWithFileError)
+{
+    const RunResult r = run("normals " + quoted(test::data_path("pcl/bunny.pcd")) +
+                            " -o /nonexistent-dir/out.ply");
+    EXPECT_EQ(r.exit_code, 3) << r.out;
+    EXPECT_NE(r.out.find("/nonexistent-dir/out.ply"), std::string::npos) << r.out;
+}
+
+} // namespace
+} // namespace pointform

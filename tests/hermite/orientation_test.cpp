@@ -1,0 +1,276 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/core/error.h"
+#include "pointform/geometry/shapes.h"
+#include "pointform/hermite/normals.h"
+#include "pointform/hermite/orientation.h"
+#include "pointform/spatial/kd_tree.h"
+
+#include "support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <set>
+
+namespace pointform {
+namespace {
+
+struct Prepared
+{
+    KnnTable table;
+    Normals normals;
+};
+
+Prepared prepare(const PointCloud& cloud, std::size_t k)
+{
+    const KdTree tree(cloud.positions);
+    Prepared p;
+    p.table = knn_batch(tree, cloud.positions, k);
+    p.normals = estimate_normals(cloud.positions, p.table);
+    return p;
+}
+
+OrientedNormals orient(const PointCloud& cloud, std::size_t k, OrientationOptions options = {})
+{
+    const Prepared p = prepare(cloud, k);
+    return orient_normals_mst(cloud.positions, p.normals.normals, p.table, options);
+}
+
+TEST(OrientNormalsMst, SphereOutward)
+{
+    const PointCloud sphere = sample_shape(Shape::Sphere, {.count = 20000, .seed = 1});
+    const OrientedNormals result = orient(sphere, 16);
+    EXPECT_EQ(result.components, 1U);
+    EXPECT_TRUE(result.unoriented.empty());
+    EXPECT_GE(test::oriented_fraction(result.normals, sphere.normals), 0.999);
+}
+
+TEST(OrientNormalsMst, TorusOutward)
+{
+    const PointCloud torus = sample_shape(Shape::Torus, {.count = 50000, .seed = 2});
+    const OrientedNormals result = orient(torus, 16);
+    EXPECT_EQ(result.components, 1U);
+    EXPECT_GE(test::oriented_fraction(result.normals, torus.normals), 0.999);
+}
+
+TEST(OrientNormalsMst, TwoDisjointSpheresEachOutward)
+{
+    const PointCloud spheres = sample_shape(Shape::TwoSpheres, {.count = 30000, .seed = 3});
+    const OrientedNormals result = orient(spheres, 16);
+    EXPECT_EQ(result.components, 2U);
+    // Check each sphere separately: a single-seed method orients only one of them.
+    for (const double side : {-1.0, 1.0})
+    {
+        std::vector<Vec3f> est;
+        std::vector<Vec3f> truth;
+        for (std::size_t i = 0; i < spheres.size(); ++i)
+            if (static_cast<double>(spheres.positions[i].x()) * side > 0.0)
+            {
+                est.push_back(result.normals[i]);
+                truth.push_back(spheres.normals[i]);
+            }
+        EXPECT_GE(test::oriented_fraction(est, truth), 0.999) << "sphere at x = " << side;
+    }
+}
+
+TEST(OrientNormalsMst, ThinPlateBothSidesOutward)
+{
+    // Sampling step ≈ 0.0145; k = 16 neighbourhoods reach about 0.033. A plate 0.04 thick (2.8
+    // steps, 2% of its width) has its two sides in each other's 16-neighbourhoods at the rim and
+    // in the 16-NN graph's reach, yet each side must come out facing away from the other.
+    const double thickness = 0.04;
+    const PointCloud plate =
+        sample_shape(Shape::Plate, {.count = 40000, .seed = 4, .thickness = thickness});
+    const OrientedNormals result = orient(plate, 16, {.k = 10});
+    std::vector<Vec3f> est;
+    std::vector<Vec3f> truth;
+    for (std::size_t i = 0; i < plate.size(); ++i)
+    {
+        const Vec3f& p = plate.positions[i];
+        // The two large faces, away from the rim where the normal turns through 90° in 2 steps.
+        if (std::abs(p.x()) < 0.95F && std::abs(p.y()) < 0.95F)
+        {
+            est.push_back(result.normals[i]);
+            truth.push_back(plate.normals[i]);
+        }
+    }
+    EXPECT_GE(test::oriented_fraction(est, truth), 0.999);
+}
+
+TEST(OrientNormalsMst, ReflectionRuleOrientsPlateThinnerThanTheNeighbourhood)
+{
+    // Half a sampling step thick: Hoppe's rule crosses the wall and flips one side (about 50%).
+    const PointCloud plate =
+        sample_shape(Shape::Plate, {.count = 40000, .seed = 4, .thickness = 0.01});
+    const OrientedNormals result = orient(plate, 16, {.k = 10, .rule = OrientationRule::Reflection});
+    std::vector<Vec3f> est;
+    std::vector<Vec3f> truth;
+    for (std::size_t i = 0; i < plate.size(); ++i)
+        if (std::abs(plate.positions[i].x()) < 0.95F && std::abs(plate.positions[i].y()) < 0.95F)
+        {
+            est.push_back(result.normals[i]);
+            truth.push_back(plate.normals[i]);
+        }
+    EXPECT_GE(test::oriented_fraction(est, truth), 0.99);
+}
+
+TEST(OrientNormalsMst, NoisySphereWithHoles)
+{
+    const PointCloud sphere = sample_shape(
+        Shape::Sphere, {.count = 40000, .seed = 5, .noise = 0.002, .holes = 10, .hole_radius = 0.06});
+    ASSERT_LT(sphere.size(), 40000U);
+    const OrientedNormals result = orient(sphere, 16);
+    EXPECT_GE(test::oriented_fraction(result.normals, sphere.normals), 0.999);
+}
+
+TEST(OrientNormalsMst, OpenSheetFacesUp)
+{
+    // A gently curved open height field (terrain-like): no enclosed volume, so the seed's +z wins.
+    std::vector<Vec3f> points;
+    for (int i = 0; i < 100; ++i)
+        for (int j = 0; j < 100; ++j)
+        {
+            const float x = 0.02F * static_cast<float>(i) - 1.0F;
+            const float y = 0.02F * static_cast<float>(j) - 1.0F;
+            points.emplace_back(x, y, 0.1F * std::sin(3.0F * x) * std::cos(2.0F * y));
+        }
+    const KdTree tree(points);
+    const KnnTable table = knn_batch(tree, points, 12);
+    const Normals normals = estimate_normals(points, table);
+    const OrientedNormals result = orient_normals_mst(points, normals.normals, table);
+    for (const auto& n : result.normals)
+        EXPECT_GT(n.z(), 0.0F);
+}
+
+TEST(OrientNormalsMst, DegenerateSamplesInheritAndAreCounted)
+{
+    PointCloud sphere = sample_shape(Shape::Sphere, {.count = 5000, .seed = 6});
+    // 20 copies of one sample: the PCA neighbourhood of each copy is a single point.
+    const Vec3f dup = sphere.positions[0];
+    const Vec3f dup_normal = sphere.normals[0];
+    for (int i = 0; i < 20; ++i)
+    {
+        sphere.positions.push_back(dup);
+        sphere.normals.push_back(dup_normal);
+    }
+    const Prepared p = prepare(sphere, 16);
+    EXPECT_GE(p.normals.degenerate.size(), 20U);
+    const OrientedNormals result =
+        orient_normals_mst(sphere.positions, p.normals.normals, p.table);
+    EXPECT_GE(result.inherited, 20U);
+    EXPECT_TRUE(result.unoriented.empty());
+    EXPECT_GE(test::oriented_fraction(result.normals, sphere.normals), 0.999);
+}
+
+TEST(OrientNormalsMst, ComponentWithoutNormalsIsReportedUnoriented)
+{
+    PointCloud sphere = sample_shape(Shape::Sphere, {.count = 3000, .seed = 7});
+    const std::size_t first_extra = sphere.size();
+    // A far cluster of 20 coincident points: its own component, no usable normal.
+    for (int i = 0; i < 20; ++i)
+        sphere.positions.emplace_back(10.0F, 10.0F, 10.0F);
+    const Prepared p = prepare(sphere, 16);
+    const OrientedNormals result =
+        orient_normals_mst(sphere.positions, p.normals.normals, p.table);
+    EXPECT_EQ(result.components, 2U);
+    ASSERT_EQ(result.unoriented.size(), 20U);
+    EXPECT_EQ(result.unoriented.front(), first_extra);
+    for (const auto i : result.unoriented)
+        EXPECT_EQ(result.normals[i], Vec3f::Zero());
+}
+
+/// Kruskal over every edge of the symmetrised kNN graph, by brute force.
+double brute_force_msf_weight(const PointCloud& cloud, const Prepared& p, std::size_t columns,
+                              OrientationRule rule)
+{
+    const auto& n = p.normals.normals;
+    std::set<std::pair<std::uint32_t, std::uint32_t>> edges;
+    for (std::uint32_t i = 0; i < cloud.size(); ++i)
+        for (const auto j : p.table.neighbors(i).first(columns))
+            if (j != i)
+                edges.emplace(std::min(i, j), std::max(i, j));
+    std::vector<std::tuple<double, std::uint32_t, std::uint32_t>> weighted;
+    for (const auto& [a, b] : edges)
+    {
+        Vec3d predicted = n[a].cast<double>();
+        if (rule == OrientationRule::Reflection)
+        {
+            const Vec3d e = (cloud.positions[b] - cloud.positions[a]).cast<double>().normalized();
+            predicted -= 2.0 * predicted.dot(e) * e;
+        }
+        const double w = 1.0 - std::abs(predicted.dot(n[b].cast<double>()));
+        weighted.emplace_back(w, a, b);
+    }
+    std::sort(weighted.begin(), weighted.end());
+    std::vector<std::uint32_t> parent(cloud.size());
+    std::iota(parent.begin(), parent.end(), 0U);
+    const auto find = [&](std::uint32_t x) {
+        while (parent[x] != x)
+            x = parent[x] = parent[parent[x]];
+        return x;
+    };
+    double total = 0.0;
+    for (const auto& [w, a, b] : weighted)
+    {
+        const auto ra = find(a);
+        const auto rb = find(b);
+        if (ra != rb)
+        {
+            parent[ra] = rb;
+            total += w;
+        }
+    }
+    return total;
+}
+
+TEST(RiemannianForest, WeightMatchesBruteForceKruskal)
+{
+    for (const auto rule : {OrientationRule::Hoppe, OrientationRule::Reflection})
+        for (const std::uint64_t seed : {1, 2, 3})
+        {
+            const PointCloud cloud =
+                sample_shape(Shape::TwoSpheres, {.count = 400, .seed = seed, .noise = 0.01});
+            const Prepared p = prepare(cloud, 8);
+            const RiemannianForest forest = riemannian_spanning_forest(
+                cloud.positions, p.normals.normals, p.table, {.k = 6, .rule = rule});
+            const double expected = brute_force_msf_weight(cloud, p, 6, rule);
+            EXPECT_NEAR(forest.total_cost, expected, 1e-4 * std::max(1.0, expected))
+                << "rule " << static_cast<int>(rule) << " seed " << seed;
+            // A forest: N − components edges, every sample reached, parents before children.
+            EXPECT_EQ(forest.order.size(), cloud.size());
+            std::vector<bool> seen(cloud.size(), false);
+            for (const auto v : forest.order)
+            {
+                EXPECT_TRUE(forest.parent[v] == v || seen[forest.parent[v]]);
+                seen[v] = true;
+            }
+        }
+}
+
+TEST(SimpleOrientations, TowardsAlongAndFlip)
+{
+    const PointCloud sphere = sample_shape(Shape::Sphere, {.count = 2000, .seed = 8});
+    std::vector<Vec3f> scrambled = sphere.normals;
+    for (std::size_t i = 0; i < scrambled.size(); i += 2)
+        scrambled[i] = -scrambled[i];
+
+    const OrientedNormals inward = orient_normals_towards(sphere.positions, scrambled, Vec3d::Zero());
+    EXPECT_EQ(test::oriented_fraction(inward.normals, sphere.normals), 0.0);
+    EXPECT_EQ(inward.flipped, sphere.size() - (sphere.size() + 1) / 2);
+
+    const OrientedNormals up = orient_normals_along(scrambled, Vec3d::UnitZ());
+    for (const auto& n : up.normals)
+        EXPECT_GE(n.z(), 0.0F);
+    EXPECT_THROW((void)orient_normals_along(scrambled, Vec3d::Zero()), InvalidInput);
+
+    const OrientedNormals flipped = flip_normals(sphere.normals);
+    EXPECT_EQ(test::oriented_fraction(flipped.normals, sphere.normals), 0.0);
+    EXPECT_EQ(flipped.flipped, sphere.size());
+}
+
+} // namespace
+} // namespace pointform

@@ -1,0 +1,102 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/core/error.h"
+#include "pointform/hermite/radius.h"
+#include "pointform/spatial/kd_tree.h"
+
+#include "support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace pointform {
+namespace {
+
+/// A unit-spaced grid in the plane z = 0: the distance to the k-th neighbour is known exactly.
+std::vector<Vec3f> grid(int n)
+{
+    std::vector<Vec3f> points;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+            points.emplace_back(static_cast<float>(i), static_cast<float>(j), 0.0F);
+    return points;
+}
+
+TEST(InfluenceRadii, DistanceToKthNeighbourTimesScale)
+{
+    const auto points = grid(20);
+    const KdTree tree(points);
+    // Self, 4 at distance 1, 4 at √2, 4 at 2: the 9th nearest (self included) is at √2.
+    const KnnTable table = knn_batch(tree, points, 9);
+    const std::vector<float> radii = influence_radii(table, 1.5);
+    const std::size_t interior = 10 * 20 + 10;
+    EXPECT_NEAR(radii[interior], 1.5 * std::sqrt(2.0), 1e-6);
+    EXPECT_THROW((void)influence_radii(table, 0.0), InvalidInput);
+    EXPECT_THROW((void)influence_radii(table, std::nan("")), InvalidInput);
+}
+
+TEST(RadiusRegions, BallSetsAndBoxScales)
+{
+    const auto regions = parse_radius_regions(R"({"regions": [
+        {"ball": {"center": [100, 200, 0], "radius": 2.5}, "set": 0.75},
+        {"box": {"min": [109.5, 209.5, -1], "max": [119.5, 219.5, 1]}, "scale": 3}
+    ]})",
+                                              "inline.json");
+    ASSERT_EQ(regions.size(), 2U);
+    // Points stored relative to an origin: regions are in world coordinates.
+    const Vec3d origin(100.0, 200.0, 0.0);
+    const auto points = grid(20);
+    const std::vector<float> automatic(points.size(), 1.0F);
+    const std::vector<float> radii = apply_radius_regions(points, origin, automatic, regions);
+    for (std::size_t i = 0; i < points.size(); ++i)
+    {
+        const Vec3d p = origin + points[i].cast<double>();
+        float expected = 1.0F;
+        if ((p - origin).norm() <= 2.5)
+            expected = 0.75F;
+        if (p.x() >= 109.5 && p.y() >= 209.5)
+            expected = 3.0F;
+        EXPECT_EQ(radii[i], expected) << "point " << i;
+    }
+}
+
+TEST(RadiusRegions, ErrorsNameTheProblem)
+{
+    const auto expect_error = [](const std::string& json, const std::string& fragment) {
+        try
+        {
+            (void)parse_radius_regions(json, "regions.json");
+            ADD_FAILURE() << "no error for " << json;
+        }
+        catch (const IoError& e)
+        {
+            const std::string what = e.what();
+            EXPECT_NE(what.find("regions.json"), std::string::npos) << what;
+            EXPECT_NE(what.find(fragment), std::string::npos) << what;
+        }
+    };
+    expect_error("{\"regions\": [\n  {\"ball\": }\n]}", "regions.json:2");
+    expect_error(R"({"regions": [{"ball": {"center": [0,0,0], "radius": 1}}]})", "\"set\"");
+    expect_error(R"({"regions": [{"ball": {"center": [0,0], "radius": 1}, "set": 1}]})",
+                 "array of 3");
+    expect_error(R"({"regions": [{"ball": {"center": [0,0,0], "radius": -1}, "set": 1}]})",
+                 "negative");
+    expect_error(R"({"regions": [{"box": {"min": [0,0,0], "max": [1,1,1]}, "set": -2}]})",
+                 "positive");
+    expect_error(R"({"regions": [{"box": {"min": [2,0,0], "max": [1,1,1]}, "set": 2}]})",
+                 "exceed");
+    expect_error(R"({"zones": []})", "\"regions\"");
+}
+
+TEST(RadiusRegions, ReadsFileAndReportsMissingFile)
+{
+    test::TempDir dir;
+    test::write_file(dir / "r.json", R"({"regions": [{"ball": {"center": [0,0,0], "radius": 1}, "set": 0.5}]})");
+    EXPECT_EQ(read_radius_regions(dir / "r.json").size(), 1U);
+    EXPECT_THROW((void)read_radius_regions(dir / "missing.json"), IoError);
+}
+
+} // namespace
+} // namespace pointform

@@ -1,0 +1,121 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+#include "pointform/geometry/shapes.h"
+#include "pointform/hermite/surfels.h"
+
+#include "support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+namespace pointform {
+namespace {
+
+TEST(ComputeSurfels, TorusGivesOutwardNormalsAndRadii)
+{
+    const PointCloud torus = sample_shape(Shape::Torus, {.count = 30000, .seed = 9});
+    PointCloud input = torus;
+    input.normals.clear();
+    const SurfelResult result = compute_surfels(input, {.k = 16, .radius_scale = 2.0});
+    ASSERT_EQ(result.surfels.size(), torus.size());
+    ASSERT_EQ(result.surfels.radii.size(), torus.size());
+    EXPECT_GE(test::oriented_fraction(result.surfels.normals, torus.normals), 0.999);
+    // Radii are of the order of the sampling step: area / N = 4π²Rr / N.
+    const double step = std::sqrt(4.0 * M_PI * M_PI * 0.35 / 30000.0);
+    for (const float r : result.surfels.radii)
+    {
+        EXPECT_GT(r, 0.5 * step);
+        EXPECT_LT(r, 20.0 * step);
+    }
+    EXPECT_EQ(result.stage_seconds.size(), 6U);
+}
+
+TEST(ComputeSurfels, GeoreferencedCoordinatesKeepPrecision)
+{
+    // The same sphere at a UTM-like offset: float storage relative to the origin loses nothing.
+    PointCloud sphere = sample_shape(Shape::Sphere, {.count = 8000, .seed = 10});
+    const PointCloud reference = sphere;
+    sphere.origin = Vec3d(512345.0, 4212345.0, 310.0);
+    const SurfelResult near = compute_surfels(reference);
+    const SurfelResult far = compute_surfels(sphere);
+    EXPECT_EQ(near.surfels.normals, far.surfels.normals);
+    EXPECT_EQ(far.surfels.origin, sphere.origin);
+}
+
+TEST(ComputeSurfels, OrientModes)
+{
+    const PointCloud sphere = sample_shape(Shape::Sphere, {.count = 5000, .seed = 11});
+    const SurfelResult inward = compute_surfels(sphere, {.orient = OrientMode::Flip});
+    EXPECT_EQ(test::oriented_fraction(inward.surfels.normals, sphere.normals), 0.0);
+    const SurfelResult towards_center =
+        compute_surfels(sphere, {.orient = OrientMode::Towards, .orient_target = Vec3d::Zero()});
+    EXPECT_EQ(test::oriented_fraction(towards_center.surfels.normals, sphere.normals), 0.0);
+    const SurfelResult along =
+        compute_surfels(sphere, {.orient = OrientMode::Along, .orient_target = -Vec3d::UnitX()});
+    for (const auto& n : along.surfels.normals)
+        EXPECT_LE(n.x(), 0.0F);
+}
+
+TEST(ComputeSurfels, SameOutputForOneAndTwoThreads)
+{
+    const PointCloud cloud = sample_shape(
+        Shape::TwoSpheres, {.count = 20000, .seed = 12, .noise = 0.003, .holes = 4});
+    set_thread_count(1);
+    const SurfelResult one = compute_surfels(cloud);
+    set_thread_count(2);
+    const SurfelResult two = compute_surfels(cloud);
+    set_thread_count(0);
+    EXPECT_EQ(one.surfels.normals, two.surfels.normals);
+    EXPECT_EQ(one.surfels.radii, two.surfels.radii);
+    EXPECT_EQ(one.orientation.flipped, two.orientation.flipped);
+}
+
+TEST(ComputeSurfels, RejectsBadInput)
+{
+    PointCloud cloud = sample_shape(Shape::Sphere, {.count = 100, .seed = 13});
+    EXPECT_THROW((void)compute_surfels(cloud, {.k = 101}), InvalidInput); // fewer points than k
+    EXPECT_THROW((void)compute_surfels(cloud, {.k = 2}), InvalidInput);
+    EXPECT_THROW((void)compute_surfels(cloud, {.radius_scale = 0.0}), InvalidInput);
+    EXPECT_THROW((void)compute_surfels(PointCloud{}), InvalidInput); // empty
+
+    PointCloud with_nan = cloud;
+    with_nan.positions[17].y() = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_THROW((void)compute_surfels(with_nan), InvalidInput);
+    PointCloud with_inf = cloud;
+    with_inf.positions[3].x() = std::numeric_limits<float>::infinity();
+    EXPECT_THROW((void)compute_surfels(with_inf), InvalidInput);
+
+    PointCloud coincident;
+    coincident.positions.assign(50, Vec3f(1.0F, 2.0F, 3.0F));
+    try
+    {
+        (void)compute_surfels(coincident);
+        ADD_FAILURE() << "coincident points accepted";
+    }
+    catch (const InvalidInput& e)
+    {
+        EXPECT_NE(std::string(e.what()).find("coincide"), std::string::npos) << e.what();
+    }
+
+    PointCloud collinear;
+    for (int i = 0; i < 50; ++i)
+        collinear.positions.emplace_back(0.1F * static_cast<float>(i), 0.2F * static_cast<float>(i),
+                                         -0.3F * static_cast<float>(i));
+    try
+    {
+        (void)compute_surfels(collinear);
+        ADD_FAILURE() << "collinear points accepted";
+    }
+    catch (const InvalidInput& e)
+    {
+        EXPECT_NE(std::string(e.what()).find("line"), std::string::npos) << e.what();
+    }
+}
+
+} // namespace
+} // namespace pointform

@@ -1,0 +1,421 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "io_test_util.h"
+#include "support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+
+namespace pointform::test
+{
+namespace
+{
+
+/// One point of the test clouds: the fields x y z normal_x normal_y normal_z rgb curvature
+/// hist[3], all float32 as PCL writes them (rgb is a packed 0x00RRGGBB in a float's bits).
+struct PcdPoint
+{
+    std::array<float, 3> xyz;
+    std::array<float, 3> normal;
+    std::uint32_t rgb;
+    float curvature;
+    std::array<float, 3> hist;
+};
+
+constexpr std::uint32_t width = 4;
+constexpr std::uint32_t height = 3;
+
+bool is_missing(std::size_t i)
+{
+    return i == 1 || i == 5 || i == 6;
+}
+
+/// An organized 4 x 3 cloud whose points 1, 5 and 6 are NaN (missing pixels).
+std::vector<PcdPoint> organized_points()
+{
+    std::vector<PcdPoint> points;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (std::uint32_t i = 0; i < width * height; ++i)
+    {
+        const auto f = static_cast<float>(i);
+        PcdPoint p{};
+        p.xyz = is_missing(i) ? std::array<float, 3>{nan, nan, nan}
+                              : std::array<float, 3>{0.1F * f, 1.0F + 0.2F * f, -0.05F * f};
+        p.normal = is_missing(i) ? std::array<float, 3>{nan, nan, nan}
+                                 : std::array<float, 3>{0.0F, 0.6F, 0.8F};
+        p.rgb = ((20 * i) << 16U) | ((10 * i) << 8U) | i;
+        p.curvature = 0.01F * f;
+        p.hist = {f, f, f};
+        points.push_back(p);
+    }
+    return points;
+}
+
+std::string header(std::string_view data, std::uint64_t points = width * height)
+{
+    return "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\n"
+           "FIELDS x y z normal_x normal_y normal_z rgb curvature hist\n"
+           "SIZE 4 4 4 4 4 4 4 4 4\nTYPE F F F F F F F F F\nCOUNT 1 1 1 1 1 1 1 1 3\n"
+           "WIDTH " +
+           std::to_string(width) + "\nHEIGHT " + std::to_string(height) +
+           "\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(points) + "\nDATA " +
+           std::string(data) + "\n";
+}
+
+std::string ascii_pcd(const std::vector<PcdPoint>& points)
+{
+    std::string text = header("ascii");
+    for (const PcdPoint& p : points)
+    {
+        const auto number = [](float v)
+        {
+            return std::isnan(v) ? std::string("nan") : std::to_string(v);
+        };
+        for (const float v : p.xyz)
+            text += number(v) + " ";
+        for (const float v : p.normal)
+            text += number(v) + " ";
+        text += std::to_string(p.rgb) + " " + std::to_string(p.curvature);
+        for (const float v : p.hist)
+            text += " " + std::to_string(v);
+        text += "\n";
+    }
+    return text;
+}
+
+std::string aos_bytes(const std::vector<PcdPoint>& points)
+{
+    Bytes b;
+    for (const PcdPoint& p : points)
+    {
+        for (const float v : p.xyz)
+            b.le(v);
+        for (const float v : p.normal)
+            b.le(v);
+        b.le(p.rgb).le(p.curvature);
+        for (const float v : p.hist)
+            b.le(v);
+    }
+    return b.str();
+}
+
+/// Fields one after another: all x, then all y, ... (what binary_compressed compresses).
+std::string soa_bytes(const std::vector<PcdPoint>& points)
+{
+    Bytes b;
+    for (int k = 0; k < 3; ++k)
+        for (const PcdPoint& p : points)
+            b.le(p.xyz[k]);
+    for (int k = 0; k < 3; ++k)
+        for (const PcdPoint& p : points)
+            b.le(p.normal[k]);
+    for (const PcdPoint& p : points)
+        b.le(p.rgb);
+    for (const PcdPoint& p : points)
+        b.le(p.curvature);
+    for (const PcdPoint& p : points)
+        for (const float v : p.hist)
+            b.le(v);
+    return b.str();
+}
+
+std::string compressed_pcd(const std::vector<PcdPoint>& points)
+{
+    const std::string raw = soa_bytes(points);
+    const std::string lzf = lzf_literal_encode(raw);
+    Bytes b;
+    b.text(header("binary_compressed"))
+        .le(static_cast<std::uint32_t>(lzf.size()))
+        .le(static_cast<std::uint32_t>(raw.size()))
+        .text(lzf);
+    return b.str();
+}
+
+void check_organized(const ReadResult& result)
+{
+    const std::vector<PcdPoint> points = organized_points();
+    EXPECT_EQ(result.format, FileFormat::Pcd);
+    EXPECT_EQ(result.dropped_points, 3U);
+    const PointCloud& cloud = result.points;
+    ASSERT_EQ(cloud.size(), 9U);
+    ASSERT_TRUE(cloud.has_normals());
+    ASSERT_TRUE(cloud.has_colors());
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < points.size(); ++i)
+    {
+        if (is_missing(i))
+            continue;
+        const Vec3d expected(points[i].xyz[0], points[i].xyz[1], points[i].xyz[2]);
+        EXPECT_LT((cloud.world(k) - expected).norm(), 1e-5) << i;
+        EXPECT_LT((cloud.normals[k] - Vec3f(0.0F, 0.6F, 0.8F)).norm(), 1e-6F);
+        const std::uint32_t c = points[i].rgb;
+        EXPECT_EQ(cloud.colors[k],
+                  (Color{static_cast<std::uint8_t>(c >> 16U), static_cast<std::uint8_t>(c >> 8U),
+                         static_cast<std::uint8_t>(c)}));
+        ++k;
+    }
+    EXPECT_NE(result.description.find("organized 4 x 3"), std::string::npos);
+}
+
+TEST(PcdRead, AsciiOrganizedWithNaNs)
+{
+    TempDir dir;
+    const auto path = dir / "ascii.pcd";
+    write_file(path, ascii_pcd(organized_points()));
+    const ReadResult result = read_geometry(path);
+    EXPECT_NE(result.description.find("PCD ascii"), std::string::npos);
+    check_organized(result);
+}
+
+TEST(PcdRead, BinaryOrganizedWithNaNs)
+{
+    TempDir dir;
+    const auto path = dir / "binary.pcd";
+    write_file(path, header("binary") + aos_bytes(organized_points()));
+    const ReadResult result = read_geometry(path);
+    EXPECT_NE(result.description.find("PCD binary"), std::string::npos);
+    check_organized(result);
+}
+
+TEST(PcdRead, BinaryCompressedOrganizedWithNaNs)
+{
+    TempDir dir;
+    const auto path = dir / "compressed.pcd";
+    write_file(path, compressed_pcd(organized_points()));
+    const ReadResult result = read_geometry(path);
+    EXPECT_NE(result.description.find("PCD binary_compressed"), std::string::npos);
+    check_organized(result);
+}
+
+TEST(PcdRead, ErrorPolicyRejectsNaNs)
+{
+    TempDir dir;
+    const auto path = dir / "binary.pcd";
+    const std::string head = header("binary");
+    write_file(path, head + aos_bytes(organized_points()));
+    const auto e =
+        expect_io_error([&] { (void)read_geometry(path, {.non_finite = NonFinitePolicy::Error}); },
+                        path, "non-finite");
+    ASSERT_TRUE(e && e->offset());
+    EXPECT_EQ(*e->offset(), head.size() + sizeof(float) * 11);  // point 1: 11 floats a point
+}
+
+TEST(PcdRead, BackReferencesInLzf)
+{
+    // Four points at (1, 2, 3): each field block is one value repeated, coded as a 4-byte
+    // literal and a 12-byte back reference at distance 4 (length 12 = 7 + 3 + 2).
+    Bytes stream;
+    for (const float v : {1.0F, 2.0F, 3.0F})
+    {
+        stream.le<std::uint8_t>(3).le(v);
+        stream.le<std::uint8_t>(0xE0).le<std::uint8_t>(3).le<std::uint8_t>(3);
+    }
+    TempDir dir;
+    const auto path = dir / "backref.pcd";
+    Bytes file;
+    file.text(
+            "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 4\n"
+            "HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 4\nDATA binary_compressed\n")
+        .le(static_cast<std::uint32_t>(stream.size()))
+        .le<std::uint32_t>(48)
+        .text(stream.str());
+    write_file(path, file.str());
+    const ReadResult result = read_geometry(path);
+    ASSERT_EQ(result.points.size(), 4U);
+    for (std::size_t i = 0; i < 4; ++i)
+        EXPECT_EQ(result.points.world(i), Vec3d(1, 2, 3));
+    EXPECT_FALSE(result.points.has_normals());
+    EXPECT_FALSE(result.points.has_colors());
+}
+
+TEST(PcdRead, MixedTypesAndPackedRgbaAsUnsigned)
+{
+    TempDir dir;
+    const auto path = dir / "mixed.pcd";
+    Bytes b;
+    b.text(
+        "FIELDS x y z _ rgba intensity\nSIZE 8 4 2 1 4 1\nTYPE F I U U U I\nWIDTH 2\n"
+        "POINTS 2\nDATA binary\n");
+    b.le(1.5)
+        .le<std::int32_t>(-7)
+        .le<std::uint16_t>(65000)
+        .le<std::uint8_t>(0)
+        .le<std::uint32_t>(0xFF102030U)
+        .le<std::int8_t>(-1);
+    b.le(-2.5)
+        .le<std::int32_t>(8)
+        .le<std::uint16_t>(3)
+        .le<std::uint8_t>(0)
+        .le<std::uint32_t>(0x80FFFFFFU)
+        .le<std::int8_t>(1);
+    write_file(path, b.str());
+    const PointCloud cloud = read_point_cloud(path);
+    ASSERT_EQ(cloud.size(), 2U);
+    EXPECT_EQ(cloud.world(0), Vec3d(1.5, -7, 65000));
+    EXPECT_EQ(cloud.world(1), Vec3d(-2.5, 8, 3));
+    EXPECT_EQ(cloud.colors[0], (Color{0x10, 0x20, 0x30}));
+    EXPECT_EQ(cloud.colors[1], (Color{255, 255, 255}));
+}
+
+TEST(PcdRead, AsciiRgbWrittenAsFloat)
+{
+    // Older PCL printed the float whose bits hold the color.
+    const std::uint32_t packed = 0x00FF8040U;
+    const float as_float = std::bit_cast<float>(packed);
+    char text[64];
+    std::snprintf(text, sizeof(text), "%.9g", static_cast<double>(as_float));
+    TempDir dir;
+    const auto path = dir / "float_rgb.pcd";
+    write_file(path, std::string("FIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+                                 "WIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3 ") +
+                         text + "\n");
+    EXPECT_EQ(read_point_cloud(path).colors[0], (Color{0xFF, 0x80, 0x40}));
+}
+
+TEST(PcdErrors, PointsMismatch)
+{
+    TempDir dir;
+    const auto path = dir / "points.pcd";
+    write_file(path, header("binary", 10) + aos_bytes(organized_points()));
+    expect_io_error([&] { (void)read_geometry(path); }, path, "does not match WIDTH x HEIGHT");
+}
+
+TEST(PcdErrors, TruncatedBinary)
+{
+    TempDir dir;
+    const auto path = dir / "short.pcd";
+    const std::string head = header("binary");
+    std::string data = aos_bytes(organized_points());
+    data.resize(data.size() - 10);
+    write_file(path, head + data);
+    const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, "point 11 of the 12");
+    ASSERT_TRUE(e && e->offset());
+    EXPECT_EQ(*e->offset(), head.size() + 11 * 11 * sizeof(float));
+}
+
+TEST(PcdErrors, BinaryLongerThanPoints)
+{
+    TempDir dir;
+    const auto path = dir / "long.pcd";
+    write_file(path, header("binary") + aos_bytes(organized_points()) + "junk");
+    expect_io_error([&] { (void)read_geometry(path); }, path, "4 bytes after");
+}
+
+TEST(PcdErrors, CompressedSizesAndCorruptStream)
+{
+    TempDir dir;
+    const std::vector<PcdPoint> points = organized_points();
+    const std::string raw = soa_bytes(points);
+    const std::string lzf = lzf_literal_encode(raw);
+
+    const auto wrong_size = dir / "wrong_size.pcd";
+    write_file(wrong_size, Bytes()
+                               .text(header("binary_compressed"))
+                               .le(static_cast<std::uint32_t>(lzf.size()))
+                               .le(static_cast<std::uint32_t>(raw.size() - 4))
+                               .text(lzf)
+                               .str());
+    expect_io_error([&] { (void)read_geometry(wrong_size); }, wrong_size, "uncompressed size");
+
+    const auto truncated = dir / "truncated.pcd";
+    write_file(truncated, Bytes()
+                              .text(header("binary_compressed"))
+                              .le(static_cast<std::uint32_t>(lzf.size()))
+                              .le(static_cast<std::uint32_t>(raw.size()))
+                              .text(std::string_view(lzf).substr(0, lzf.size() / 2))
+                              .str());
+    expect_io_error([&] { (void)read_geometry(truncated); }, truncated, "truncated");
+
+    const auto corrupt = dir / "corrupt.pcd";
+    std::string bad = lzf;
+    bad[0] = static_cast<char>(0x20);  // a back reference before any output
+    write_file(corrupt, Bytes()
+                            .text(header("binary_compressed"))
+                            .le(static_cast<std::uint32_t>(bad.size()))
+                            .le(static_cast<std::uint32_t>(raw.size()))
+                            .text(bad)
+                            .str());
+    expect_io_error([&] { (void)read_geometry(corrupt); }, corrupt, "corrupt LZF");
+
+    const auto headless = dir / "headless.pcd";
+    write_file(headless, header("binary_compressed") + "ab");
+    expect_io_error([&] { (void)read_geometry(headless); }, headless, "truncated");
+}
+
+TEST(PcdErrors, AsciiLinesAndValues)
+{
+    TempDir dir;
+    const std::string head =
+        "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 3\nHEIGHT 1\n"
+        "POINTS 3\nDATA ascii\n";
+    const auto fewer = dir / "fewer.pcd";
+    write_file(fewer, head + "0 0 0\n1 1 1\n");
+    auto e = expect_io_error([&] { (void)read_geometry(fewer); }, fewer, "2 of the 3 POINTS");
+    ASSERT_TRUE(e && e->line());
+    EXPECT_EQ(*e->line(), 10U);
+
+    const auto more = dir / "more.pcd";
+    write_file(more, head + "0 0 0\n1 1 1\n2 2 2\n3 3 3\n");
+    e = expect_io_error([&] { (void)read_geometry(more); }, more, "more data lines");
+    ASSERT_TRUE(e && e->line());
+    EXPECT_EQ(*e->line(), 11U);
+
+    const auto values = dir / "values.pcd";
+    write_file(values, head + "0 0 0\n1 1\n2 2 2\n");
+    e = expect_io_error([&] { (void)read_geometry(values); }, values, "2 values, expected 3");
+    ASSERT_TRUE(e && e->line());
+    EXPECT_EQ(*e->line(), 9U);
+
+    const auto garbage = dir / "garbage.pcd";
+    write_file(garbage, head + "0 0 0\n1 one 1\n2 2 2\n");
+    expect_io_error([&] { (void)read_geometry(garbage); }, garbage, "'one'");
+}
+
+TEST(PcdErrors, MalformedHeaders)
+{
+    TempDir dir;
+    const auto check =
+        [&](const std::string& name, const std::string& content, std::string_view fragment)
+    {
+        const auto path = dir / name;
+        write_file(path, content);
+        expect_io_error([&] { (void)read_geometry(path); }, path, fragment);
+    };
+    check("nodata.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\n", "no DATA");
+    check("noxyz.pcd", "FIELDS x y\nSIZE 4 4\nTYPE F F\nWIDTH 1\nDATA ascii\n0 0\n",
+          "no x, y and z");
+    check("sizes.pcd", "FIELDS x y z\nSIZE 4 4\nTYPE F F F\nWIDTH 1\nDATA ascii\n0 0 0\n",
+          "SIZE has 2 values");
+    check("type.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F Q\nWIDTH 1\nDATA ascii\n0 0 0\n",
+          "unknown field type");
+    check("fsize.pcd", "FIELDS x y z\nSIZE 4 4 2\nTYPE F F F\nWIDTH 1\nDATA ascii\n0 0 0\n",
+          "unsupported size");
+    check("kind.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nDATA zip\n", "unknown DATA");
+    check("width.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nDATA ascii\n0 0 0\n", "no WIDTH");
+}
+
+TEST(PcdErrors, HugeDeclaredCountsFailCleanly)
+{
+    TempDir dir;
+    const auto path = dir / "huge.pcd";
+    write_file(path,
+               "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 100000000000\nHEIGHT 1\n"
+               "POINTS 100000000000\nDATA binary\n0123456789ab");
+    expect_io_error([&] { (void)read_geometry(path); }, path, "truncated");
+
+    const auto compressed = dir / "huge_compressed.pcd";
+    write_file(compressed, Bytes()
+                               .text("FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 300000000\n"
+                                     "HEIGHT 1\nPOINTS 300000000\nDATA binary_compressed\n")
+                               .le<std::uint32_t>(4)
+                               .le<std::uint32_t>(3600000000U)
+                               .text("abcd")
+                               .str());
+    expect_io_error([&] { (void)read_geometry(compressed); }, compressed, "too small");
+}
+
+}  // namespace
+}  // namespace pointform::test
