@@ -12,7 +12,7 @@ packages=(
   clang-format
 )
 if [[ "${1:-}" == "--peers" ]]; then
-  packages+=(python3 python3-numpy python3-open3d libcgal-dev time)
+  packages+=(python3 python3-numpy python3-open3d libcgal-dev libtbb-dev time)
 fi
 
 missing=()

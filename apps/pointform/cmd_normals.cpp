@@ -160,7 +160,7 @@ void register_normals(CLI::App& app, const GlobalOptions& global)
                     "Point set or mesh: .ply .xyz .pts .csv .txt .pwn .off .obj .pcd .las")
         ->required();
     cmd->add_option("-o,--output", options->output, "Output surfels (.ply, or .xyz)")->required();
-    cmd->add_option("-k", options->k, "Neighbours for PCA and radius, the point itself included")
+    cmd->add_option("-k", options->k, "Neighbours of each point, besides itself, for PCA and the radius")
         ->capture_default_str()
         ->check(CLI::Range(3, 1000));
     cmd->add_option("--graph-k", options->graph_k,

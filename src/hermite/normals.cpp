@@ -84,11 +84,12 @@ Normals estimate_normals(std::span<const Vec3f> positions, const NormalOptions& 
     if (options.k < 3)
         throw InvalidInput("estimate_normals: k = " + std::to_string(options.k) +
                            " is too small; a plane needs at least 3 neighbours");
-    if (positions.size() < options.k)
+    if (positions.size() <= options.k)
         throw InvalidInput("estimate_normals: " + std::to_string(positions.size()) +
-                           " points are fewer than k = " + std::to_string(options.k));
+                           " points are fewer than k + 1 = " + std::to_string(options.k + 1));
     const KdTree tree(positions);
-    const KnnTable table = knn_batch(tree, positions, options.k, {.progress = options.progress});
+    const KnnTable table =
+        knn_batch(tree, positions, options.k + 1, {.progress = options.progress});
     return estimate_normals(positions, table, options.progress);
 }
 

@@ -47,9 +47,9 @@ void check_surfel_input(const PointCloud& cloud, std::size_t k)
     if (k < 3)
         throw InvalidInput("k = " + std::to_string(k) +
                            " is too small: a tangent plane needs at least 3 neighbours");
-    if (cloud.size() < k)
-        throw InvalidInput("only " + std::to_string(cloud.size()) +
-                           " points, fewer than k = " + std::to_string(k) + " neighbours");
+    if (cloud.size() <= k)
+        throw InvalidInput("only " + std::to_string(cloud.size()) + " points, fewer than k + 1 = " +
+                           std::to_string(k + 1) + " (a point and its k neighbours)");
     for (std::size_t i = 0; i < cloud.size(); ++i)
         if (!cloud.positions[i].allFinite())
             throw InvalidInput("point " + std::to_string(i) + " has a NaN or infinite coordinate");
@@ -94,7 +94,8 @@ SurfelResult compute_surfels(const PointCloud& cloud, const SurfelOptions& optio
 
     const KdTree tree(positions);
     timer.lap("kd-tree");
-    const KnnTable table = knn_batch(tree, positions, options.k, {.progress = options.progress});
+    const KnnTable table =
+        knn_batch(tree, positions, options.k + 1, {.progress = options.progress});
     timer.lap("knn");
     Normals normals = estimate_normals(positions, table, options.progress);
     result.degenerate = normals.degenerate.size();

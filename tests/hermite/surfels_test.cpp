@@ -78,7 +78,7 @@ TEST(ComputeSurfels, SameOutputForOneAndTwoThreads)
 TEST(ComputeSurfels, RejectsBadInput)
 {
     PointCloud cloud = sample_shape(Shape::Sphere, {.count = 100, .seed = 13});
-    EXPECT_THROW((void)compute_surfels(cloud, {.k = 101}), InvalidInput); // fewer points than k
+    EXPECT_THROW((void)compute_surfels(cloud, {.k = 100}), InvalidInput); // no 100 others each
     EXPECT_THROW((void)compute_surfels(cloud, {.k = 2}), InvalidInput);
     EXPECT_THROW((void)compute_surfels(cloud, {.radius_scale = 0.0}), InvalidInput);
     EXPECT_THROW((void)compute_surfels(PointCloud{}), InvalidInput); // empty

@@ -74,7 +74,7 @@ std::string make_las(const LasSpec& spec, const std::vector<std::array<std::int3
     if (spec.minor >= 3)
         b.le<std::uint64_t>(0);
     if (spec.minor >= 4)
-        b.le<std::uint64_t>(0).le<std::uint32_t>(0).le(declared).zeros(15 * 8);
+        b.le<std::uint64_t>(0).le<std::uint32_t>(0).le(declared).zeros(std::size_t{15} * 8);
     EXPECT_EQ(b.size(), header_size);
     b.zeros(spec.padding);
     for (std::size_t i = 0; i < xyz.size(); ++i)

@@ -54,7 +54,7 @@ std::vector<PcdPoint> organized_points()
     return points;
 }
 
-std::string header(std::string_view data, std::uint64_t points = width * height)
+std::string header(std::string_view data, std::uint64_t points = std::uint64_t{width} * height)
 {
     return "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\n"
            "FIELDS x y z normal_x normal_y normal_z rgb curvature hist\n"
@@ -293,7 +293,7 @@ TEST(PcdErrors, TruncatedBinary)
     write_file(path, head + data);
     const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, "point 11 of the 12");
     ASSERT_TRUE(e && e->offset());
-    EXPECT_EQ(*e->offset(), head.size() + 11 * 11 * sizeof(float));
+    EXPECT_EQ(*e->offset(), head.size() + std::size_t{11} * 11 * sizeof(float));
 }
 
 TEST(PcdErrors, BinaryLongerThanPoints)

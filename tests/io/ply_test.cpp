@@ -264,7 +264,7 @@ TEST(PlyErrors, TruncatedBinaryNamesTheByteOffset)
     const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, "truncated");
     ASSERT_TRUE(e);
     ASSERT_TRUE(e->offset());
-    EXPECT_EQ(*e->offset(), header + 9 * 12 + 4);  // x of vertex 9 read, y cut
+    EXPECT_EQ(*e->offset(), header + std::size_t{9 * 12 + 4});  // x of vertex 9 read, y cut
 }
 
 TEST(PlyErrors, HeaderCountLargerThanBinaryData)

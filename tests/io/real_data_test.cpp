@@ -28,7 +28,8 @@ struct Expected
     std::size_t dropped = 0;
 };
 
-void PrintTo(const Expected& e, std::ostream* os)
+// GoogleTest looks this printer up by its name.
+void PrintTo(const Expected& e, std::ostream* os)  // NOLINT(readability-identifier-naming)
 {
     *os << e.file;
 }

@@ -43,8 +43,8 @@ struct PlaneFit
 /// \brief Options for estimate_normals.
 struct NormalOptions
 {
-    /// Neighbours in each fit, the point itself included. 16 suits most scans; raise it for
-    /// noisy data. Must not exceed the number of points.
+    /// Neighbours in each fit besides the point itself. 16 suits most scans; raise it for
+    /// noisy data. Must be less than the number of points.
     std::size_t k = 16;
     /// Optional progress report.
     ProgressCallback progress;
@@ -67,7 +67,7 @@ struct Normals
                                        const ProgressCallback& progress = {});
 
 /// \brief One-off: builds a kd-tree, finds k neighbours and estimates normals.
-/// \throw InvalidInput if there are fewer than k points or k < 3
+/// \throw InvalidInput if there are not more than k points, or k < 3
 [[nodiscard]] Normals estimate_normals(std::span<const Vec3f> positions,
                                        const NormalOptions& options = {});
 

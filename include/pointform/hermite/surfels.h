@@ -28,7 +28,8 @@ enum class OrientMode
 /// \brief Options for compute_surfels: Level 1 → Level 2 (§4).
 struct SurfelOptions
 {
-    /// Neighbours for PCA and for the automatic radius, the point itself included.
+    /// Neighbours of each point, besides itself, for PCA and the automatic radius (as CGAL counts
+    /// them; Open3D's KNN(k) counts the point itself).
     std::size_t k = 16;
     /// Neighbours a point in the orientation graph; 0 = min(k, 10).
     std::size_t graph_k = 0;
@@ -60,7 +61,7 @@ struct SurfelResult
     std::vector<std::pair<std::string, double>> stage_seconds;
 };
 
-/// \brief Checks that points can carry surfels: at least `k` points (k ≥ 3), all finite, not all
+/// \brief Checks that points can carry surfels: more than `k` points (k ≥ 3), all finite, not all
 /// coincident and not all on one line.
 /// \throw InvalidInput saying which condition fails
 void check_surfel_input(const PointCloud& cloud, std::size_t k);
