@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: MIT
 // Copyright (c) 2026 the pointform authors
 
-#include "common.h"
-
 #include "pointform/core/parallel.h"
 #include "pointform/io/io.h"
 #include "pointform/spatial/kd_tree.h"
+
+#include "common.h"
 
 #include <nlohmann/json.hpp>
 

@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: MIT
 // Copyright (c) 2026 the pointform authors
 
-#include "common.h"
-
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 #include "pointform/hermite/surfels.h"
 #include "pointform/io/io.h"
+
+#include "common.h"
 
 #include <nlohmann/json.hpp>
 
@@ -68,11 +68,11 @@ void parse_orient(const std::string& text, SurfelOptions& options)
 void run_normals(const NormalsCommandOptions& options, const GlobalOptions& global)
 {
     set_thread_count(global.threads);
-    SurfelOptions surfel_options{.k = options.k,
-                                 .graph_k = options.graph_k,
-                                 .rule = options.rule == "reflection" ? OrientationRule::Reflection
-                                                                      : OrientationRule::Hoppe,
-                                 .radius_scale = options.radius_scale};
+    SurfelOptions surfel_options{
+        .k = options.k,
+        .graph_k = options.graph_k,
+        .rule = options.rule == "reflection" ? OrientationRule::Reflection : OrientationRule::Hoppe,
+        .radius_scale = options.radius_scale};
     parse_orient(options.orient, surfel_options);
     if (!options.radius_regions.empty())
         surfel_options.radius_regions = read_radius_regions(options.radius_regions);
@@ -107,14 +107,12 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
         out["degenerate"] = result.degenerate;
         out["inherited"] = orientation.inherited;
         out["unoriented"] = orientation.unoriented.size();
-        out["unoriented_indices"] =
-            std::vector<std::uint32_t>(orientation.unoriented.begin(),
-                                       orientation.unoriented.begin() +
-                                           static_cast<std::ptrdiff_t>(std::min<std::size_t>(
-                                               orientation.unoriented.size(), 100)));
-        out["radius"] = {{"min", radii.front()},
-                         {"median", radii[radii.size() / 2]},
-                         {"max", radii.back()}};
+        out["unoriented_indices"] = std::vector<std::uint32_t>(
+            orientation.unoriented.begin(),
+            orientation.unoriented.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(
+                                                 orientation.unoriented.size(), 100)));
+        out["radius"] = {
+            {"min", radii.front()}, {"median", radii[radii.size() / 2]}, {"max", radii.back()}};
         nlohmann::json stages = nlohmann::json::object();
         for (const auto& [stage, seconds] : timings.stages())
             stages[stage] = seconds;
@@ -133,9 +131,9 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
     print_row("normals flipped", std::to_string(orientation.flipped));
     print_row("degenerate (inherited)", std::to_string(result.degenerate));
     print_row("unoriented", std::to_string(orientation.unoriented.size()));
-    print_row("radius min/median/max",
-              format_number(radii.front()) + " / " + format_number(radii[radii.size() / 2]) +
-                  " / " + format_number(radii.back()));
+    print_row("radius min/median/max", format_number(radii.front()) + " / " +
+                                           format_number(radii[radii.size() / 2]) + " / " +
+                                           format_number(radii.back()));
     std::string times;
     for (const auto& [stage, seconds] : timings.stages())
         times += (times.empty() ? "" : ", ") + stage + " " + format_number(seconds);
@@ -160,7 +158,8 @@ void register_normals(CLI::App& app, const GlobalOptions& global)
                     "Point set or mesh: .ply .xyz .pts .csv .txt .pwn .off .obj .pcd .las")
         ->required();
     cmd->add_option("-o,--output", options->output, "Output surfels (.ply, or .xyz)")->required();
-    cmd->add_option("-k", options->k, "Neighbours of each point, besides itself, for PCA and the radius")
+    cmd->add_option("-k", options->k,
+                    "Neighbours of each point, besides itself, for PCA and the radius")
         ->capture_default_str()
         ->check(CLI::Range(3, 1000));
     cmd->add_option("--graph-k", options->graph_k,

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: MIT
 // Copyright (c) 2026 the pointform authors
 
-#include "common.h"
-
 #include "pointform/geometry/shapes.h"
 #include "pointform/io/io.h"
+
+#include "common.h"
 
 #include <cstdio>
 #include <memory>
@@ -35,8 +35,9 @@ void register_sample(CLI::App& app, const GlobalOptions& global)
 {
     auto options = std::make_shared<SampleCommandOptions>();
     CLI::App* cmd = app.add_subcommand(
-        "sample", "Sample an analytic shape with its exact outward normals (test and benchmark "
-                  "inputs)");
+        "sample",
+        "Sample an analytic shape with its exact outward normals (test and benchmark "
+        "inputs)");
     cmd->add_option("shape", options->shape, "sphere, torus, two-spheres or plate")
         ->required()
         ->check(CLI::IsMember({"sphere", "torus", "two-spheres", "plate"}));

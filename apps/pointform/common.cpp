@@ -12,8 +12,7 @@
 
 namespace pointform::cli {
 
-TerminalProgress::TerminalProgress(bool enabled)
-    : enabled_(enabled && ::isatty(STDERR_FILENO) == 1)
+TerminalProgress::TerminalProgress(bool enabled) : enabled_(enabled && ::isatty(STDERR_FILENO) == 1)
 {
     callback_ = [this](std::string_view stage, double fraction) {
         if (!enabled_)

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: MIT
 // Copyright (c) 2026 the pointform authors
 
-#include "common.h"
-
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
+
+#include "common.h"
 
 #include <CLI/CLI.hpp>
 
@@ -27,9 +27,10 @@ enum ExitCode : int
 
 int main(int argc, char** argv)
 {
-    CLI::App app{"pointform: multiresolution free-form modeling from point-sampled geometry.\n"
-                 "Exit codes: 0 success, 2 invalid input, 3 file error, 4 other failure; "
-                 "usage errors as CLI11 reports them (non-zero)."};
+    CLI::App app{
+        "pointform: multiresolution free-form modeling from point-sampled geometry.\n"
+        "Exit codes: 0 success, 2 invalid input, 3 file error, 4 other failure; "
+        "usage errors as CLI11 reports them (non-zero)."};
     app.set_version_flag("--version", "pointform 0.1.0");
     app.require_subcommand(1);
     app.fallthrough();

@@ -14,9 +14,10 @@ namespace {
 
 void surfels(benchmark::State& state, Shape shape, double noise, std::size_t holes)
 {
-    const PointCloud truth = sample_shape(
-        shape, {.count = static_cast<std::size_t>(state.range(0)), .seed = 1, .noise = noise,
-                .holes = holes});
+    const PointCloud truth = sample_shape(shape, {.count = static_cast<std::size_t>(state.range(0)),
+                                                  .seed = 1,
+                                                  .noise = noise,
+                                                  .holes = holes});
     PointCloud input = truth;
     input.normals.clear();
     double oriented = 0.0;

@@ -44,8 +44,7 @@
 #include <tuple>
 #include <vector>
 
-namespace
-{
+namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
@@ -68,7 +67,7 @@ struct Arguments
     std::string input_path;
     std::string output_path;
     unsigned int k = 16;
-    unsigned int threads = 0;  // 0: all hardware threads
+    unsigned int threads = 0; // 0: all hardware threads
 };
 
 struct Timer
@@ -207,7 +206,7 @@ int run(const Arguments& args)
         args.threads != 0 ? args.threads : std::max(1U, std::thread::hardware_concurrency());
     const tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, threads);
 #else
-    const unsigned int threads = 1;  // Parallel_if_available_tag is Sequential_tag without TBB
+    const unsigned int threads = 1; // Parallel_if_available_tag is Sequential_tag without TBB
 #endif
 
     Timer timer;
@@ -225,20 +224,19 @@ int run(const Arguments& args)
 
     write_ply(args.output_path, entries, oriented_count);
     const double write_s = timer.lap();
-    const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                                         total.start)
-                               .count();
+    const double total_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - total.start).count();
 
     std::printf(
         "{\"tool\": \"cgal\", \"cgal_version\": \"%s\", \"points\": %zu, \"unoriented\": %zu, "
         "\"k\": %u, \"concurrency\": \"%s\", \"threads\": %u, \"timings_s\": {\"read\": %.6f, "
         "\"estimate\": %.6f, \"orient\": %.6f, \"write\": %.6f, \"total\": %.6f}}\n",
-        CGAL_VERSION_STR, entries.size(), entries.size() - oriented_count, args.k,
-        concurrency_name, threads, read_s, estimate_s, orient_s, write_s, total_s);
+        CGAL_VERSION_STR, entries.size(), entries.size() - oriented_count, args.k, concurrency_name,
+        threads, read_s, estimate_s, orient_s, write_s, total_s);
     return 0;
 }
 
-}  // namespace
+} // namespace
 
 int main(int argc, char** argv)
 {

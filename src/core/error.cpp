@@ -28,8 +28,7 @@ std::string describe(const std::filesystem::path& path, const std::string& what,
 IoError::IoError(const std::filesystem::path& path, const std::string& what,
                  std::optional<std::uint64_t> line, std::optional<std::uint64_t> offset)
     : Error(describe(path, what, line, offset)), path_(path), line_(line), offset_(offset)
-{
-}
+{}
 
 namespace detail {
 

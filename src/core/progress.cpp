@@ -11,8 +11,7 @@ namespace pointform {
 
 ProgressReporter::ProgressReporter(const ProgressCallback& callback, std::string_view stage)
     : callback_(callback ? &callback : nullptr), stage_(stage)
-{
-}
+{}
 
 void ProgressReporter::update(double done, double total)
 {

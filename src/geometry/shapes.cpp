@@ -85,21 +85,21 @@ Sample sample_one(Shape shape, std::mt19937_64& rng, const SampleOptions& option
 {
     switch (shape)
     {
-    case Shape::Sphere:
-    {
-        const Vec3d n = random_unit(rng);
-        return {n, n};
-    }
-    case Shape::Torus:
-        return sample_torus(rng);
-    case Shape::TwoSpheres:
-    {
-        const Vec3d n = random_unit(rng);
-        const double side = std::uniform_int_distribution<int>(0, 1)(rng) == 0 ? -1.0 : 1.0;
-        return {n + Vec3d(side * spheres_offset, 0.0, 0.0), n};
-    }
-    case Shape::Plate:
-        return sample_plate(rng, options.thickness);
+        case Shape::Sphere:
+        {
+            const Vec3d n = random_unit(rng);
+            return {n, n};
+        }
+        case Shape::Torus:
+            return sample_torus(rng);
+        case Shape::TwoSpheres:
+        {
+            const Vec3d n = random_unit(rng);
+            const double side = std::uniform_int_distribution<int>(0, 1)(rng) == 0 ? -1.0 : 1.0;
+            return {n + Vec3d(side * spheres_offset, 0.0, 0.0), n};
+        }
+        case Shape::Plate:
+            return sample_plate(rng, options.thickness);
     }
     throw InvalidInput("unknown shape");
 }
@@ -111,8 +111,9 @@ PointCloud sample_shape(Shape shape, const SampleOptions& options)
     if (options.count == 0)
         throw InvalidInput("sample_shape: count must be positive");
     if (!(options.noise >= 0.0) || !(options.hole_radius >= 0.0) || !(options.thickness > 0.0))
-        throw InvalidInput("sample_shape: noise, hole radius and thickness must be non-negative "
-                           "(thickness positive)");
+        throw InvalidInput(
+            "sample_shape: noise, hole radius and thickness must be non-negative "
+            "(thickness positive)");
 
     std::mt19937_64 rng(options.seed);
     std::vector<Sample> samples;
@@ -163,7 +164,8 @@ Shape parse_shape(const std::string& name)
         return Shape::TwoSpheres;
     if (name == "plate")
         return Shape::Plate;
-    throw InvalidInput("unknown shape '" + name + "' (expected sphere, torus, two-spheres or plate)");
+    throw InvalidInput("unknown shape '" + name +
+                       "' (expected sphere, torus, two-spheres or plate)");
 }
 
 } // namespace pointform

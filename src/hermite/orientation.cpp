@@ -8,11 +8,11 @@
 
 #include <algorithm>
 #include <bit>
-#include <numeric>
-#include <utility>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <string>
+#include <utility>
 
 namespace pointform {
 namespace {
@@ -268,9 +268,8 @@ RiemannianForest riemannian_spanning_forest(std::span<const Vec3f> positions,
     return forest;
 }
 
-OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
-                                   std::span<const Vec3f> normals, const KnnTable& neighbors,
-                                   const OrientationOptions& options)
+OrientedNormals orient_normals_mst(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
+                                   const KnnTable& neighbors, const OrientationOptions& options)
 {
     const RiemannianForest forest =
         riemannian_spanning_forest(positions, normals, neighbors, options);

@@ -128,12 +128,10 @@ std::vector<RadiusRegion> parse_radius_regions(const std::string& text,
             else
                 ++column;
         }
-        throw IoError(source, "invalid JSON at column " + std::to_string(column) + ": " +
-                                  e.what(),
+        throw IoError(source, "invalid JSON at column " + std::to_string(column) + ": " + e.what(),
                       line);
     }
-    if (!document.is_object() || !document.contains("regions") ||
-        !document["regions"].is_array())
+    if (!document.is_object() || !document.contains("regions") || !document["regions"].is_array())
         throw IoError(source, "expected an object with a \"regions\" array");
     std::vector<RadiusRegion> regions;
     const json& items = document["regions"];
@@ -157,8 +155,8 @@ std::vector<float> apply_radius_regions(std::span<const Vec3f> positions, const 
                                         std::span<const RadiusRegion> regions)
 {
     if (radii.size() != positions.size())
-        throw InvalidInput("apply_radius_regions: " + std::to_string(radii.size()) +
-                           " radii for " + std::to_string(positions.size()) + " points");
+        throw InvalidInput("apply_radius_regions: " + std::to_string(radii.size()) + " radii for " +
+                           std::to_string(positions.size()) + " points");
     if (regions.empty())
         return radii;
     parallel_blocks(positions.size(), 8192, [&](std::size_t begin, std::size_t end) {
@@ -168,9 +166,10 @@ std::vector<float> apply_radius_regions(std::span<const Vec3f> positions, const 
             const float automatic = radii[i];
             for (const auto& region : regions)
                 if (region.contains(p))
-                    radii[i] = region.scale > 0.0
-                                   ? static_cast<float>(region.scale * static_cast<double>(automatic))
-                                   : static_cast<float>(region.radius);
+                    radii[i] =
+                        region.scale > 0.0
+                            ? static_cast<float>(region.scale * static_cast<double>(automatic))
+                            : static_cast<float>(region.radius);
         }
     });
     return radii;

@@ -104,38 +104,37 @@ SurfelResult compute_surfels(const PointCloud& cloud, const SurfelOptions& optio
     OrientedNormals oriented;
     switch (options.orient)
     {
-    case OrientMode::Mst:
-    case OrientMode::Flip:
-    {
-        const std::size_t graph_k =
-            options.graph_k == 0 ? std::min<std::size_t>(options.k, 10) : options.graph_k;
-        oriented = orient_normals_mst(
-            positions, normals.normals, table,
-            {.k = graph_k, .rule = options.rule, .progress = options.progress});
-        if (options.orient == OrientMode::Flip)
+        case OrientMode::Mst:
+        case OrientMode::Flip:
         {
-            OrientedNormals flipped = flip_normals(oriented.normals);
-            oriented.normals = std::move(flipped.normals);
-            oriented.flipped = n - oriented.flipped;
+            const std::size_t graph_k =
+                options.graph_k == 0 ? std::min<std::size_t>(options.k, 10) : options.graph_k;
+            oriented = orient_normals_mst(
+                positions, normals.normals, table,
+                {.k = graph_k, .rule = options.rule, .progress = options.progress});
+            if (options.orient == OrientMode::Flip)
+            {
+                OrientedNormals flipped = flip_normals(oriented.normals);
+                oriented.normals = std::move(flipped.normals);
+                oriented.flipped = n - oriented.flipped;
+            }
+            break;
         }
-        break;
-    }
-    case OrientMode::None:
-        oriented.normals = normals.normals;
-        break;
-    case OrientMode::Towards:
-        oriented =
-            orient_normals_towards(positions, normals.normals, options.orient_target - cloud.origin);
-        break;
-    case OrientMode::Along:
-        oriented = orient_normals_along(normals.normals, options.orient_target);
-        break;
+        case OrientMode::None:
+            oriented.normals = normals.normals;
+            break;
+        case OrientMode::Towards:
+            oriented = orient_normals_towards(positions, normals.normals,
+                                              options.orient_target - cloud.origin);
+            break;
+        case OrientMode::Along:
+            oriented = orient_normals_along(normals.normals, options.orient_target);
+            break;
     }
     timer.lap("orientation");
 
     std::vector<float> radii = influence_radii(table, options.radius_scale);
-    radii = apply_radius_regions(positions, cloud.origin, std::move(radii),
-                                 options.radius_regions);
+    radii = apply_radius_regions(positions, cloud.origin, std::move(radii), options.radius_regions);
     timer.lap("radius");
 
     // Back to the input order.

@@ -7,9 +7,8 @@
 
 #include "support/test_support.h"
 
-#include <nlohmann/json.hpp>
-
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <sys/wait.h>
 
@@ -62,9 +61,8 @@ TEST(Cli, NormalsOnBunnyWritesSurfels)
 {
     test::TempDir dir;
     const auto out = dir / "bunny.ply";
-    const RunResult r =
-        run("normals " + quoted(test::data_path("bunny/bun_zipper.ply")) + " -o " + quoted(out) +
-            " -k 12 --radius-scale 2 --json");
+    const RunResult r = run("normals " + quoted(test::data_path("bunny/bun_zipper.ply")) + " -o " +
+                            quoted(out) + " -k 12 --radius-scale 2 --json");
     ASSERT_EQ(r.exit_code, 0) << r.out;
     const auto report = nlohmann::json::parse(r.out);
     EXPECT_EQ(report["points"], 35947);
@@ -92,9 +90,9 @@ TEST(Cli, OrientTowardsAndRegions)
     test::write_file(dir / "regions.json",
                      R"({"regions": [{"box": {"min": [-1,-1,-1], "max": [1,1,1]}, "set": 0.25}]})");
     const auto out = dir / "s.ply";
-    const RunResult r = run("normals " + quoted(test::data_path("pcl/bunny.pcd")) + " -o " +
-                            quoted(out) + " --orient towards:0,0,1 --radius-regions " +
-                            quoted(dir / "regions.json"));
+    const RunResult r =
+        run("normals " + quoted(test::data_path("pcl/bunny.pcd")) + " -o " + quoted(out) +
+            " --orient towards:0,0,1 --radius-regions " + quoted(dir / "regions.json"));
     ASSERT_EQ(r.exit_code, 0) << r.out;
     const PointCloud surfels = read_point_cloud(out);
     for (std::size_t i = 0; i < surfels.size(); ++i)
@@ -129,13 +127,14 @@ struct BadCase
 
 TEST(Cli, BadInputFailsCleanly)
 {
-    const std::string ply_header = "ply\nformat binary_little_endian 1.0\nelement vertex 100\n"
-                                   "property float x\nproperty float y\nproperty float z\n"
-                                   "end_header\n";
+    const std::string ply_header =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 100\n"
+        "property float x\nproperty float y\nproperty float z\n"
+        "end_header\n";
     std::string line_points;
     for (int i = 0; i < 50; ++i)
-        line_points += std::to_string(i) + " " + std::to_string(2 * i) + " " +
-                       std::to_string(3 * i) + "\n";
+        line_points +=
+            std::to_string(i) + " " + std::to_string(2 * i) + " " + std::to_string(3 * i) + "\n";
     std::string same_points;
     for (int i = 0; i < 50; ++i)
         same_points += "1 2 3\n";
@@ -176,8 +175,8 @@ TEST(Cli, BadInputFailsCleanly)
 
 TEST(Cli, UnwritableOutputFailsWithFileError)
 {
-    const RunResult r = run("normals " + quoted(test::data_path("pcl/bunny.pcd")) +
-                            " -o /nonexistent-dir/out.ply");
+    const RunResult r =
+        run("normals " + quoted(test::data_path("pcl/bunny.pcd")) + " -o /nonexistent-dir/out.ply");
     EXPECT_EQ(r.exit_code, 3) << r.out;
     EXPECT_NE(r.out.find("/nonexistent-dir/out.ply"), std::string::npos) << r.out;
 }

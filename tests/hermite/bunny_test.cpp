@@ -22,7 +22,8 @@ std::vector<Vec3f> vertex_normals(const TriMesh& mesh)
     const auto& p = mesh.vertices.positions;
     for (const auto& t : mesh.triangles)
     {
-        const Vec3d n = (p[t[1]] - p[t[0]]).cast<double>().cross((p[t[2]] - p[t[0]]).cast<double>());
+        const Vec3d n =
+            (p[t[1]] - p[t[0]]).cast<double>().cross((p[t[2]] - p[t[0]]).cast<double>());
         for (const auto v : t)
             sum[v] += n;
     }

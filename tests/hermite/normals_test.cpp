@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: MIT
 // Copyright (c) 2026 the pointform authors
 
+#include "pointform/hermite/normals.h"
+
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 #include "pointform/geometry/shapes.h"
-#include "pointform/hermite/normals.h"
 
 #include "support/test_support.h"
 
@@ -55,7 +56,8 @@ TEST(EstimateNormals, SphereNormalsAreRadial)
     const Normals normals = estimate_normals(sphere.positions, {.k = 16});
     ASSERT_EQ(normals.normals.size(), sphere.size());
     EXPECT_TRUE(normals.degenerate.empty());
-    // Sampling step h ≈ sqrt(4π/N) ≈ 0.025 on a unit sphere: the fit's tilt is O(h), a degree or so.
+    // Sampling step h ≈ sqrt(4π/N) ≈ 0.025 on a unit sphere: the fit's tilt is O(h), a degree or
+    // so.
     EXPECT_LT(test::line_angle_quantile_deg(normals.normals, sphere.normals, 0.5), 1.0);
     EXPECT_LT(test::line_angle_quantile_deg(normals.normals, sphere.normals, 1.0), 5.0);
     for (const auto& n : normals.normals)

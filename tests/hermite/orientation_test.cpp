@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: MIT
 // Copyright (c) 2026 the pointform authors
 
+#include "pointform/hermite/orientation.h"
+
 #include "pointform/core/error.h"
 #include "pointform/geometry/shapes.h"
 #include "pointform/hermite/normals.h"
-#include "pointform/hermite/orientation.h"
 #include "pointform/spatial/kd_tree.h"
 
 #include "support/test_support.h"
@@ -106,7 +107,8 @@ TEST(OrientNormalsMst, ReflectionRuleOrientsPlateThinnerThanTheNeighbourhood)
     // Half a sampling step thick: Hoppe's rule crosses the wall and flips one side (about 50%).
     const PointCloud plate =
         sample_shape(Shape::Plate, {.count = 40000, .seed = 4, .thickness = 0.01});
-    const OrientedNormals result = orient(plate, 16, {.k = 10, .rule = OrientationRule::Reflection});
+    const OrientedNormals result =
+        orient(plate, 16, {.k = 10, .rule = OrientationRule::Reflection});
     std::vector<Vec3f> est;
     std::vector<Vec3f> truth;
     for (std::size_t i = 0; i < plate.size(); ++i)
@@ -120,8 +122,9 @@ TEST(OrientNormalsMst, ReflectionRuleOrientsPlateThinnerThanTheNeighbourhood)
 
 TEST(OrientNormalsMst, NoisySphereWithHoles)
 {
-    const PointCloud sphere = sample_shape(
-        Shape::Sphere, {.count = 40000, .seed = 5, .noise = 0.002, .holes = 10, .hole_radius = 0.06});
+    const PointCloud sphere =
+        sample_shape(Shape::Sphere,
+                     {.count = 40000, .seed = 5, .noise = 0.002, .holes = 10, .hole_radius = 0.06});
     ASSERT_LT(sphere.size(), 40000U);
     const OrientedNormals result = orient(sphere, 16);
     EXPECT_GE(test::oriented_fraction(result.normals, sphere.normals), 0.999);
@@ -159,8 +162,7 @@ TEST(OrientNormalsMst, DegenerateSamplesInheritAndAreCounted)
     }
     const Prepared p = prepare(sphere, 16);
     EXPECT_GE(p.normals.degenerate.size(), 20U);
-    const OrientedNormals result =
-        orient_normals_mst(sphere.positions, p.normals.normals, p.table);
+    const OrientedNormals result = orient_normals_mst(sphere.positions, p.normals.normals, p.table);
     EXPECT_GE(result.inherited, 20U);
     EXPECT_TRUE(result.unoriented.empty());
     EXPECT_GE(test::oriented_fraction(result.normals, sphere.normals), 0.999);
@@ -174,8 +176,7 @@ TEST(OrientNormalsMst, ComponentWithoutNormalsIsReportedUnoriented)
     for (int i = 0; i < 20; ++i)
         sphere.positions.emplace_back(10.0F, 10.0F, 10.0F);
     const Prepared p = prepare(sphere, 16);
-    const OrientedNormals result =
-        orient_normals_mst(sphere.positions, p.normals.normals, p.table);
+    const OrientedNormals result = orient_normals_mst(sphere.positions, p.normals.normals, p.table);
     EXPECT_EQ(result.components, 2U);
     ASSERT_EQ(result.unoriented.size(), 20U);
     EXPECT_EQ(result.unoriented.front(), first_extra);
@@ -258,7 +259,8 @@ TEST(SimpleOrientations, TowardsAlongAndFlip)
     for (std::size_t i = 0; i < scrambled.size(); i += 2)
         scrambled[i] = -scrambled[i];
 
-    const OrientedNormals inward = orient_normals_towards(sphere.positions, scrambled, Vec3d::Zero());
+    const OrientedNormals inward =
+        orient_normals_towards(sphere.positions, scrambled, Vec3d::Zero());
     EXPECT_EQ(test::oriented_fraction(inward.normals, sphere.normals), 0.0);
     EXPECT_EQ(inward.flipped, sphere.size() - (sphere.size() + 1) / 2);
 

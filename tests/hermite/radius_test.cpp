@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
 // Copyright (c) 2026 the pointform authors
 
-#include "pointform/core/error.h"
 #include "pointform/hermite/radius.h"
+
+#include "pointform/core/error.h"
 #include "pointform/spatial/kd_tree.h"
 
 #include "support/test_support.h"
@@ -85,15 +86,15 @@ TEST(RadiusRegions, ErrorsNameTheProblem)
                  "negative");
     expect_error(R"({"regions": [{"box": {"min": [0,0,0], "max": [1,1,1]}, "set": -2}]})",
                  "positive");
-    expect_error(R"({"regions": [{"box": {"min": [2,0,0], "max": [1,1,1]}, "set": 2}]})",
-                 "exceed");
+    expect_error(R"({"regions": [{"box": {"min": [2,0,0], "max": [1,1,1]}, "set": 2}]})", "exceed");
     expect_error(R"({"zones": []})", "\"regions\"");
 }
 
 TEST(RadiusRegions, ReadsFileAndReportsMissingFile)
 {
     test::TempDir dir;
-    test::write_file(dir / "r.json", R"({"regions": [{"ball": {"center": [0,0,0], "radius": 1}, "set": 0.5}]})");
+    test::write_file(dir / "r.json",
+                     R"({"regions": [{"ball": {"center": [0,0,0], "radius": 1}, "set": 0.5}]})");
     EXPECT_EQ(read_radius_regions(dir / "r.json").size(), 1U);
     EXPECT_THROW((void)read_radius_regions(dir / "missing.json"), IoError);
 }

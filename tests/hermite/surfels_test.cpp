@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: MIT
 // Copyright (c) 2026 the pointform authors
 
+#include "pointform/hermite/surfels.h"
+
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 #include "pointform/geometry/shapes.h"
-#include "pointform/hermite/surfels.h"
 
 #include "support/test_support.h"
 
@@ -63,8 +64,8 @@ TEST(ComputeSurfels, OrientModes)
 
 TEST(ComputeSurfels, SameOutputForOneAndTwoThreads)
 {
-    const PointCloud cloud = sample_shape(
-        Shape::TwoSpheres, {.count = 20000, .seed = 12, .noise = 0.003, .holes = 4});
+    const PointCloud cloud =
+        sample_shape(Shape::TwoSpheres, {.count = 20000, .seed = 12, .noise = 0.003, .holes = 4});
     set_thread_count(1);
     const SurfelResult one = compute_surfels(cloud);
     set_thread_count(2);

@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: MIT
 // Copyright (c) 2026 the pointform authors
 
+#include "pointform/spatial/kd_tree.h"
+
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 #include "pointform/geometry/shapes.h"
-#include "pointform/spatial/kd_tree.h"
 
 #include <gtest/gtest.h>
 

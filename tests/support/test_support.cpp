@@ -5,15 +5,16 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <numbers>
-#include <vector>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
-#include <unistd.h>
+#include <vector>
 
 namespace pointform::test {
 
@@ -21,15 +22,14 @@ TempDir::TempDir()
 {
     static std::atomic<int> counter{0};
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    std::string name = info != nullptr
-                           ? std::string(info->test_suite_name()) + "." + info->name()
-                           : std::string("pointform");
+    std::string name = info != nullptr ? std::string(info->test_suite_name()) + "." + info->name()
+                                       : std::string("pointform");
     for (auto& c : name)
         if (c == '/')
             c = '_';
-    path_ = std::filesystem::temp_directory_path() /
-            ("pf_" + name + "_" + std::to_string(::getpid()) + "_" +
-             std::to_string(counter.fetch_add(1)));
+    path_ =
+        std::filesystem::temp_directory_path() / ("pf_" + name + "_" + std::to_string(::getpid()) +
+                                                  "_" + std::to_string(counter.fetch_add(1)));
     std::filesystem::create_directories(path_);
 }
 
@@ -76,14 +76,15 @@ double line_angle_quantile_deg(std::span<const Vec3f> estimated, std::span<const
     std::vector<double> angles;
     for (std::size_t i = 0; i < std::min(estimated.size(), truth.size()); ++i)
     {
-        const double c = std::abs(estimated[i].cast<double>().normalized().dot(
-            truth[i].cast<double>().normalized()));
+        const double c = std::abs(
+            estimated[i].cast<double>().normalized().dot(truth[i].cast<double>().normalized()));
         angles.push_back(std::acos(std::min(1.0, c)) * 180.0 / std::numbers::pi);
     }
     if (angles.empty())
         return 0.0;
     const auto at = static_cast<std::size_t>(q * static_cast<double>(angles.size() - 1));
-    std::nth_element(angles.begin(), angles.begin() + static_cast<std::ptrdiff_t>(at), angles.end());
+    std::nth_element(angles.begin(), angles.begin() + static_cast<std::ptrdiff_t>(at),
+                     angles.end());
     return angles[at];
 }
 

@@ -73,11 +73,11 @@ public:
 
 /// Internal invariant check; active unless NDEBUG is defined without PF_KEEP_ASSERTS.
 #if !defined(NDEBUG) || defined(PF_KEEP_ASSERTS)
-#define PF_ASSERT(cond)                                                                         \
-    do                                                                                          \
-    {                                                                                           \
-        if (!(cond))                                                                            \
-            ::pointform::detail::assert_fail(#cond, __FILE__, __LINE__);                        \
+#define PF_ASSERT(cond)                                                  \
+    do                                                                   \
+    {                                                                    \
+        if (!(cond))                                                     \
+            ::pointform::detail::assert_fail(#cond, __FILE__, __LINE__); \
     } while (false)
 #else
 #define PF_ASSERT(cond) ((void)0)

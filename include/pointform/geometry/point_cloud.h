@@ -31,10 +31,7 @@ struct PointCloud
     [[nodiscard]] bool has_radii() const { return !radii.empty(); }
 
     /// \brief World position of point i, in double precision.
-    [[nodiscard]] Vec3d world(std::size_t i) const
-    {
-        return origin + positions[i].cast<double>();
-    }
+    [[nodiscard]] Vec3d world(std::size_t i) const { return origin + positions[i].cast<double>(); }
     /// \brief Bounding box in world units.
     [[nodiscard]] Aabb bounds() const { return bounding_box(positions, origin); }
 };

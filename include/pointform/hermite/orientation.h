@@ -98,12 +98,12 @@ struct OrientedNormals
 ///
 /// Every connected component is handled on its own: its seed is its highest point (largest z),
 /// whose normal is turned to +z, and orientation spreads from it along the minimum spanning
-/// tree, each sample taking the sign that agrees with its tree parent under `options.rule`. Then, so that closed
-/// surfaces come out with outward normals whatever their shape, the component's normals are
-/// flipped if the area-weighted flux Σ a_i n_i·(p_i − c) (3 × the enclosed volume for a closed
-/// surface, by the divergence theorem) is clearly negative; for open, flat components the flux
-/// says little and the seed's +z stands. Samples with a zero normal (degenerate neighbourhoods)
-/// take their tree parent's normal and are counted in `inherited`.
+/// tree, each sample taking the sign that agrees with its tree parent under `options.rule`. Then,
+/// so that closed surfaces come out with outward normals whatever their shape, the component's
+/// normals are flipped if the area-weighted flux Σ a_i n_i·(p_i − c) (3 × the enclosed volume for a
+/// closed surface, by the divergence theorem) is clearly negative; for open, flat components the
+/// flux says little and the seed's +z stands. Samples with a zero normal (degenerate
+/// neighbourhoods) take their tree parent's normal and are counted in `inherited`.
 ///
 /// \param positions  N points
 /// \param normals    N unoriented normals (unit, or zero where undefined)

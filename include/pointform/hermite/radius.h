@@ -61,8 +61,7 @@ struct RadiusRegion
 /// \param radii      N automatic radii
 /// \return the new radii
 [[nodiscard]] std::vector<float> apply_radius_regions(std::span<const Vec3f> positions,
-                                                      const Vec3d& origin,
-                                                      std::vector<float> radii,
+                                                      const Vec3d& origin, std::vector<float> radii,
                                                       std::span<const RadiusRegion> regions);
 
 } // namespace pointform

@@ -59,8 +59,7 @@ public:
 
     /// \brief Appends to the buffers every point within `radius` of `query`, nearest first.
     /// \return the number appended
-    std::size_t radius_search(const Vec3f& query, float radius,
-                              std::vector<std::uint32_t>& indices,
+    std::size_t radius_search(const Vec3f& query, float radius, std::vector<std::uint32_t>& indices,
                               std::vector<float>& squared_distances) const;
 
 private:

@@ -17,7 +17,7 @@ struct KnnTable
     KnnTable() = default; // not an aggregate: `{.k = 16}` means options, never a table
 
     std::size_t k = 0;
-    std::vector<std::uint32_t> indices;  ///< N*k, row-major
+    std::vector<std::uint32_t> indices;   ///< N*k, row-major
     std::vector<float> squared_distances; ///< N*k, row-major, non-decreasing within a row
 
     [[nodiscard]] std::size_t rows() const { return k == 0 ? 0 : indices.size() / k; }
