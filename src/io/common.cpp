@@ -7,8 +7,7 @@
 #include <cmath>
 #include <utility>
 
-namespace pointform::detail
-{
+namespace pointform::detail {
 
 std::string to_lower(std::string_view text)
 {
@@ -108,7 +107,7 @@ void OutputBuffer::write_number(float value)
 
 void OutputBuffer::write_number(double value, int precision)
 {
-    constexpr int max_digits = 17;  // enough for any double
+    constexpr int max_digits = 17; // enough for any double
     if (precision > max_digits)
         precision = max_digits;
     char text[64];
@@ -140,4 +139,4 @@ void write_world_text(OutputBuffer& out, const PointCloud& cloud, std::size_t i,
     }
 }
 
-}  // namespace pointform::detail
+} // namespace pointform::detail

@@ -24,8 +24,7 @@
 #include <type_traits>
 #include <vector>
 
-namespace pointform::detail
-{
+namespace pointform::detail {
 
 /// Where in a file a problem was found: a 1-based line (text) or a byte offset (binary).
 struct Location
@@ -83,8 +82,7 @@ class ByteCursor
 public:
     ByteCursor(const std::filesystem::path& path, std::string_view bytes, std::size_t offset = 0)
         : path_(&path), bytes_(bytes), offset_(offset)
-    {
-    }
+    {}
 
     [[nodiscard]] std::size_t offset() const { return offset_; }
     [[nodiscard]] std::size_t remaining() const { return bytes_.size() - offset_; }
@@ -137,8 +135,7 @@ public:
     explicit LineReader(std::string_view text, std::size_t start = 0,
                         std::uint64_t lines_before = 0)
         : text_(text), pos_(start), line_(lines_before)
-    {
-    }
+    {}
 
     /// Next line, or false at the end of the text.
     bool next(std::string_view& line)
@@ -388,4 +385,4 @@ void write_xyz(OutputBuffer& out, const PointCloud& cloud, int precision);
 void write_off(OutputBuffer& out, const TriMesh& mesh, int precision);
 void write_obj(OutputBuffer& out, const TriMesh& mesh, int precision);
 
-}  // namespace pointform::detail
+} // namespace pointform::detail

@@ -14,10 +14,8 @@
 #include <system_error>
 #include <utility>
 
-namespace pointform
-{
-namespace
-{
+namespace pointform {
+namespace {
 
 using detail::fail;
 
@@ -84,7 +82,7 @@ void write_atomically(const std::filesystem::path& path, Body&& body)
     for (int i = 0; i < attempts && file == nullptr; ++i)
     {
         temp = temporary_name(path);
-        file = std::fopen(temp.c_str(), "wbx");  // x: fail rather than reuse an existing name
+        file = std::fopen(temp.c_str(), "wbx"); // x: fail rather than reuse an existing name
         if (file == nullptr && errno != EEXIST)
             break;
     }
@@ -119,7 +117,7 @@ FileFormat resolve_format(const std::filesystem::path& path, FileFormat format)
     return format == FileFormat::Auto ? format_from_extension(path) : format;
 }
 
-}  // namespace
+} // namespace
 
 std::string format_name(FileFormat format)
 {
@@ -221,14 +219,12 @@ void write_point_cloud(const std::filesystem::path& path, const PointCloud& clou
     const FileFormat format = resolve_format(path, options.format);
     if (format != FileFormat::Ply && format != FileFormat::Xyz)
         fail(path, "cannot write point clouds as " + format_name(format) + " (use ply or xyz)");
-    write_atomically(path,
-                     [&](detail::OutputBuffer& out)
-                     {
-                         if (format == FileFormat::Ply)
-                             detail::write_ply(out, cloud, {}, options.ascii, options.precision);
-                         else
-                             detail::write_xyz(out, cloud, options.precision);
-                     });
+    write_atomically(path, [&](detail::OutputBuffer& out) {
+        if (format == FileFormat::Ply)
+            detail::write_ply(out, cloud, {}, options.ascii, options.precision);
+        else
+            detail::write_xyz(out, cloud, options.precision);
+    });
 }
 
 void write_mesh(const std::filesystem::path& path, const TriMesh& mesh, const WriteOptions& options)
@@ -244,23 +240,21 @@ void write_mesh(const std::filesystem::path& path, const TriMesh& mesh, const Wr
     const FileFormat format = resolve_format(path, options.format);
     if (format != FileFormat::Ply && format != FileFormat::Off && format != FileFormat::Obj)
         fail(path, "cannot write meshes as " + format_name(format) + " (use ply, off or obj)");
-    write_atomically(path,
-                     [&](detail::OutputBuffer& out)
-                     {
-                         switch (format)
-                         {
-                             case FileFormat::Ply:
-                                 detail::write_ply(out, mesh.vertices, mesh.triangles,
-                                                   options.ascii, options.precision);
-                                 break;
-                             case FileFormat::Off:
-                                 detail::write_off(out, mesh, options.precision);
-                                 break;
-                             default:
-                                 detail::write_obj(out, mesh, options.precision);
-                                 break;
-                         }
-                     });
+    write_atomically(path, [&](detail::OutputBuffer& out) {
+        switch (format)
+        {
+            case FileFormat::Ply:
+                detail::write_ply(out, mesh.vertices, mesh.triangles, options.ascii,
+                                  options.precision);
+                break;
+            case FileFormat::Off:
+                detail::write_off(out, mesh, options.precision);
+                break;
+            default:
+                detail::write_obj(out, mesh, options.precision);
+                break;
+        }
+    });
 }
 
-}  // namespace pointform
+} // namespace pointform

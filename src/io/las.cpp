@@ -9,10 +9,8 @@
 #include <algorithm>
 #include <cmath>
 
-namespace pointform::detail
-{
-namespace
-{
+namespace pointform::detail {
+namespace {
 
 constexpr std::size_t header_size_1_0 = 227;
 constexpr std::size_t header_size_1_4 = 375;
@@ -118,7 +116,7 @@ LasHeader parse_header(const std::filesystem::path& path, std::string_view bytes
     return h;
 }
 
-}  // namespace
+} // namespace
 
 ReadResult read_las(const std::filesystem::path& path, std::string_view bytes,
                     NonFinitePolicy policy)
@@ -167,8 +165,7 @@ ReadResult read_las(const std::filesystem::path& path, std::string_view bytes,
         }
         if (has_colors)
         {
-            const auto channel = [&](std::size_t c)
-            {
+            const auto channel = [&](std::size_t c) {
                 const auto v = load<std::uint16_t>(record + color_at + 2 * c, ByteOrder::Little);
                 return static_cast<std::uint8_t>(v >> shift);
             };
@@ -186,4 +183,4 @@ ReadResult read_las(const std::filesystem::path& path, std::string_view bytes,
     return result;
 }
 
-}  // namespace pointform::detail
+} // namespace pointform::detail

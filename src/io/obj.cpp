@@ -10,10 +10,8 @@
 #include <cmath>
 #include <limits>
 
-namespace pointform::detail
-{
-namespace
-{
+namespace pointform::detail {
+namespace {
 
 /// One face corner that names a normal: vertex index and normal index, both 0-based.
 struct CornerNormal
@@ -77,7 +75,7 @@ std::vector<Vec3f> vertex_normals(std::size_t vertex_count, const std::vector<Ve
     return sum;
 }
 
-}  // namespace
+} // namespace
 
 ReadResult read_obj(const std::filesystem::path& path, std::string_view bytes,
                     NonFinitePolicy policy)
@@ -123,7 +121,7 @@ ReadResult read_obj(const std::filesystem::path& path, std::string_view bytes,
                     first_non_finite_line = lines.line_number();
             }
             positions.push_back(p);
-            if (n == 6)  // x y z r g b, a common extension
+            if (n == 6) // x y z r g b, a common extension
                 colors.push_back({to_color(v[3]), to_color(v[4]), to_color(v[5])});
             else
                 all_colored = false;
@@ -242,4 +240,4 @@ void write_obj(OutputBuffer& out, const TriMesh& mesh, int precision)
     }
 }
 
-}  // namespace pointform::detail
+} // namespace pointform::detail

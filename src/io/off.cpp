@@ -9,10 +9,8 @@
 #include <cmath>
 #include <limits>
 
-namespace pointform::detail
-{
-namespace
-{
+namespace pointform::detail {
+namespace {
 
 struct OffVariant
 {
@@ -84,7 +82,7 @@ private:
     LineReader lines_;
 };
 
-}  // namespace
+} // namespace
 
 ReadResult read_off(const std::filesystem::path& path, std::string_view bytes,
                     NonFinitePolicy policy)
@@ -119,7 +117,7 @@ ReadResult read_off(const std::filesystem::path& path, std::string_view bytes,
     if (vertex_count > std::numeric_limits<std::uint32_t>::max())
         fail(path, "too many vertices for 32-bit face indices", lines.where());
 
-    constexpr std::size_t min_vertex_line = 6;  // "0 0 0\n"
+    constexpr std::size_t min_vertex_line = 6; // "0 0 0\n"
     CloudBuilder builder(path, policy, {.normals = variant->normals, .colors = variant->colors},
                          capped_reserve(vertex_count, bytes.size(), min_vertex_line));
     const std::size_t required = 3 + (variant->normals ? 3 : 0);
@@ -170,7 +168,7 @@ ReadResult read_off(const std::filesystem::path& path, std::string_view bytes,
     }
 
     ReadResult result;
-    constexpr std::size_t min_face_line = 8;  // "3 0 1 2\n"
+    constexpr std::size_t min_face_line = 8; // "3 0 1 2\n"
     result.triangles.reserve(capped_reserve(face_count, bytes.size(), min_face_line));
     std::vector<std::uint32_t> polygon;
     for (std::uint64_t f = 0; f < face_count; ++f)
@@ -237,4 +235,4 @@ void write_off(OutputBuffer& out, const TriMesh& mesh, int precision)
     }
 }
 
-}  // namespace pointform::detail
+} // namespace pointform::detail

@@ -10,10 +10,8 @@
 #include <cmath>
 #include <limits>
 
-namespace pointform::detail
-{
-namespace
-{
+namespace pointform::detail {
+namespace {
 
 enum class PcdRole : std::uint8_t
 {
@@ -30,7 +28,7 @@ enum class PcdRole : std::uint8_t
 struct PcdField
 {
     std::string name;
-    char type = 'F';  ///< F (float), I (signed), U (unsigned)
+    char type = 'F'; ///< F (float), I (signed), U (unsigned)
     std::size_t size = 4;
     std::size_t count = 1;
     PcdRole role = PcdRole::None;
@@ -128,8 +126,7 @@ PcdHeader parse_header(const std::filesystem::path& path, std::string_view bytes
         if (rest.empty() || rest.front() == '#' || !next_token(rest, keyword))
             continue;
         split(rest, values);
-        const auto integer = [&](std::string_view token)
-        {
+        const auto integer = [&](std::string_view token) {
             std::uint64_t v = 0;
             if (!parse_integer(token, v))
                 fail(path, "malformed number " + quote(token) + " in " + std::string(keyword),
@@ -451,7 +448,7 @@ void read_ascii(const std::filesystem::path& path, std::string_view bytes, const
              Location::at_line(lines.line_number() + 1));
 }
 
-}  // namespace
+} // namespace
 
 bool lzf_decompress(std::string_view input, std::span<char> output)
 {
@@ -492,7 +489,7 @@ bool lzf_decompress(std::string_view input, std::span<char> output)
             length > static_cast<std::size_t>(out_end - out))
             return false;
         const char* from = out - distance;
-        for (std::size_t k = 0; k < length; ++k)  // may overlap: copy forward byte by byte
+        for (std::size_t k = 0; k < length; ++k) // may overlap: copy forward byte by byte
             *out++ = *from++;
     }
     return out == out_end;
@@ -589,4 +586,4 @@ ReadResult read_pcd(const std::filesystem::path& path, std::string_view bytes,
     return result;
 }
 
-}  // namespace pointform::detail
+} // namespace pointform::detail

@@ -12,10 +12,8 @@
 #include <cmath>
 #include <limits>
 
-namespace pointform::detail
-{
-namespace
-{
+namespace pointform::detail {
+namespace {
 
 enum class PlyType : std::uint8_t
 {
@@ -96,7 +94,7 @@ constexpr std::size_t role_count = static_cast<std::size_t>(Role::FaceIndices) +
 struct PlyProperty
 {
     std::string name;
-    PlyType type = PlyType::Float32;  ///< value type (item type for lists)
+    PlyType type = PlyType::Float32; ///< value type (item type for lists)
     bool is_list = false;
     PlyType count_type = PlyType::Uint8;
     Role role = Role::None;
@@ -107,7 +105,7 @@ struct PlyElement
     std::string name;
     std::uint64_t count = 0;
     std::vector<PlyProperty> properties;
-    std::uint64_t line = 0;  ///< header line that declares it
+    std::uint64_t line = 0; ///< header line that declares it
 
     /// Bytes per instance in binary, or 0 if the element has a list property.
     [[nodiscard]] std::size_t fixed_stride() const
@@ -143,10 +141,10 @@ struct PlyHeader
 {
     PlyEncoding encoding = PlyEncoding::Ascii;
     std::vector<PlyElement> elements;
-    std::size_t data_offset = 0;        ///< first byte after end_header
-    std::uint64_t header_lines = 0;     ///< number of header lines
-    std::optional<std::size_t> vertex;  ///< index of the vertex element, if any
-    std::optional<std::size_t> face;    ///< index of the face element with vertex indices, if any
+    std::size_t data_offset = 0;       ///< first byte after end_header
+    std::uint64_t header_lines = 0;    ///< number of header lines
+    std::optional<std::size_t> vertex; ///< index of the vertex element, if any
+    std::optional<std::size_t> face;   ///< index of the face element with vertex indices, if any
     AttributeSet attributes;
 };
 
@@ -290,8 +288,7 @@ PlyHeader parse_header(const std::filesystem::path& path, std::string_view bytes
                 property.role = vertex_role(property.name);
                 found[static_cast<std::size_t>(property.role)] = true;
             }
-            const auto has = [&](Role role)
-            {
+            const auto has = [&](Role role) {
                 return found[static_cast<std::size_t>(role)];
             };
             if (!has(Role::X) || !has(Role::Y) || !has(Role::Z))
@@ -335,7 +332,7 @@ PlyHeader parse_header(const std::filesystem::path& path, std::string_view bytes
 
 std::uint8_t to_color(double value, PlyType type)
 {
-    if (!(value > 0.0))  // also catches NaN
+    if (!(value > 0.0)) // also catches NaN
         return 0;
     if (is_floating(type))
         return static_cast<std::uint8_t>(std::lround(std::min(value, 1.0) * 255.0));
@@ -351,8 +348,7 @@ public:
     BinarySource(const std::filesystem::path& path, std::string_view bytes, std::size_t offset,
                  ByteOrder order)
         : cursor_(path, bytes, offset), order_(order)
-    {
-    }
+    {}
 
     void begin(const PlyElement& element, std::uint64_t index)
     {
@@ -484,8 +480,7 @@ public:
     AsciiSource(const std::filesystem::path& path, std::string_view bytes, std::size_t offset,
                 std::uint64_t header_lines)
         : path_(&path), lines_(bytes, offset, header_lines)
-    {
-    }
+    {}
 
     void begin(const PlyElement& element, std::uint64_t index)
     {
@@ -679,8 +674,7 @@ template <typename Source>
 ReadResult read_body(Source& source, const PlyHeader& header, NonFinitePolicy policy,
                      std::size_t ascii_min_line)
 {
-    const auto min_size = [&](const PlyElement& element)
-    {
+    const auto min_size = [&](const PlyElement& element) {
         return ascii_min_line > 0 ? ascii_min_line
                                   : std::max<std::size_t>(1, element.min_binary_size());
     };
@@ -737,7 +731,7 @@ void write_header(OutputBuffer& out, const PointCloud& cloud, std::size_t faces,
     out.write("end_header\n");
 }
 
-}  // namespace
+} // namespace
 
 ReadResult read_ply(const std::filesystem::path& path, std::string_view bytes,
                     NonFinitePolicy policy)
@@ -747,7 +741,7 @@ ReadResult read_ply(const std::filesystem::path& path, std::string_view bytes,
     if (header.encoding == PlyEncoding::Ascii)
     {
         AsciiSource source(path, bytes, header.data_offset, header.header_lines);
-        constexpr std::size_t min_line = 2;  // one digit and a newline
+        constexpr std::size_t min_line = 2; // one digit and a newline
         result = read_body(source, header, policy, min_line);
         result.description = "PLY ascii";
     }
@@ -848,4 +842,4 @@ void write_ply(OutputBuffer& out, const PointCloud& cloud, std::span<const Trian
     }
 }
 
-}  // namespace pointform::detail
+} // namespace pointform::detail

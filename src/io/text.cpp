@@ -10,10 +10,8 @@
 #include <algorithm>
 #include <cmath>
 
-namespace pointform::detail
-{
-namespace
-{
+namespace pointform::detail {
+namespace {
 
 enum class Column : std::uint8_t
 {
@@ -99,8 +97,7 @@ Layout layout_from_names(const std::filesystem::path& path, std::string_view lin
     std::string_view token;
     while (next_token(line, token, separators_include_commas))
         layout.columns.push_back(column_from_name(token));
-    const auto has = [&](Column c)
-    {
+    const auto has = [&](Column c) {
         return std::find(layout.columns.begin(), layout.columns.end(), c) != layout.columns.end();
     };
     if (!has(Column::X) || !has(Column::Y) || !has(Column::Z))
@@ -171,15 +168,14 @@ std::uint8_t to_color(double value)
     return static_cast<std::uint8_t>(std::lround(std::min(value, 255.0)));
 }
 
-}  // namespace
+} // namespace
 
 ReadResult read_text(const std::filesystem::path& path, std::string_view bytes,
                      NonFinitePolicy policy, bool pts_hint)
 {
     LineReader lines(bytes);
     std::string_view line;
-    const auto next_data_line = [&]()
-    {
+    const auto next_data_line = [&]() {
         while (lines.next(line))
         {
             const std::string_view content = trim(line);
@@ -322,4 +318,4 @@ void write_xyz(OutputBuffer& out, const PointCloud& cloud, int precision)
     }
 }
 
-}  // namespace pointform::detail
+} // namespace pointform::detail

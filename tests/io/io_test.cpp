@@ -6,10 +6,8 @@
 
 #include <gtest/gtest.h>
 
-namespace pointform::test
-{
-namespace
-{
+namespace pointform::test {
+namespace {
 
 TEST(IoFormat, FromExtension)
 {
@@ -163,5 +161,5 @@ TEST(IoWrite, EmptyCloudRoundTrips)
     }
 }
 
-}  // namespace
-}  // namespace pointform::test
+} // namespace
+} // namespace pointform::test

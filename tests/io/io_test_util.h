@@ -25,8 +25,7 @@
 #include <string_view>
 #include <vector>
 
-namespace pointform::test
-{
+namespace pointform::test {
 
 /// Appends text and binary values in either byte order to a byte string.
 class Bytes
@@ -130,8 +129,7 @@ inline TriMesh make_grid_mesh(std::size_t rows, std::size_t cols,
             mesh.vertices.positions.emplace_back(x, y,
                                                  0.1F * std::sin(6.0F * x) * std::cos(4.0F * y));
         }
-    const auto id = [&](std::size_t r, std::size_t c)
-    {
+    const auto id = [&](std::size_t r, std::size_t c) {
         return static_cast<std::uint32_t>(r * (cols + 1) + c);
     };
     for (std::size_t r = 0; r < rows; ++r)
@@ -222,4 +220,4 @@ inline std::vector<std::string> list_directory(const std::filesystem::path& dir)
     return names;
 }
 
-}  // namespace pointform::test
+} // namespace pointform::test

@@ -9,10 +9,8 @@
 #include <array>
 #include <cmath>
 
-namespace pointform::test
-{
-namespace
-{
+namespace pointform::test {
+namespace {
 
 using Rgb16 = std::array<std::uint16_t, 3>;
 
@@ -40,12 +38,12 @@ struct LasSpec
 {
     int minor = 2;
     int format = 0;
-    std::size_t extra_bytes = 0;  ///< bytes after the standard record fields
-    std::size_t padding = 0;      ///< bytes between the header and the point data
+    std::size_t extra_bytes = 0; ///< bytes after the standard record fields
+    std::size_t padding = 0;     ///< bytes between the header and the point data
     Vec3d scale = Vec3d(0.001, 0.001, 0.001);
     Vec3d offset = Vec3d(5e5, 4e6, 100.0);
-    bool legacy_count = true;          ///< LAS 1.4: also fill the 32-bit legacy count
-    std::uint64_t declared_extra = 0;  ///< points declared beyond those written
+    bool legacy_count = true;         ///< LAS 1.4: also fill the 32-bit legacy count
+    std::uint64_t declared_extra = 0; ///< points declared beyond those written
 };
 
 /// A LAS file with the given integer coordinates (X Y Z before scale and offset) and colors.
@@ -70,7 +68,7 @@ std::string make_las(const LasSpec& spec, const std::vector<std::array<std::int3
         b.le(spec.scale[k]);
     for (int k = 0; k < 3; ++k)
         b.le(spec.offset[k]);
-    b.zeros(48);  // max and min: informative only
+    b.zeros(48); // max and min: informative only
     if (spec.minor >= 3)
         b.le<std::uint64_t>(0);
     if (spec.minor >= 4)
@@ -81,7 +79,7 @@ std::string make_las(const LasSpec& spec, const std::vector<std::array<std::int3
     {
         const std::size_t start = b.size();
         b.le(xyz[i][0]).le(xyz[i][1]).le(xyz[i][2]);
-        b.le<std::uint16_t>(static_cast<std::uint16_t>(i));  // intensity
+        b.le<std::uint16_t>(static_cast<std::uint16_t>(i)); // intensity
         const std::size_t at = rgb_offset(spec.format);
         if (at != 0)
         {
@@ -145,8 +143,7 @@ struct LasCase
 };
 
 class LasFormats : public ::testing::TestWithParam<LasCase>
-{
-};
+{};
 
 TEST_P(LasFormats, ScaleOffsetColorsAndExtraBytes)
 {
@@ -157,7 +154,7 @@ TEST_P(LasFormats, ScaleOffsetColorsAndExtraBytes)
     spec.minor = param.minor;
     spec.format = param.format;
     spec.extra_bytes = 5;
-    spec.padding = 54 + 16;  // where a VLR would sit
+    spec.padding = 54 + 16; // where a VLR would sit
     const auto xyz = sample_xyz(500);
     const auto rgb = sample_rgb(500, true);
     write_file(path, make_las(spec, xyz, rgb));
@@ -183,8 +180,7 @@ INSTANTIATE_TEST_SUITE_P(AllPointFormats, LasFormats,
                                            LasCase{3, 5}, LasCase{4, 6}, LasCase{4, 7},
                                            LasCase{4, 8}, LasCase{4, 9}, LasCase{4, 10},
                                            LasCase{4, 0}, LasCase{4, 3}),
-                         [](const ::testing::TestParamInfo<LasCase>& test)
-                         {
+                         [](const ::testing::TestParamInfo<LasCase>& test) {
                              return "v1_" + std::to_string(test.param.minor) + "_format" +
                                     std::to_string(test.param.format);
                          });
@@ -257,7 +253,7 @@ TEST(LasErrors, Truncated)
     const LasSpec spec{.minor = 2, .format = 3, .declared_extra = 1};
     const auto xyz = sample_xyz(10);
     std::string bytes = make_las(spec, xyz, sample_rgb(10, true));
-    bytes += std::string(20, '\0');  // part of the 11th record
+    bytes += std::string(20, '\0'); // part of the 11th record
     write_file(path, bytes);
     const auto e =
         expect_io_error([&] { (void)read_geometry(path); }, path, "point record 10 of the 11");
@@ -290,9 +286,8 @@ TEST(LasErrors, UnsupportedVersionFormatAndLayout)
 {
     TempDir dir;
     const std::string good = make_las({.minor = 2, .format = 1}, sample_xyz(3), {});
-    const auto check =
-        [&](const std::string& name, std::size_t at, char value, std::string_view fragment)
-    {
+    const auto check = [&](const std::string& name, std::size_t at, char value,
+                           std::string_view fragment) {
         std::string bytes = good;
         bytes[at] = value;
         const auto path = dir / name;
@@ -307,5 +302,5 @@ TEST(LasErrors, UnsupportedVersionFormatAndLayout)
     check("offset.las", 97, 0x7F, "truncated");
 }
 
-}  // namespace
-}  // namespace pointform::test
+} // namespace
+} // namespace pointform::test

@@ -6,10 +6,8 @@
 
 #include <gtest/gtest.h>
 
-namespace pointform::test
-{
-namespace
-{
+namespace pointform::test {
+namespace {
 
 TEST(OffRoundTrip, Mesh)
 {
@@ -85,8 +83,7 @@ TEST(OffErrors, Malformed)
 {
     TempDir dir;
     const auto check = [&](const std::string& name, const std::string& content,
-                           std::string_view fragment, std::uint64_t line)
-    {
+                           std::string_view fragment, std::uint64_t line) {
         const auto path = dir / name;
         write_file(path, content);
         const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, fragment);
@@ -168,15 +165,14 @@ TEST(ObjRead, PartialNormalReferencesGiveNoNormals)
     write_file(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 5 5\nvn 0 0 1\nf 1//1 2//1 3//1\n");
     const PointCloud cloud = read_point_cloud(path);
     EXPECT_EQ(cloud.size(), 4U);
-    EXPECT_FALSE(cloud.has_normals());  // vertex 4 has none
+    EXPECT_FALSE(cloud.has_normals()); // vertex 4 has none
 }
 
 TEST(ObjErrors, Malformed)
 {
     TempDir dir;
     const auto check = [&](const std::string& name, const std::string& content,
-                           std::string_view fragment, std::uint64_t line)
-    {
+                           std::string_view fragment, std::uint64_t line) {
         const auto path = dir / name;
         write_file(path, content);
         const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, fragment);
@@ -212,5 +208,5 @@ TEST(ObjErrors, DroppingVerticesOfAMeshIsAnError)
     EXPECT_EQ(result.dropped_points, 1U);
 }
 
-}  // namespace
-}  // namespace pointform::test
+} // namespace
+} // namespace pointform::test

@@ -9,10 +9,8 @@
 #include <array>
 #include <cmath>
 
-namespace pointform::test
-{
-namespace
-{
+namespace pointform::test {
+namespace {
 
 /// One point of the test clouds: the fields x y z normal_x normal_y normal_z rgb curvature
 /// hist[3], all float32 as PCL writes them (rgb is a packed 0x00RRGGBB in a float's bits).
@@ -70,8 +68,7 @@ std::string ascii_pcd(const std::vector<PcdPoint>& points)
     std::string text = header("ascii");
     for (const PcdPoint& p : points)
     {
-        const auto number = [](float v)
-        {
+        const auto number = [](float v) {
             return std::isnan(v) ? std::string("nan") : std::to_string(v);
         };
         for (const float v : p.xyz)
@@ -200,7 +197,7 @@ TEST(PcdRead, ErrorPolicyRejectsNaNs)
         expect_io_error([&] { (void)read_geometry(path, {.non_finite = NonFinitePolicy::Error}); },
                         path, "non-finite");
     ASSERT_TRUE(e && e->offset());
-    EXPECT_EQ(*e->offset(), head.size() + sizeof(float) * 11);  // point 1: 11 floats a point
+    EXPECT_EQ(*e->offset(), head.size() + sizeof(float) * 11); // point 1: 11 floats a point
 }
 
 TEST(PcdRead, BackReferencesInLzf)
@@ -331,7 +328,7 @@ TEST(PcdErrors, CompressedSizesAndCorruptStream)
 
     const auto corrupt = dir / "corrupt.pcd";
     std::string bad = lzf;
-    bad[0] = static_cast<char>(0x20);  // a back reference before any output
+    bad[0] = static_cast<char>(0x20); // a back reference before any output
     write_file(corrupt, Bytes()
                             .text(header("binary_compressed"))
                             .le(static_cast<std::uint32_t>(bad.size()))
@@ -377,9 +374,8 @@ TEST(PcdErrors, AsciiLinesAndValues)
 TEST(PcdErrors, MalformedHeaders)
 {
     TempDir dir;
-    const auto check =
-        [&](const std::string& name, const std::string& content, std::string_view fragment)
-    {
+    const auto check = [&](const std::string& name, const std::string& content,
+                           std::string_view fragment) {
         const auto path = dir / name;
         write_file(path, content);
         expect_io_error([&] { (void)read_geometry(path); }, path, fragment);
@@ -417,5 +413,5 @@ TEST(PcdErrors, HugeDeclaredCountsFailCleanly)
     expect_io_error([&] { (void)read_geometry(compressed); }, compressed, "too small");
 }
 
-}  // namespace
-}  // namespace pointform::test
+} // namespace
+} // namespace pointform::test

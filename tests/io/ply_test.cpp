@@ -6,10 +6,8 @@
 
 #include <gtest/gtest.h>
 
-namespace pointform::test
-{
-namespace
-{
+namespace pointform::test {
+namespace {
 
 TEST(PlyRoundTrip, BinaryWithAllAttributes)
 {
@@ -24,7 +22,7 @@ TEST(PlyRoundTrip, BinaryWithAllAttributes)
     EXPECT_EQ(result.description, "PLY binary_little_endian");
     EXPECT_TRUE(result.triangles.empty());
     EXPECT_EQ(result.dropped_points, 0U);
-    expect_same_cloud(cloud, result.points, 0.0);  // float in, float out: exact
+    expect_same_cloud(cloud, result.points, 0.0); // float in, float out: exact
 }
 
 TEST(PlyRoundTrip, AsciiWithAllAttributes)
@@ -40,7 +38,7 @@ TEST(PlyRoundTrip, AsciiWithAllAttributes)
 
     const ReadResult result = read_geometry(path);
     EXPECT_EQ(result.description, "PLY ascii");
-    expect_same_cloud(cloud, result.points, 0.0);  // shortest float text round-trips exactly
+    expect_same_cloud(cloud, result.points, 0.0); // shortest float text round-trips exactly
 }
 
 TEST(PlyRoundTrip, PositionsOnlyHaveNoAttributes)
@@ -168,8 +166,8 @@ void check_every_type(const ReadResult& result)
         EXPECT_EQ(cloud.world(i), Vec3d(-1000.0 + k, 60000.0 + k, -2000000000.0 + k)) << i;
         EXPECT_EQ(cloud.normals[i], Vec3f(0.0F, 0.0F, -1.0F));
         EXPECT_EQ(cloud.colors[i].r, 10 * i);
-        EXPECT_EQ(cloud.colors[i].g, 0x12 * (i + 1));  // 16-bit: high byte
-        EXPECT_EQ(cloud.colors[i].b, 128);             // float 0.5
+        EXPECT_EQ(cloud.colors[i].g, 0x12 * (i + 1)); // 16-bit: high byte
+        EXPECT_EQ(cloud.colors[i].b, 128);            // float 0.5
         EXPECT_FLOAT_EQ(cloud.radii[i], 0.125F * static_cast<float>(i + 1));
     }
     const std::vector<Triangle> expected = {{0, 1, 2}, {0, 2, 3}, {3, 2, 1}};
@@ -259,12 +257,12 @@ TEST(PlyErrors, TruncatedBinaryNamesTheByteOffset)
     const auto path = dir / "truncated.ply";
     std::string bytes = small_binary_ply(10, 10);
     const std::size_t header = bytes.size() - 120;
-    bytes.resize(bytes.size() - 5);  // last vertex loses 5 bytes
+    bytes.resize(bytes.size() - 5); // last vertex loses 5 bytes
     write_file(path, bytes);
     const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, "truncated");
     ASSERT_TRUE(e);
     ASSERT_TRUE(e->offset());
-    EXPECT_EQ(*e->offset(), header + std::size_t{9 * 12 + 4});  // x of vertex 9 read, y cut
+    EXPECT_EQ(*e->offset(), header + std::size_t{9 * 12 + 4}); // x of vertex 9 read, y cut
 }
 
 TEST(PlyErrors, HeaderCountLargerThanBinaryData)
@@ -435,9 +433,8 @@ TEST(PlyErrors, FaceIndexOutOfRange)
 TEST(PlyErrors, MalformedHeaders)
 {
     TempDir dir;
-    const auto check =
-        [&](const std::string& name, const std::string& content, std::string_view fragment)
-    {
+    const auto check = [&](const std::string& name, const std::string& content,
+                           std::string_view fragment) {
         const auto path = dir / name;
         write_file(path, content);
         expect_io_error([&] { (void)read_geometry(path); }, path, fragment);
@@ -459,5 +456,5 @@ TEST(PlyErrors, MalformedHeaders)
           "before any element");
 }
 
-}  // namespace
-}  // namespace pointform::test
+} // namespace
+} // namespace pointform::test

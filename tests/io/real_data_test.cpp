@@ -11,10 +11,8 @@
 #include <cctype>
 #include <ostream>
 
-namespace pointform::test
-{
-namespace
-{
+namespace pointform::test {
+namespace {
 
 struct Expected
 {
@@ -24,19 +22,18 @@ struct Expected
     std::size_t triangles;
     bool normals;
     bool colors;
-    Vec3d size;  ///< bbox size, 4 significant digits
+    Vec3d size; ///< bbox size, 4 significant digits
     std::size_t dropped = 0;
 };
 
 // GoogleTest looks this printer up by its name.
-void PrintTo(const Expected& e, std::ostream* os)  // NOLINT(readability-identifier-naming)
+void PrintTo(const Expected& e, std::ostream* os) // NOLINT(readability-identifier-naming)
 {
     *os << e.file;
 }
 
 class RealData : public ::testing::TestWithParam<Expected>
-{
-};
+{};
 
 TEST_P(RealData, CountsAttributesAndBoundingBox)
 {
@@ -92,8 +89,7 @@ INSTANTIATE_TEST_SUITE_P(
                                Vec3d(3363, 4636, 179.8)},
                       Expected{"lidar/4_6_crop.las", FileFormat::Las, 23875, 0, false, true,
                                Vec3d(200, 200, 61.78)}),
-    [](const ::testing::TestParamInfo<Expected>& test)
-    {
+    [](const ::testing::TestParamInfo<Expected>& test) {
         std::string name = test.param.file;
         for (char& c : name)
             if (!std::isalnum(static_cast<unsigned char>(c)))
@@ -154,8 +150,8 @@ TEST(RealDataRoundTrip, LidarThroughPlyAndXyz)
         write_point_cloud(dir / name, cloud);
         PointCloud expected = cloud;
         if (std::string(name) == "crop.xyz")
-            expected.colors.clear();                                      // xyz carries no colors
-        expect_same_cloud(expected, read_point_cloud(dir / name), 1e-8);  // 1e-8 x 290 m: 3 µm
+            expected.colors.clear();                                     // xyz carries no colors
+        expect_same_cloud(expected, read_point_cloud(dir / name), 1e-8); // 1e-8 x 290 m: 3 µm
     }
 }
 
@@ -175,5 +171,5 @@ TEST(RealDataRoundTrip, KittenThroughXyz)
     expect_same_cloud(cloud, read_point_cloud(dir / "kitten.xyz"), 0.0);
 }
 
-}  // namespace
-}  // namespace pointform::test
+} // namespace
+} // namespace pointform::test

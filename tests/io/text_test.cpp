@@ -6,10 +6,8 @@
 
 #include <gtest/gtest.h>
 
-namespace pointform::test
-{
-namespace
-{
+namespace pointform::test {
+namespace {
 
 TEST(XyzRoundTrip, PositionsAndNormalsExact)
 {
@@ -94,7 +92,7 @@ TEST(XyzRead, CsvHeaderByName)
     EXPECT_EQ(cloud.world(0), Vec3d(10, 20, 30));
     ASSERT_TRUE(cloud.has_normals());
     EXPECT_EQ(cloud.normals[0], Vec3f(0, 0, 1));
-    EXPECT_EQ(cloud.normals[1], Vec3f(1, 0, 0));  // normalized
+    EXPECT_EQ(cloud.normals[1], Vec3f(1, 0, 0)); // normalized
     EXPECT_NE(result.description.find("header"), std::string::npos);
 }
 
@@ -223,5 +221,5 @@ TEST(XyzErrors, OnlyComments)
     expect_io_error([&] { (void)read_geometry(path); }, path, "no data lines");
 }
 
-}  // namespace
-}  // namespace pointform::test
+} // namespace
+} // namespace pointform::test
