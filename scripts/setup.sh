@@ -3,6 +3,7 @@
 # Installs everything pointform needs from Debian 12 packages. Run as root (or with sudo).
 #   bash scripts/setup.sh          build and test dependencies
 #   bash scripts/setup.sh --peers  also the peers of the side-by-side benchmarks (Open3D, CGAL)
+#   bash scripts/setup.sh --fuzz   also Clang and libFuzzer for scripts/fuzz.sh
 set -euo pipefail
 
 packages=(
@@ -11,9 +12,12 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format
 )
-if [[ "${1:-}" == "--peers" ]]; then
-  packages+=(python3 python3-numpy python3-open3d libcgal-dev libtbb-dev time)
-fi
+case "${1:-}" in
+  --peers) packages+=(python3 python3-numpy python3-open3d libcgal-dev libtbb-dev time) ;;
+  --fuzz) packages+=(clang-14 libclang-rt-14-dev libomp-14-dev) ;;
+  "") ;;
+  *) echo "setup: unknown option $1 (expected --peers or --fuzz)" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <atomic>
 #include <exception>
+#include <mutex>
 #include <vector>
 
 namespace pointform {
@@ -46,6 +47,7 @@ void parallel_blocks(std::size_t n, std::size_t block,
     std::vector<std::exception_ptr> errors(blocks);
     std::atomic<std::size_t> done{0};
     std::atomic<bool> stop{false};
+    std::mutex reporting;
 
     const auto run_block = [&](std::size_t b) {
         if (stop.load(std::memory_order_relaxed))
@@ -60,7 +62,8 @@ void parallel_blocks(std::size_t n, std::size_t block,
             stop = true;
         }
         const std::size_t finished = done.fetch_add(1) + 1;
-        if (progress != nullptr && omp_get_thread_num() == 0)
+        // Whichever thread finds the reporter free reports; the others never wait for it.
+        if (progress != nullptr && reporting.try_lock())
         {
             try
             {
@@ -72,6 +75,7 @@ void parallel_blocks(std::size_t n, std::size_t block,
                     errors[b] = std::current_exception();
                 stop = true;
             }
+            reporting.unlock();
         }
     };
 

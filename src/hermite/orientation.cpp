@@ -110,17 +110,15 @@ float agreement(std::span<const Vec3f> positions, std::span<const Vec3f> normals
 {
     const Vec3f& na = normals[a];
     const Vec3f& nb = normals[b];
-    if (rule == OrientationRule::Reflection)
-    {
-        const Vec3f e = positions[b] - positions[a];
-        const float len2 = e.squaredNorm();
-        if (len2 > 0.0F)
-        {
-            const Vec3f predicted = na - (2.0F * na.dot(e) / len2) * e;
-            return nb.dot(predicted);
-        }
-    }
-    return na.dot(nb);
+    const float hoppe = na.dot(nb);
+    if (rule == OrientationRule::Hoppe)
+        return hoppe;
+    const Vec3f e = positions[b] - positions[a];
+    const float len2 = e.squaredNorm();
+    if (len2 == 0.0F)
+        return hoppe;
+    const Vec3f predicted = na - (2.0F * na.dot(e) / len2) * e;
+    return nb.dot(predicted);
 }
 
 float edge_cost(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
@@ -278,26 +276,134 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions, std::span<c
     result.normals.assign(normals.begin(), normals.end());
     result.components = forest.roots.size();
 
-    // Propagate along the trees: the root turns to +z, every child agrees with its parent.
+    // 1. Propagate along the trees, but only across reliable tree edges: they cut each tree into
+    //    patches inside which every step is trustworthy. A patch's first sample keeps its sign.
+    std::vector<std::uint32_t> patch(n, RiemannianForest::none);
+    std::uint32_t patch_count = 0;
     for (const std::uint32_t v : forest.order)
     {
-        Vec3f& normal = result.normals[v];
         const std::uint32_t parent = forest.parent[v];
-        if (parent == v)
+        const bool joins = parent != v && usable(normals[v]) && usable(normals[parent]) &&
+                           edge_cost(positions, normals, options.rule, parent, v) <=
+                               static_cast<float>(options.patch_cost);
+        if (!joins)
         {
-            if (normal.z() < 0.0F)
-                normal = -normal;
+            patch[v] = patch_count++;
             continue;
         }
-        const Vec3f& reference = result.normals[parent];
-        if (!usable(normal))
+        patch[v] = patch[parent];
+        if (agreement(positions, result.normals, options.rule, parent, v) < 0.0F)
+            result.normals[v] = -result.normals[v];
+    }
+
+    // 2. Patches vote on their relative orientation over every graph edge between them, and a
+    //    maximum spanning forest of the patch graph (by the size of the vote) decides each
+    //    patch's flip: many agreeing edges outweigh the single edge a tree happened to use.
+    const std::size_t columns = options.k == 0 ? neighbors.k : std::min(options.k, neighbors.k);
+    struct Vote
+    {
+        std::uint32_t a;
+        std::uint32_t b;
+        float weight;
+    };
+    std::vector<Vote> votes;
+    for (std::size_t i = 0; i < n; ++i)
+    {
+        const auto pi = patch[i];
+        if (pi == RiemannianForest::none)
+            continue;
+        for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
         {
-            normal = reference;
+            const auto pj = patch[j];
+            if (pj == RiemannianForest::none || pj == pi)
+                continue;
+            const float w = agreement(positions, result.normals, options.rule,
+                                      static_cast<std::uint32_t>(i), j);
+            votes.push_back({std::min(pi, pj), std::max(pi, pj), w});
+        }
+    }
+    std::sort(votes.begin(), votes.end(),
+              [](const Vote& x, const Vote& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+    std::vector<Vote> patch_edges;
+    for (std::size_t v = 0; v < votes.size();)
+    {
+        Vote sum = votes[v];
+        double total = 0.0;
+        for (; v < votes.size() && votes[v].a == sum.a && votes[v].b == sum.b; ++v)
+            total += static_cast<double>(votes[v].weight);
+        sum.weight = static_cast<float>(total);
+        patch_edges.push_back(sum);
+    }
+    std::vector<Vote>().swap(votes);
+    std::stable_sort(patch_edges.begin(), patch_edges.end(), [](const Vote& x, const Vote& y) {
+        return std::abs(x.weight) > std::abs(y.weight);
+    });
+    DisjointSets patch_sets(patch_count);
+    std::vector<std::uint32_t> patch_degree(patch_count + 1, 0);
+    std::vector<Vote> patch_tree;
+    for (const auto& e : patch_edges)
+        if (patch_sets.unite(e.a, e.b))
+        {
+            patch_tree.push_back(e);
+            ++patch_degree[e.a + 1];
+            ++patch_degree[e.b + 1];
+        }
+    for (std::size_t p = 0; p < patch_count; ++p)
+        patch_degree[p + 1] += patch_degree[p];
+    std::vector<std::pair<std::uint32_t, bool>> patch_adjacent(patch_degree[patch_count]);
+    {
+        std::vector<std::uint32_t> fill(patch_degree.begin(), patch_degree.end() - 1);
+        for (const auto& e : patch_tree)
+        {
+            patch_adjacent[fill[e.a]++] = {e.b, e.weight < 0.0F};
+            patch_adjacent[fill[e.b]++] = {e.a, e.weight < 0.0F};
+        }
+    }
+    // Walk each patch tree from the patch of its component's root, accumulating flips.
+    constexpr std::uint8_t unvisited = 2;
+    std::vector<std::uint8_t> patch_flip(patch_count, unvisited);
+    std::vector<std::uint32_t> queue;
+    for (const std::uint32_t root : forest.roots)
+    {
+        if (root == RiemannianForest::none || patch_flip[patch[root]] != unvisited)
+            continue;
+        patch_flip[patch[root]] = 0;
+        queue.assign(1, patch[root]);
+        for (std::size_t head = 0; head < queue.size(); ++head)
+        {
+            const std::uint32_t p = queue[head];
+            for (std::uint32_t e = patch_degree[p]; e < patch_degree[p + 1]; ++e)
+            {
+                const auto [q, disagree] = patch_adjacent[e];
+                if (patch_flip[q] != unvisited)
+                    continue;
+                patch_flip[q] = static_cast<std::uint8_t>(patch_flip[p] ^ (disagree ? 1U : 0U));
+                queue.push_back(q);
+            }
+        }
+    }
+    for (std::size_t i = 0; i < n; ++i)
+        if (patch[i] != RiemannianForest::none && patch_flip[patch[i]] == 1)
+            result.normals[i] = -result.normals[i];
+
+    // 3. Samples without a normal of their own take their tree parent's; each component's root
+    //    then faces +z.
+    for (const std::uint32_t v : forest.order)
+    {
+        const std::uint32_t parent = forest.parent[v];
+        if (parent != v && !usable(result.normals[v]))
+        {
+            result.normals[v] = result.normals[parent];
             ++result.inherited;
         }
-        else if (agreement(positions, result.normals, options.rule, parent, v) < 0.0F)
-            normal = -normal;
     }
+    std::vector<std::uint8_t> root_down(forest.roots.size(), 0);
+    for (std::size_t c = 0; c < forest.roots.size(); ++c)
+        root_down[c] =
+            forest.roots[c] != RiemannianForest::none && result.normals[forest.roots[c]].z() < 0.0F;
+    for (std::size_t i = 0; i < n; ++i)
+        if (forest.component[i] != RiemannianForest::none && root_down[forest.component[i]] != 0)
+            result.normals[i] = -result.normals[i];
 
     // Flux test per component: Σ a_i n_i·(p_i − c), with a_i ≈ squared k-th neighbour distance.
     const std::size_t component_count = forest.roots.size();

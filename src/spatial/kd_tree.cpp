@@ -62,7 +62,7 @@ KdTree::KdTree(std::span<const Vec3f> positions, const KdTreeOptions& options)
     if (positions.size() >= std::numeric_limits<std::uint32_t>::max())
         throw InvalidInput("kd-tree: " + std::to_string(positions.size()) +
                            " points exceed the 32-bit index range");
-    impl_ = std::make_unique<Impl>(positions, options.leaf_size == 0 ? 12 : options.leaf_size);
+    impl_ = std::make_unique<Impl>(positions, options.leaf_size == 0 ? 16 : options.leaf_size);
 }
 
 KdTree::~KdTree() = default;

@@ -12,6 +12,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -101,6 +102,40 @@ TEST(Cli, OrientTowardsAndRegions)
         EXPECT_GE(surfels.normals[i].cast<double>().dot(to_view), 0.0);
         EXPECT_EQ(surfels.radii[i], 0.25F);
     }
+}
+
+TEST(Cli, SameOutputWhateverTheThreadCount)
+{
+    test::TempDir dir;
+    const std::string input = quoted(test::data_path("bunny/bun000.ply"));
+    ASSERT_EQ(run("-j 1 normals " + input + " -o " + quoted(dir / "one.ply")).exit_code, 0);
+    ASSERT_EQ(run("-j 2 normals " + input + " -o " + quoted(dir / "two.ply")).exit_code, 0);
+    ASSERT_EQ(run("-j 3 normals " + input + " -o " + quoted(dir / "three.ply")).exit_code, 0);
+    const std::string one = test::read_file(dir / "one.ply");
+    EXPECT_FALSE(one.empty());
+    EXPECT_EQ(one, test::read_file(dir / "two.ply"));
+    EXPECT_EQ(one, test::read_file(dir / "three.ply"));
+}
+
+TEST(Cli, GeoreferencedLidarKeepsItsCoordinates)
+{
+    test::TempDir dir;
+    const auto out = dir / "lidar.ply";
+    const auto input = test::data_path("lidar/4_6_crop.las");
+    const RunResult r =
+        run("normals " + quoted(input) + " -o " + quoted(out) + " --orient along:0,0,1");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const PointCloud original = read_point_cloud(input);
+    const PointCloud surfels = read_point_cloud(out);
+    ASSERT_EQ(surfels.size(), original.size());
+    // Coordinates near 1.6e6 m: float alone would round to 0.125 m; the origin keeps them exact.
+    double worst = 0.0;
+    for (std::size_t i = 0; i < original.size(); ++i)
+        worst = std::max(worst, (surfels.world(i) - original.world(i)).norm());
+    EXPECT_LT(worst, 1e-6);
+    // Airborne LiDAR: normals turned to the sky, as asked.
+    for (const auto& n : surfels.normals)
+        EXPECT_GE(n.z(), 0.0F);
 }
 
 TEST(Cli, InfoReportsDensityAndAttributes)

@@ -27,8 +27,8 @@ void set_thread_count(int threads);
 /// \param block  items per block; 0 picks a default (4096)
 /// \param body   called as body(begin, end) for each block; must not throw across threads:
 ///               exceptions are captured and the first one (lowest block) is rethrown.
-/// \param progress  optional; updated from one thread as blocks complete (may throw Cancelled,
-///               after which the remaining blocks are skipped).
+/// \param progress  optional; updated as blocks complete, by one thread at a time (may throw
+///               Cancelled, after which the remaining blocks are skipped).
 void parallel_blocks(std::size_t n, std::size_t block,
                      const std::function<void(std::size_t, std::size_t)>& body,
                      ProgressReporter* progress = nullptr);

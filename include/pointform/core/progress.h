@@ -16,7 +16,7 @@ namespace pointform {
 using ProgressCallback = std::function<bool(std::string_view stage, double fraction)>;
 
 /// \brief Reports progress through an optional callback, throttled so that hot loops can call
-/// `update` often. Not thread-safe: call it from one thread (the parallel helpers do).
+/// `update` often. Not thread-safe: call it from one thread at a time (parallel_blocks does).
 class ProgressReporter
 {
 public:

@@ -42,6 +42,11 @@ struct OrientationOptions
     std::size_t k = 0;
     /// Propagation rule and edge cost; see OrientationRule.
     OrientationRule rule = OrientationRule::Hoppe;
+    /// Tree edges costing more than this (normals more than about acos(1 − patch_cost) apart)
+    /// are not trusted to pass orientation on: they cut the spanning trees into patches, which
+    /// are then oriented against each other by the summed agreement of every graph edge between
+    /// them. 0.3 trusts steps up to about 45°; 2 trusts every edge (plain propagation).
+    double patch_cost = 0.3;
     /// Optional progress report.
     ProgressCallback progress;
 };

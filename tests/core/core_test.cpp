@@ -1,0 +1,118 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+#include "pointform/core/progress.h"
+#include "pointform/core/types.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <numeric>
+#include <stdexcept>
+#include <vector>
+
+namespace pointform {
+namespace {
+
+TEST(ParallelBlocks, CoversEveryIndexOnceWhateverTheThreadCount)
+{
+    for (const int threads : {1, 2, 3})
+    {
+        set_thread_count(threads);
+        std::vector<int> hits(100003, 0);
+        parallel_blocks(hits.size(), 1000, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i)
+                ++hits[i];
+        });
+        EXPECT_EQ(std::accumulate(hits.begin(), hits.end(), 0), 100003) << threads;
+        EXPECT_EQ(*std::min_element(hits.begin(), hits.end()), 1) << threads;
+    }
+    set_thread_count(0);
+    parallel_blocks(0, 10, [](std::size_t, std::size_t) { FAIL() << "called on empty range"; });
+}
+
+TEST(ParallelBlocks, RethrowsTheFirstFailingBlock)
+{
+    set_thread_count(2);
+    try
+    {
+        parallel_blocks(10000, 100, [](std::size_t begin, std::size_t) {
+            if (begin == 300 || begin == 7000)
+                throw InvalidInput("block " + std::to_string(begin));
+        });
+        ADD_FAILURE() << "no exception";
+    }
+    catch (const InvalidInput& e)
+    {
+        // With two threads either failing block may run first, but never a non-failing one.
+        const std::string what = e.what();
+        EXPECT_TRUE(what == "block 300" || what == "block 7000") << what;
+    }
+    set_thread_count(0);
+}
+
+TEST(Progress, ReportsMonotonicFractionsAndCancels)
+{
+    std::vector<double> seen;
+    const ProgressCallback record = [&](std::string_view stage, double fraction) {
+        EXPECT_EQ(stage, "stage");
+        seen.push_back(fraction);
+        return true;
+    };
+    ProgressReporter reporter(record, "stage");
+    for (int i = 0; i <= 1000; ++i)
+        reporter.update(i, 1000);
+    reporter.finish();
+    ASSERT_FALSE(seen.empty());
+    EXPECT_LE(seen.size(), 103U); // throttled to about every percent
+    EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+    EXPECT_EQ(seen.back(), 1.0);
+
+    const ProgressCallback stop = [](std::string_view, double) {
+        return false;
+    };
+    ProgressReporter cancelling(stop, "work");
+    EXPECT_THROW(cancelling.update(1, 2), Cancelled);
+
+    // No callback: nothing happens.
+    ProgressReporter silent({}, "quiet");
+    EXPECT_NO_THROW(silent.update(1, 2));
+}
+
+TEST(Progress, CancellationStopsParallelWork)
+{
+    std::atomic<std::size_t> blocks{0};
+    const ProgressCallback stop = [](std::string_view, double) {
+        return false;
+    };
+    ProgressReporter reporter(stop, "work");
+    EXPECT_THROW(
+        parallel_blocks(
+            1000000, 1000, [&](std::size_t, std::size_t) { blocks.fetch_add(1); }, &reporter),
+        Cancelled);
+    EXPECT_LT(blocks.load(), 1000U);
+}
+
+TEST(IoErrorMessage, NamesFileLineAndOffset)
+{
+    const IoError with_line("scan.xyz", "bad number", 12);
+    EXPECT_STREQ(with_line.what(), "scan.xyz:12: bad number");
+    EXPECT_EQ(with_line.line(), 12U);
+    const IoError with_offset("scan.ply", "truncated", std::nullopt, 4096);
+    EXPECT_STREQ(with_offset.what(), "scan.ply (byte 4096): truncated");
+    EXPECT_EQ(with_offset.path(), "scan.ply");
+}
+
+TEST(Ids, CompareAndValidity)
+{
+    EXPECT_FALSE(PointId{}.is_valid());
+    EXPECT_TRUE(PointId(3).is_valid());
+    EXPECT_LT(PointId(2), PointId(3));
+    EXPECT_EQ(FaceId(7), FaceId(7));
+}
+
+} // namespace
+} // namespace pointform

@@ -1,0 +1,134 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/core/error.h"
+#include "pointform/geometry/point_cloud.h"
+#include "pointform/geometry/shapes.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace pointform {
+namespace {
+
+TEST(Aabb, ExtendContainsAndDiagonal)
+{
+    Aabb box;
+    EXPECT_TRUE(box.is_empty());
+    EXPECT_EQ(box.diagonal(), 0.0);
+    box.extend(Vec3d(1, 2, 3));
+    box.extend(Vec3d(4, 6, 3));
+    EXPECT_FALSE(box.is_empty());
+    EXPECT_DOUBLE_EQ(box.diagonal(), 5.0);
+    EXPECT_TRUE(box.contains(Vec3d(2, 3, 3)));
+    EXPECT_FALSE(box.contains(Vec3d(2, 3, 3.5)));
+    EXPECT_EQ(box.center(), Vec3d(2.5, 4, 3));
+}
+
+TEST(PointCloud, OriginKeepsGeoreferencedPrecision)
+{
+    // UTM-like coordinates with millimetre detail: float alone would keep about 0.25 m.
+    const Vec3d first(512345.678, 4212345.123, 310.456);
+    const Vec3d origin = choose_origin(first);
+    EXPECT_EQ(origin, Vec3d(512346, 4212345, 310));
+    PointCloud cloud;
+    cloud.origin = origin;
+    cloud.positions.push_back((first - origin).cast<float>());
+    EXPECT_LT((cloud.world(0) - first).norm(), 1e-6);
+    EXPECT_EQ(choose_origin(Vec3d(0.12, -0.3, 0.49)), Vec3d::Zero());
+
+    const Aabb box = cloud.bounds();
+    EXPECT_LT((box.min - first).norm(), 1e-6);
+}
+
+TEST(PointCloud, ValidateRejectsMismatchedAttributes)
+{
+    PointCloud cloud;
+    cloud.positions.assign(3, Vec3f::Zero());
+    EXPECT_NO_THROW(validate(cloud));
+    cloud.normals.assign(2, Vec3f::UnitZ());
+    EXPECT_THROW(validate(cloud), InvalidInput);
+    cloud.normals.assign(3, Vec3f::UnitZ());
+    cloud.radii.assign(4, 1.0F);
+    EXPECT_THROW(validate(cloud), InvalidInput);
+}
+
+/// Distance from a point to each analytic surface, to check samples lie on it.
+double surface_distance(Shape shape, const Vec3d& p, double thickness)
+{
+    switch (shape)
+    {
+        case Shape::Sphere:
+            return std::abs(p.norm() - 1.0);
+        case Shape::Torus:
+            return std::abs(std::hypot(std::hypot(p.x(), p.y()) - 1.0, p.z()) - 0.35);
+        case Shape::TwoSpheres:
+            return std::abs((p - Vec3d(p.x() > 0 ? 1.6 : -1.6, 0, 0)).norm() - 1.0);
+        case Shape::Plate:
+        {
+            const Vec3d half(1.0, 1.0, 0.5 * thickness);
+            const Vec3d q = p.cwiseAbs() - half;
+            return std::abs(q.maxCoeff());
+        }
+    }
+    return 1e9;
+}
+
+TEST(Shapes, SamplesLieOnTheSurfaceWithUnitOutwardNormals)
+{
+    for (const Shape shape : {Shape::Sphere, Shape::Torus, Shape::TwoSpheres, Shape::Plate})
+    {
+        const PointCloud cloud = sample_shape(shape, {.count = 5000, .seed = 3});
+        ASSERT_EQ(cloud.size(), 5000U);
+        ASSERT_EQ(cloud.normals.size(), 5000U);
+        for (std::size_t i = 0; i < cloud.size(); ++i)
+        {
+            const Vec3d p = cloud.positions[i].cast<double>();
+            EXPECT_LT(surface_distance(shape, p, 0.05), 1e-5);
+            EXPECT_NEAR(cloud.normals[i].norm(), 1.0F, 1e-5F);
+            // Outward: a small step along the normal moves away from the surface's inside.
+            const Vec3d out = p + 1e-3 * cloud.normals[i].cast<double>();
+            EXPECT_NEAR(surface_distance(shape, out, 0.05), 1e-3, 1e-4);
+        }
+    }
+}
+
+TEST(Shapes, TorusSamplingIsAreaUniform)
+{
+    // The outer half of the tube (cos v > 0, farther than R from the axis) holds the area share
+    // ∫ (R + r cos v) dv over cos v > 0 / ∫ (R + r cos v) dv = 1/2 + r/(πR).
+    const PointCloud torus = sample_shape(Shape::Torus, {.count = 200000, .seed = 4});
+    std::size_t outer_half = 0;
+    for (std::size_t i = 0; i < torus.size(); ++i)
+    {
+        const Vec3f& p = torus.positions[i];
+        if (std::hypot(p.x(), p.y()) > 1.0F)
+            ++outer_half;
+    }
+    const double expected = 0.5 + 0.35 / M_PI;
+    EXPECT_NEAR(static_cast<double>(outer_half) / static_cast<double>(torus.size()), expected,
+                0.005);
+}
+
+TEST(Shapes, NoiseAndHolesAreDeterministic)
+{
+    const SampleOptions options{.count = 20000, .seed = 9, .noise = 0.01, .holes = 5};
+    const PointCloud a = sample_shape(Shape::Sphere, options);
+    const PointCloud b = sample_shape(Shape::Sphere, options);
+    EXPECT_EQ(a.positions, b.positions);
+    EXPECT_LT(a.size(), 20000U);
+    double mean_offset = 0.0;
+    for (const auto& p : a.positions)
+        mean_offset += std::abs(p.cast<double>().norm() - 1.0);
+    mean_offset /= static_cast<double>(a.size());
+    // |N(0, σ)| along the normal has mean σ√(2/π); σ = 0.01 × diagonal (2√3).
+    EXPECT_NEAR(mean_offset, 0.01 * 2.0 * std::sqrt(3.0) * std::sqrt(2.0 / M_PI), 0.005);
+
+    EXPECT_THROW((void)sample_shape(Shape::Sphere, {.count = 0}), InvalidInput);
+    EXPECT_THROW((void)sample_shape(Shape::Sphere, {.noise = -1.0}), InvalidInput);
+    EXPECT_THROW((void)parse_shape("cube"), InvalidInput);
+}
+
+} // namespace
+} // namespace pointform
