@@ -21,5 +21,7 @@ for ext in ply xyz pts csv off obj pcd las; do
   done < <(find data -name "*.$ext" -size -64k -print0)
   index=$((index + 1))
 done
+# Inputs that once found a bug run first, then the fuzzer explores from the seeds.
+./build/fuzz/tests/fuzz/read_fuzz tests/fuzz/regressions/*
 ./build/fuzz/tests/fuzz/read_fuzz -max_total_time="$seconds" -max_len=65536 -timeout=10 \
-  -rss_limit_mb=4096 -print_final_stats=1 "$corpus"
+  -rss_limit_mb=4096 -print_final_stats=1 -artifact_prefix=build/fuzz/ "$corpus"
