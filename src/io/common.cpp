@@ -139,4 +139,15 @@ void write_world_text(OutputBuffer& out, const PointCloud& cloud, std::size_t i,
     }
 }
 
+void write_triangle_text(OutputBuffer& out, const Triangle& t)
+{
+    out.write("3 ");
+    out.write_integer(t[0]);
+    out.put(' ');
+    out.write_integer(t[1]);
+    out.put(' ');
+    out.write_integer(t[2]);
+    out.put('\n');
+}
+
 } // namespace pointform::detail

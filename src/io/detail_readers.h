@@ -11,6 +11,7 @@
 #include "pointform/core/error.h"
 #include "pointform/io/io.h"
 
+#include <array>
 #include <bit>
 #include <charconv>
 #include <cstdint>
@@ -200,8 +201,10 @@ inline bool next_token(std::string_view& rest, std::string_view& token, bool com
     return text;
 }
 
-/// Parses a whole token as a double (accepts a leading '+', "nan" and "inf").
-[[nodiscard]] inline bool parse_double(std::string_view token, double& value)
+/// Parses a whole token with std::from_chars as a T (an integer type or double), also accepting
+/// a leading '+'. The whole token must be consumed.
+template <typename T>
+[[nodiscard]] bool parse_whole_token(std::string_view token, T& value)
 {
     const char* first = token.data();
     const char* last = token.data() + token.size();
@@ -211,16 +214,18 @@ inline bool next_token(std::string_view& rest, std::string_view& token, bool com
     return ec == std::errc() && ptr == last && first != last;
 }
 
+/// Parses a whole token as a double (accepts a leading '+', "nan" and "inf").
+[[nodiscard]] inline bool parse_double(std::string_view token, double& value)
+{
+    return parse_whole_token(token, value);
+}
+
 /// Parses a whole token as an integer of type T (accepts a leading '+' for signed and unsigned).
 template <typename T>
 [[nodiscard]] bool parse_integer(std::string_view token, T& value)
 {
-    const char* first = token.data();
-    const char* last = token.data() + token.size();
-    if (first != last && *first == '+')
-        ++first;
-    const auto [ptr, ec] = std::from_chars(first, last, value);
-    return ec == std::errc() && ptr == last && first != last;
+    static_assert(std::is_integral_v<T>);
+    return parse_whole_token(token, value);
 }
 
 /// Short, printable excerpt of a token for error messages.
@@ -254,6 +259,112 @@ struct PointRecord
     Vec3f normal = Vec3f::Zero();
     Color color;
     float radius = 0.0F;
+};
+
+/// What a value read from a file means for its point: the one vocabulary of every reader (PLY
+/// vertex properties, text columns, PCD fields).
+enum class Field : std::uint8_t
+{
+    None, ///< not stored (a property or column we do not use)
+    X,
+    Y,
+    Z,
+    Nx,
+    Ny,
+    Nz,
+    Red,
+    Green,
+    Blue,
+    Radius,
+};
+constexpr std::size_t field_count = static_cast<std::size_t>(Field::Radius) + 1;
+
+[[nodiscard]] constexpr bool is_color(Field field)
+{
+    return field == Field::Red || field == Field::Green || field == Field::Blue;
+}
+
+/// One name a format gives a field.
+struct FieldName
+{
+    std::string_view name;
+    Field field;
+};
+
+/// The field that `vocabulary` (a format's field names) gives `name`, or Field::None.
+[[nodiscard]] constexpr Field field_named(std::string_view name,
+                                          std::span<const FieldName> vocabulary)
+{
+    for (const FieldName& entry : vocabulary)
+        if (entry.name == name)
+            return entry.field;
+    return Field::None;
+}
+
+/// Stores `value` into `point` as `field` says: positions as double, normal components and the
+/// radius as float. A color channel must already be in [0, 255]: each format encodes colors its
+/// own way, so the reader converts them (see is_color) before this call.
+inline void set_field(PointRecord& point, Field field, double value)
+{
+    switch (field)
+    {
+        case Field::X:
+            point.position.x() = value;
+            break;
+        case Field::Y:
+            point.position.y() = value;
+            break;
+        case Field::Z:
+            point.position.z() = value;
+            break;
+        case Field::Nx:
+            point.normal.x() = static_cast<float>(value);
+            break;
+        case Field::Ny:
+            point.normal.y() = static_cast<float>(value);
+            break;
+        case Field::Nz:
+            point.normal.z() = static_cast<float>(value);
+            break;
+        case Field::Red:
+            point.color.r = static_cast<std::uint8_t>(value);
+            break;
+        case Field::Green:
+            point.color.g = static_cast<std::uint8_t>(value);
+            break;
+        case Field::Blue:
+            point.color.b = static_cast<std::uint8_t>(value);
+            break;
+        case Field::Radius:
+            point.radius = static_cast<float>(value);
+            break;
+        case Field::None:
+            break;
+    }
+}
+
+/// The fields a file declares, and what they add up to.
+class FieldSet
+{
+public:
+    void add(Field field) { found_[static_cast<std::size_t>(field)] = true; }
+    [[nodiscard]] bool has(Field field) const { return found_[static_cast<std::size_t>(field)]; }
+    [[nodiscard]] bool has_position() const
+    {
+        return has(Field::X) && has(Field::Y) && has(Field::Z);
+    }
+    /// Normals need nx, ny and nz; colors red, green and blue; radii a radius.
+    [[nodiscard]] AttributeSet attributes() const
+    {
+        AttributeSet attributes;
+        attributes.normals = has(Field::Nx) && has(Field::Ny) && has(Field::Nz);
+        attributes.colors = has(Field::Red) && has(Field::Green) && has(Field::Blue);
+        attributes.radii = has(Field::Radius);
+        return attributes;
+    }
+
+private:
+    std::array<bool, field_count> found_{};
 };
 
 /// Resolves NonFinitePolicy::FormatDefault: Drop for PCD, Error for everything else.
@@ -360,6 +471,9 @@ private:
 /// Writes the world position of point i as "x y z" text: float shortest when the origin is zero
 /// and no precision is asked, else the double world value.
 void write_world_text(OutputBuffer& out, const PointCloud& cloud, std::size_t i, int precision);
+
+/// Writes a triangle as the text face line "3 a b c" (OFF and ascii PLY).
+void write_triangle_text(OutputBuffer& out, const Triangle& t);
 
 [[nodiscard]] ReadResult read_ply(const std::filesystem::path& path, std::string_view bytes,
                                   NonFinitePolicy policy);

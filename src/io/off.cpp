@@ -224,15 +224,7 @@ void write_off(OutputBuffer& out, const TriMesh& mesh, int precision)
         out.put('\n');
     }
     for (const Triangle& t : mesh.triangles)
-    {
-        out.write("3 ");
-        out.write_integer(t[0]);
-        out.put(' ');
-        out.write_integer(t[1]);
-        out.put(' ');
-        out.write_integer(t[2]);
-        out.put('\n');
-    }
+        write_triangle_text(out, t);
 }
 
 } // namespace pointform::detail

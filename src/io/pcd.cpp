@@ -13,25 +13,14 @@
 namespace pointform::detail {
 namespace {
 
-enum class PcdRole : std::uint8_t
-{
-    None,
-    X,
-    Y,
-    Z,
-    Nx,
-    Ny,
-    Nz,
-    Rgb,
-};
-
 struct PcdField
 {
     std::string name;
     char type = 'F'; ///< F (float), I (signed), U (unsigned)
     std::size_t size = 4;
     std::size_t count = 1;
-    PcdRole role = PcdRole::None;
+    Field field = Field::None; ///< where a single value goes in the point
+    bool packed_rgb = false;   ///< a single 4-byte rgb or rgba value: the color as 0x00RRGGBB
     // Where the values are once the data is in memory: value of point i at base + i * stride.
     const char* base = nullptr;
     std::size_t stride = 0;
@@ -71,24 +60,11 @@ struct PcdHeader
     }
 };
 
-PcdRole role_of(std::string_view name)
-{
-    if (name == "x")
-        return PcdRole::X;
-    if (name == "y")
-        return PcdRole::Y;
-    if (name == "z")
-        return PcdRole::Z;
-    if (name == "normal_x")
-        return PcdRole::Nx;
-    if (name == "normal_y")
-        return PcdRole::Ny;
-    if (name == "normal_z")
-        return PcdRole::Nz;
-    if (name == "rgb" || name == "rgba")
-        return PcdRole::Rgb;
-    return PcdRole::None;
-}
+/// PCD field names we read one value from (the packed rgb field is told apart separately).
+constexpr FieldName pcd_field_names[] = {
+    {"x", Field::X},         {"y", Field::Y},         {"z", Field::Z},
+    {"normal_x", Field::Nx}, {"normal_y", Field::Ny}, {"normal_z", Field::Nz},
+};
 
 /// Reads all values of a header line into `out`; returns how many there were.
 std::size_t split(std::string_view rest, std::vector<std::string_view>& out)
@@ -246,7 +222,8 @@ PcdHeader parse_header(const std::filesystem::path& path, std::string_view bytes
                  std::to_string(header.width) + " x " + std::to_string(header.height),
              data_line);
 
-    bool found[8] = {};
+    FieldSet found;
+    bool found_rgb = false;
     for (std::size_t i = 0; i < n; ++i)
     {
         PcdField& field = header.fields[i];
@@ -263,18 +240,18 @@ PcdHeader parse_header(const std::filesystem::path& path, std::string_view bytes
                  data_line);
         if (field.count > 1'000'000)
             fail(path, "field " + field.name + " has an unreasonable COUNT", data_line);
-        field.role = field.count == 1 ? role_of(field.name) : PcdRole::None;
-        if (field.role == PcdRole::Rgb && field.size != 4)
-            field.role = PcdRole::None;
-        found[static_cast<int>(field.role)] = true;
+        if (field.count == 1)
+        {
+            field.field = field_named(field.name, pcd_field_names);
+            field.packed_rgb = (field.name == "rgb" || field.name == "rgba") && field.size == 4;
+        }
+        found.add(field.field);
+        found_rgb = found_rgb || field.packed_rgb;
     }
-    if (!found[static_cast<int>(PcdRole::X)] || !found[static_cast<int>(PcdRole::Y)] ||
-        !found[static_cast<int>(PcdRole::Z)])
+    if (!found.has_position())
         fail(path, "FIELDS has no x, y and z", data_line);
-    header.attributes.normals = found[static_cast<int>(PcdRole::Nx)] &&
-                                found[static_cast<int>(PcdRole::Ny)] &&
-                                found[static_cast<int>(PcdRole::Nz)];
-    header.attributes.colors = found[static_cast<int>(PcdRole::Rgb)];
+    header.attributes.normals = found.attributes().normals;
+    header.attributes.colors = found_rgb; // PCD colors come packed, never as separate channels
     return header;
 }
 
@@ -324,39 +301,13 @@ PointRecord binary_point(const std::vector<PcdField>& fields, std::size_t i)
     PointRecord point;
     for (const PcdField& field : fields)
     {
-        if (field.role == PcdRole::None)
+        if (field.field == Field::None && !field.packed_rgb)
             continue;
         const char* p = field.base + i * field.stride;
-        if (field.role == PcdRole::Rgb)
-        {
+        if (field.packed_rgb)
             point.color = unpack_rgb(load<std::uint32_t>(p, ByteOrder::Little));
-            continue;
-        }
-        const double v = binary_value(p, field.type, field.size);
-        switch (field.role)
-        {
-            case PcdRole::X:
-                point.position.x() = v;
-                break;
-            case PcdRole::Y:
-                point.position.y() = v;
-                break;
-            case PcdRole::Z:
-                point.position.z() = v;
-                break;
-            case PcdRole::Nx:
-                point.normal.x() = static_cast<float>(v);
-                break;
-            case PcdRole::Ny:
-                point.normal.y() = static_cast<float>(v);
-                break;
-            case PcdRole::Nz:
-                point.normal.z() = static_cast<float>(v);
-                break;
-            case PcdRole::None:
-            case PcdRole::Rgb:
-                break;
-        }
+        else
+            set_field(point, field.field, binary_value(p, field.type, field.size));
     }
     return point;
 }
@@ -392,47 +343,21 @@ void read_ascii(const std::filesystem::path& path, std::string_view bytes, const
                              std::to_string(expected),
                          where);
                 ++values;
-                double v = 0.0;
-                if (field.role == PcdRole::Rgb)
+                // PCL writes packed colors as an unsigned integer; older files print the float
+                // whose bits hold the color.
+                std::uint32_t packed = 0;
+                if (field.packed_rgb && parse_integer(token, packed))
                 {
-                    // PCL writes packed colors as an unsigned integer; older files print the
-                    // float whose bits hold the color.
-                    std::uint32_t packed = 0;
-                    if (!parse_integer(token, packed))
-                    {
-                        if (!parse_double(token, v))
-                            fail(path, "malformed number " + quote(token), where);
-                        packed = std::bit_cast<std::uint32_t>(static_cast<float>(v));
-                    }
                     point.color = unpack_rgb(packed);
                     continue;
                 }
+                double v = 0.0;
                 if (!parse_double(token, v))
                     fail(path, "malformed number " + quote(token), where);
-                switch (field.role)
-                {
-                    case PcdRole::X:
-                        point.position.x() = v;
-                        break;
-                    case PcdRole::Y:
-                        point.position.y() = v;
-                        break;
-                    case PcdRole::Z:
-                        point.position.z() = v;
-                        break;
-                    case PcdRole::Nx:
-                        point.normal.x() = static_cast<float>(v);
-                        break;
-                    case PcdRole::Ny:
-                        point.normal.y() = static_cast<float>(v);
-                        break;
-                    case PcdRole::Nz:
-                        point.normal.z() = static_cast<float>(v);
-                        break;
-                    case PcdRole::None:
-                    case PcdRole::Rgb:
-                        break;
-                }
+                if (field.packed_rgb)
+                    point.color = unpack_rgb(std::bit_cast<std::uint32_t>(static_cast<float>(v)));
+                else
+                    set_field(point, field.field, v);
             }
         }
         if (next_token(rest, token))

@@ -8,12 +8,21 @@
 #include "detail_readers.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 namespace pointform::detail {
 namespace {
+
+/// A face index as read (any number, possibly huge or NaN), for an error message. Casting it to
+/// an integer type would be undefined behaviour when it is out of range.
+std::string format_index(double index)
+{
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.17g", index);
+    return buffer;
+}
 
 enum class PlyType : std::uint8_t
 {
@@ -73,31 +82,14 @@ bool is_floating(PlyType type)
     return type == PlyType::Float32 || type == PlyType::Float64;
 }
 
-/// What a vertex property means to us.
-enum class Role : std::uint8_t
-{
-    None,
-    X,
-    Y,
-    Z,
-    Nx,
-    Ny,
-    Nz,
-    Red,
-    Green,
-    Blue,
-    Radius,
-    FaceIndices,
-};
-constexpr std::size_t role_count = static_cast<std::size_t>(Role::FaceIndices) + 1;
-
 struct PlyProperty
 {
     std::string name;
     PlyType type = PlyType::Float32; ///< value type (item type for lists)
     bool is_list = false;
     PlyType count_type = PlyType::Uint8;
-    Role role = Role::None;
+    Field field = Field::None; ///< what a vertex property means to us
+    bool face_indices = false; ///< the vertex index list of the face element
 };
 
 struct PlyElement
@@ -148,30 +140,28 @@ struct PlyHeader
     AttributeSet attributes;
 };
 
-Role vertex_role(std::string_view name)
-{
-    if (name == "x")
-        return Role::X;
-    if (name == "y")
-        return Role::Y;
-    if (name == "z")
-        return Role::Z;
-    if (name == "nx" || name == "normal_x")
-        return Role::Nx;
-    if (name == "ny" || name == "normal_y")
-        return Role::Ny;
-    if (name == "nz" || name == "normal_z")
-        return Role::Nz;
-    if (name == "red" || name == "diffuse_red" || name == "r")
-        return Role::Red;
-    if (name == "green" || name == "diffuse_green" || name == "g")
-        return Role::Green;
-    if (name == "blue" || name == "diffuse_blue" || name == "b")
-        return Role::Blue;
-    if (name == "radius")
-        return Role::Radius;
-    return Role::None;
-}
+/// Vertex property names we read.
+constexpr FieldName vertex_property_names[] = {
+    {"x", Field::X},
+    {"y", Field::Y},
+    {"z", Field::Z},
+    {"nx", Field::Nx},
+    {"normal_x", Field::Nx},
+    {"ny", Field::Ny},
+    {"normal_y", Field::Ny},
+    {"nz", Field::Nz},
+    {"normal_z", Field::Nz},
+    {"red", Field::Red},
+    {"diffuse_red", Field::Red},
+    {"r", Field::Red},
+    {"green", Field::Green},
+    {"diffuse_green", Field::Green},
+    {"g", Field::Green},
+    {"blue", Field::Blue},
+    {"diffuse_blue", Field::Blue},
+    {"b", Field::Blue},
+    {"radius", Field::Radius},
+};
 
 PlyHeader parse_header(const std::filesystem::path& path, std::string_view bytes)
 {
@@ -280,23 +270,18 @@ PlyHeader parse_header(const std::filesystem::path& path, std::string_view bytes
         PlyElement& element = header.elements[e];
         if (element.name == "vertex" && !header.vertex)
         {
-            std::array<bool, role_count> found{};
+            FieldSet found;
             for (auto& property : element.properties)
             {
                 if (property.is_list)
                     continue;
-                property.role = vertex_role(property.name);
-                found[static_cast<std::size_t>(property.role)] = true;
+                property.field = field_named(property.name, vertex_property_names);
+                found.add(property.field);
             }
-            const auto has = [&](Role role) {
-                return found[static_cast<std::size_t>(role)];
-            };
-            if (!has(Role::X) || !has(Role::Y) || !has(Role::Z))
+            if (!found.has_position())
                 fail(path, "vertex element has no x, y and z properties",
                      Location::at_line(element.line));
-            header.attributes.normals = has(Role::Nx) && has(Role::Ny) && has(Role::Nz);
-            header.attributes.colors = has(Role::Red) && has(Role::Green) && has(Role::Blue);
-            header.attributes.radii = has(Role::Radius);
+            header.attributes = found.attributes();
             header.vertex = e;
         }
         else if (element.name == "face" && !header.face)
@@ -311,7 +296,7 @@ PlyHeader parse_header(const std::filesystem::path& path, std::string_view bytes
                     if (is_floating(property.type))
                         fail(path, "face indices must have an integer type",
                              Location::at_line(element.line));
-                    property.role = Role::FaceIndices;
+                    property.face_indices = true;
                     header.face = e;
                     break;
                 }
@@ -589,42 +574,8 @@ void read_vertices(Source& source, const PlyElement& element, CloudBuilder& buil
                 continue;
             }
             const double value = source.scalar(property.type);
-            switch (property.role)
-            {
-                case Role::X:
-                    point.position.x() = value;
-                    break;
-                case Role::Y:
-                    point.position.y() = value;
-                    break;
-                case Role::Z:
-                    point.position.z() = value;
-                    break;
-                case Role::Nx:
-                    point.normal.x() = static_cast<float>(value);
-                    break;
-                case Role::Ny:
-                    point.normal.y() = static_cast<float>(value);
-                    break;
-                case Role::Nz:
-                    point.normal.z() = static_cast<float>(value);
-                    break;
-                case Role::Red:
-                    point.color.r = to_color(value, property.type);
-                    break;
-                case Role::Green:
-                    point.color.g = to_color(value, property.type);
-                    break;
-                case Role::Blue:
-                    point.color.b = to_color(value, property.type);
-                    break;
-                case Role::Radius:
-                    point.radius = static_cast<float>(value);
-                    break;
-                case Role::None:
-                case Role::FaceIndices:
-                    break;
-            }
+            set_field(point, property.field,
+                      is_color(property.field) ? to_color(value, property.type) : value);
         }
         source.end();
         builder.add(point, where);
@@ -647,7 +598,7 @@ void read_faces(Source& source, const PlyElement& element, std::uint64_t vertex_
                 continue;
             }
             const std::uint64_t n = source.list_count(property);
-            if (property.role != Role::FaceIndices)
+            if (!property.face_indices)
             {
                 source.skip_values(property.type, n);
                 continue;
@@ -658,9 +609,8 @@ void read_faces(Source& source, const PlyElement& element, std::uint64_t vertex_
                 const double index = source.scalar(property.type);
                 if (!(index >= 0.0) || index >= static_cast<double>(vertex_count))
                     fail(source.path(),
-                         "face " + std::to_string(i) + " refers to vertex " +
-                             std::to_string(static_cast<long long>(index)) + " but the file has " +
-                             std::to_string(vertex_count) + " vertices",
+                         "face " + std::to_string(i) + " refers to vertex " + format_index(index) +
+                             " but the file has " + std::to_string(vertex_count) + " vertices",
                          source.where());
                 polygon.push_back(static_cast<std::uint32_t>(index));
             }
@@ -824,13 +774,7 @@ void write_ply(OutputBuffer& out, const PointCloud& cloud, std::span<const Trian
     {
         if (ascii)
         {
-            out.write("3 ");
-            out.write_integer(t[0]);
-            out.put(' ');
-            out.write_integer(t[1]);
-            out.put(' ');
-            out.write_integer(t[2]);
-            out.put('\n');
+            write_triangle_text(out, t);
         }
         else
         {

@@ -13,24 +13,9 @@
 namespace pointform::detail {
 namespace {
 
-enum class Column : std::uint8_t
-{
-    Ignore,
-    X,
-    Y,
-    Z,
-    Nx,
-    Ny,
-    Nz,
-    Red,
-    Green,
-    Blue,
-    Radius,
-};
-
 struct Layout
 {
-    std::vector<Column> columns;
+    std::vector<Field> columns; ///< what each column holds (Field::None: ignored)
     AttributeSet attributes;
     std::string description;
 };
@@ -61,34 +46,24 @@ bool all_numbers(std::string_view line)
     return true;
 }
 
-Column column_from_name(std::string_view raw)
+/// Column names (lower case) we read.
+constexpr FieldName column_names[] = {
+    {"x", Field::X},        {"//x", Field::X},         {"y", Field::Y},
+    {"z", Field::Z},        {"nx", Field::Nx},         {"normal_x", Field::Nx},
+    {"normalx", Field::Nx}, {"ny", Field::Ny},         {"normal_y", Field::Ny},
+    {"normaly", Field::Ny}, {"nz", Field::Nz},         {"normal_z", Field::Nz},
+    {"normalz", Field::Nz}, {"r", Field::Red},         {"red", Field::Red},
+    {"g", Field::Green},    {"green", Field::Green},   {"b", Field::Blue},
+    {"blue", Field::Blue},  {"radius", Field::Radius},
+};
+
+Field column_from_name(std::string_view raw)
 {
     while (!raw.empty() && (raw.front() == '"' || raw.front() == '\''))
         raw.remove_prefix(1);
     while (!raw.empty() && (raw.back() == '"' || raw.back() == '\''))
         raw.remove_suffix(1);
-    const std::string name = to_lower(raw);
-    if (name == "x" || name == "//x")
-        return Column::X;
-    if (name == "y")
-        return Column::Y;
-    if (name == "z")
-        return Column::Z;
-    if (name == "nx" || name == "normal_x" || name == "normalx")
-        return Column::Nx;
-    if (name == "ny" || name == "normal_y" || name == "normaly")
-        return Column::Ny;
-    if (name == "nz" || name == "normal_z" || name == "normalz")
-        return Column::Nz;
-    if (name == "r" || name == "red")
-        return Column::Red;
-    if (name == "g" || name == "green")
-        return Column::Green;
-    if (name == "b" || name == "blue")
-        return Column::Blue;
-    if (name == "radius")
-        return Column::Radius;
-    return Column::Ignore;
+    return field_named(to_lower(raw), column_names);
 }
 
 Layout layout_from_names(const std::filesystem::path& path, std::string_view line, Location where)
@@ -97,16 +72,14 @@ Layout layout_from_names(const std::filesystem::path& path, std::string_view lin
     std::string_view token;
     while (next_token(line, token, separators_include_commas))
         layout.columns.push_back(column_from_name(token));
-    const auto has = [&](Column c) {
-        return std::find(layout.columns.begin(), layout.columns.end(), c) != layout.columns.end();
-    };
-    if (!has(Column::X) || !has(Column::Y) || !has(Column::Z))
+    FieldSet found;
+    for (const Field field : layout.columns)
+        found.add(field);
+    if (!found.has_position())
         fail(path,
              "first line is neither numbers nor a header naming x, y and z columns: " + quote(line),
              where);
-    layout.attributes.normals = has(Column::Nx) && has(Column::Ny) && has(Column::Nz);
-    layout.attributes.colors = has(Column::Red) && has(Column::Green) && has(Column::Blue);
-    layout.attributes.radii = has(Column::Radius);
+    layout.attributes = found.attributes();
     layout.description =
         "text with a header line, " + std::to_string(layout.columns.size()) + " columns";
     return layout;
@@ -132,23 +105,23 @@ Layout layout_from_count(const std::filesystem::path& path, std::string_view lin
         fail(path, "expected at least 3 values (x y z) on a line, found " + std::to_string(n),
              where);
     Layout layout;
-    layout.columns.assign(n, Column::Ignore);
-    layout.columns[0] = Column::X;
-    layout.columns[1] = Column::Y;
-    layout.columns[2] = Column::Z;
+    layout.columns.assign(n, Field::None);
+    layout.columns[0] = Field::X;
+    layout.columns[1] = Field::Y;
+    layout.columns[2] = Field::Z;
     if (n == 7 && (pts_hint || looks_like_pts_colors(line)))
     {
-        layout.columns[4] = Column::Red;
-        layout.columns[5] = Column::Green;
-        layout.columns[6] = Column::Blue;
+        layout.columns[4] = Field::Red;
+        layout.columns[5] = Field::Green;
+        layout.columns[6] = Field::Blue;
         layout.attributes.colors = true;
         layout.description = "text, 7 columns (x y z intensity r g b)";
     }
     else if (n >= 6)
     {
-        layout.columns[3] = Column::Nx;
-        layout.columns[4] = Column::Ny;
-        layout.columns[5] = Column::Nz;
+        layout.columns[3] = Field::Nx;
+        layout.columns[4] = Field::Ny;
+        layout.columns[5] = Field::Nz;
         layout.attributes.normals = true;
         layout.description =
             "text, " + std::to_string(n) + " columns (x y z nx ny nz" + (n > 6 ? " ...)" : ")");
@@ -244,41 +217,8 @@ ReadResult read_text(const std::filesystem::path& path, std::string_view bytes,
             double v = 0.0;
             if (!parse_double(token, v))
                 fail(path, "malformed number " + quote(token), where);
-            switch (layout.columns[k])
-            {
-                case Column::X:
-                    point.position.x() = v;
-                    break;
-                case Column::Y:
-                    point.position.y() = v;
-                    break;
-                case Column::Z:
-                    point.position.z() = v;
-                    break;
-                case Column::Nx:
-                    point.normal.x() = static_cast<float>(v);
-                    break;
-                case Column::Ny:
-                    point.normal.y() = static_cast<float>(v);
-                    break;
-                case Column::Nz:
-                    point.normal.z() = static_cast<float>(v);
-                    break;
-                case Column::Red:
-                    point.color.r = to_color(v);
-                    break;
-                case Column::Green:
-                    point.color.g = to_color(v);
-                    break;
-                case Column::Blue:
-                    point.color.b = to_color(v);
-                    break;
-                case Column::Radius:
-                    point.radius = static_cast<float>(v);
-                    break;
-                case Column::Ignore:
-                    break;
-            }
+            const Field field = layout.columns[k];
+            set_field(point, field, is_color(field) ? to_color(v) : v);
             ++k;
         }
         if (k != columns)

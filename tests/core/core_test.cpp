@@ -10,8 +10,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <numeric>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 namespace pointform {
@@ -89,11 +91,18 @@ TEST(Progress, CancellationStopsParallelWork)
         return false;
     };
     ProgressReporter reporter(stop, "work");
-    EXPECT_THROW(
-        parallel_blocks(
-            1000000, 1000, [&](std::size_t, std::size_t) { blocks.fetch_add(1); }, &reporter),
-        Cancelled);
-    EXPECT_LT(blocks.load(), 1000U);
+    EXPECT_THROW(parallel_blocks(
+                     1000000, 1000,
+                     [&](std::size_t, std::size_t) {
+                         // Real work takes time; without it one thread races through every block
+                         // before the other has even reported its first.
+                         std::this_thread::sleep_for(std::chrono::microseconds(200));
+                         blocks.fetch_add(1);
+                     },
+                     &reporter),
+                 Cancelled);
+    // The first report cancels; only blocks already started may finish.
+    EXPECT_LT(blocks.load(), 100U);
 }
 
 TEST(IoErrorMessage, NamesFileLineAndOffset)

@@ -4,12 +4,15 @@
 #pragma once
 
 // Helpers for the io tests: building file bytes by hand (either byte order), a literal-only LZF
-// encoder, deterministic sample clouds and meshes, and comparisons relative to the bbox diagonal.
+// encoder, deterministic sample clouds and meshes, comparisons relative to the bbox diagonal, and
+// checks that reading a file fails with the expected IoError (message, line or byte offset).
 
 #include "pointform/core/error.h"
 #include "pointform/geometry/point_cloud.h"
 #include "pointform/geometry/tri_mesh.h"
 #include "pointform/io/io.h"
+
+#include "support/test_support.h"
 
 #include <gtest/gtest.h>
 
@@ -208,6 +211,57 @@ std::optional<IoError> expect_io_error(F&& f, const std::filesystem::path& path,
     }
     ADD_FAILURE() << "expected IoError, but nothing was thrown";
     return std::nullopt;
+}
+
+/// Checks that an error from expect_io_error names 1-based line `line`.
+inline void expect_error_line(const std::optional<IoError>& e, std::uint64_t line,
+                              const std::filesystem::path& path)
+{
+    ASSERT_TRUE(e && e->line()) << path;
+    EXPECT_EQ(*e->line(), line) << path;
+}
+
+/// Checks that an error from expect_io_error names byte offset `offset`.
+inline void expect_error_offset(const std::optional<IoError>& e, std::uint64_t offset,
+                                const std::filesystem::path& path)
+{
+    ASSERT_TRUE(e && e->offset()) << path;
+    EXPECT_EQ(*e->offset(), offset) << path;
+}
+
+/// Writes `content` to `path` and reads it with read_geometry, which must throw an IoError that
+/// names `path` and contains `fragment`. Returns the error, or nothing after recording a failure.
+inline std::optional<IoError> expect_file_error(const std::filesystem::path& path,
+                                                const std::string& content,
+                                                std::string_view fragment,
+                                                const ReadOptions& options = {})
+{
+    write_file(path, content);
+    return expect_io_error([&] { (void)read_geometry(path, options); }, path, fragment);
+}
+
+/// As expect_file_error, and the error must name 1-based line `line`.
+inline std::optional<IoError> expect_file_error_at_line(const std::filesystem::path& path,
+                                                        const std::string& content,
+                                                        std::string_view fragment,
+                                                        std::uint64_t line,
+                                                        const ReadOptions& options = {})
+{
+    std::optional<IoError> e = expect_file_error(path, content, fragment, options);
+    expect_error_line(e, line, path);
+    return e;
+}
+
+/// As expect_file_error, and the error must name byte offset `offset`.
+inline std::optional<IoError> expect_file_error_at_offset(const std::filesystem::path& path,
+                                                          const std::string& content,
+                                                          std::string_view fragment,
+                                                          std::uint64_t offset,
+                                                          const ReadOptions& options = {})
+{
+    std::optional<IoError> e = expect_file_error(path, content, fragment, options);
+    expect_error_offset(e, offset, path);
+    return e;
 }
 
 /// Files in a directory (names only), to check that failed writes leave nothing behind.

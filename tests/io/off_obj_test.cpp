@@ -82,23 +82,19 @@ TEST(OffRead, ColorAndNormalVariants)
 TEST(OffErrors, Malformed)
 {
     TempDir dir;
-    const auto check = [&](const std::string& name, const std::string& content,
-                           std::string_view fragment, std::uint64_t line) {
-        const auto path = dir / name;
-        write_file(path, content);
-        const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, fragment);
-        ASSERT_TRUE(e && e->line()) << name;
-        EXPECT_EQ(*e->line(), line) << name;
-    };
-    check("bad_index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", "refers to vertex 3", 6);
-    check("missing_faces.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "1 of the 2 faces", 7);
-    check("missing_vertices.off", "OFF\n4 0 0\n0 0 0\n1 0 0\n", "2 of the 4 vertices", 5);
-    check("short_vertex.off", "OFF\n2 0 0\n0 0 0\n1 0\n", "2 values", 4);
-    check("garbage.off", "OFF\n1 0 0\n0 zero 0\n", "'zero'", 3);
-    check("short_face.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4 0 1 2\n", "declares 4", 6);
-    check("nan.off", "OFF\n2 0 0\n0 0 0\n1 nan 0\n", "non-finite", 4);
-    check("keyword.off", "# comment\nPLY\n", "not an OFF file", 2);
-    check("counts.off", "OFF\nthree 1 0\n", "counts", 2);
+    expect_file_error_at_line(dir / "bad_index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n",
+                              "refers to vertex 3", 6);
+    expect_file_error_at_line(dir / "missing_faces.off",
+                              "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "1 of the 2 faces", 7);
+    expect_file_error_at_line(dir / "missing_vertices.off", "OFF\n4 0 0\n0 0 0\n1 0 0\n",
+                              "2 of the 4 vertices", 5);
+    expect_file_error_at_line(dir / "short_vertex.off", "OFF\n2 0 0\n0 0 0\n1 0\n", "2 values", 4);
+    expect_file_error_at_line(dir / "garbage.off", "OFF\n1 0 0\n0 zero 0\n", "'zero'", 3);
+    expect_file_error_at_line(dir / "short_face.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4 0 1 2\n",
+                              "declares 4", 6);
+    expect_file_error_at_line(dir / "nan.off", "OFF\n2 0 0\n0 0 0\n1 nan 0\n", "non-finite", 4);
+    expect_file_error_at_line(dir / "keyword.off", "# comment\nPLY\n", "not an OFF file", 2);
+    expect_file_error_at_line(dir / "counts.off", "OFF\nthree 1 0\n", "counts", 2);
 }
 
 TEST(ObjRoundTrip, MeshWithAndWithoutNormals)
@@ -171,35 +167,28 @@ TEST(ObjRead, PartialNormalReferencesGiveNoNormals)
 TEST(ObjErrors, Malformed)
 {
     TempDir dir;
-    const auto check = [&](const std::string& name, const std::string& content,
-                           std::string_view fragment, std::uint64_t line) {
-        const auto path = dir / name;
-        write_file(path, content);
-        const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, fragment);
-        ASSERT_TRUE(e && e->line()) << name;
-        EXPECT_EQ(*e->line(), line) << name;
-    };
-    check("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "refers to vertex 4", 4);
-    check("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "refers to vertex 0", 4);
-    check("negative.obj", "v 0 0 0\nv 1 0 0\nf -1 -2 -3\n", "refers to vertex -3", 3);
-    check("normal.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n",
-          "refers to normal 2", 5);
-    check("garbage.obj", "v 0 0 0\nv 1 0 x\n", "'x'", 2);
-    check("corner.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 three\n", "'three'", 4);
-    check("short.obj", "v 0 0\n", "x y z", 1);
-    check("nan.obj", "v 0 0 0\nv inf 0 0\n", "non-finite", 2);
+    expect_file_error_at_line(dir / "range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n",
+                              "refers to vertex 4", 4);
+    expect_file_error_at_line(dir / "zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n",
+                              "refers to vertex 0", 4);
+    expect_file_error_at_line(dir / "negative.obj", "v 0 0 0\nv 1 0 0\nf -1 -2 -3\n",
+                              "refers to vertex -3", 3);
+    expect_file_error_at_line(dir / "normal.obj",
+                              "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n",
+                              "refers to normal 2", 5);
+    expect_file_error_at_line(dir / "garbage.obj", "v 0 0 0\nv 1 0 x\n", "'x'", 2);
+    expect_file_error_at_line(dir / "corner.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 three\n",
+                              "'three'", 4);
+    expect_file_error_at_line(dir / "short.obj", "v 0 0\n", "x y z", 1);
+    expect_file_error_at_line(dir / "nan.obj", "v 0 0 0\nv inf 0 0\n", "non-finite", 2);
 }
 
 TEST(ObjErrors, DroppingVerticesOfAMeshIsAnError)
 {
     TempDir dir;
-    const auto path = dir / "drop.obj";
-    write_file(path, "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
-    const auto e =
-        expect_io_error([&] { (void)read_geometry(path, {.non_finite = NonFinitePolicy::Drop}); },
-                        path, "face indices would be wrong");
-    ASSERT_TRUE(e && e->line());
-    EXPECT_EQ(*e->line(), 2U);
+    expect_file_error_at_line(dir / "drop.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n",
+                              "face indices would be wrong", 2,
+                              {.non_finite = NonFinitePolicy::Drop});
 
     const auto points = dir / "drop_points.obj";
     write_file(points, "v 0 0 0\nv nan 0 0\nv 0 1 0\n");

@@ -157,47 +157,45 @@ void check_organized(const ReadResult& result)
     EXPECT_NE(result.description.find("organized 4 x 3"), std::string::npos);
 }
 
+/// Writes `content` to `path`, reads it back and checks that it holds organized_points() (see
+/// check_organized) and that its description names `kind`.
+void check_organized_file(const std::filesystem::path& path, const std::string& content,
+                          std::string_view kind)
+{
+    write_file(path, content);
+    const ReadResult result = read_geometry(path);
+    EXPECT_NE(result.description.find(kind), std::string::npos);
+    check_organized(result);
+}
+
 TEST(PcdRead, AsciiOrganizedWithNaNs)
 {
     TempDir dir;
-    const auto path = dir / "ascii.pcd";
-    write_file(path, ascii_pcd(organized_points()));
-    const ReadResult result = read_geometry(path);
-    EXPECT_NE(result.description.find("PCD ascii"), std::string::npos);
-    check_organized(result);
+    check_organized_file(dir / "ascii.pcd", ascii_pcd(organized_points()), "PCD ascii");
 }
 
 TEST(PcdRead, BinaryOrganizedWithNaNs)
 {
     TempDir dir;
-    const auto path = dir / "binary.pcd";
-    write_file(path, header("binary") + aos_bytes(organized_points()));
-    const ReadResult result = read_geometry(path);
-    EXPECT_NE(result.description.find("PCD binary"), std::string::npos);
-    check_organized(result);
+    check_organized_file(dir / "binary.pcd", header("binary") + aos_bytes(organized_points()),
+                         "PCD binary");
 }
 
 TEST(PcdRead, BinaryCompressedOrganizedWithNaNs)
 {
     TempDir dir;
-    const auto path = dir / "compressed.pcd";
-    write_file(path, compressed_pcd(organized_points()));
-    const ReadResult result = read_geometry(path);
-    EXPECT_NE(result.description.find("PCD binary_compressed"), std::string::npos);
-    check_organized(result);
+    check_organized_file(dir / "compressed.pcd", compressed_pcd(organized_points()),
+                         "PCD binary_compressed");
 }
 
 TEST(PcdRead, ErrorPolicyRejectsNaNs)
 {
     TempDir dir;
-    const auto path = dir / "binary.pcd";
     const std::string head = header("binary");
-    write_file(path, head + aos_bytes(organized_points()));
-    const auto e =
-        expect_io_error([&] { (void)read_geometry(path, {.non_finite = NonFinitePolicy::Error}); },
-                        path, "non-finite");
-    ASSERT_TRUE(e && e->offset());
-    EXPECT_EQ(*e->offset(), head.size() + sizeof(float) * 11); // point 1: 11 floats a point
+    expect_file_error_at_offset(dir / "binary.pcd", head + aos_bytes(organized_points()),
+                                "non-finite",
+                                head.size() + sizeof(float) * 11, // point 1: 11 floats a point
+                                {.non_finite = NonFinitePolicy::Error});
 }
 
 TEST(PcdRead, BackReferencesInLzf)
@@ -275,30 +273,25 @@ TEST(PcdRead, AsciiRgbWrittenAsFloat)
 TEST(PcdErrors, PointsMismatch)
 {
     TempDir dir;
-    const auto path = dir / "points.pcd";
-    write_file(path, header("binary", 10) + aos_bytes(organized_points()));
-    expect_io_error([&] { (void)read_geometry(path); }, path, "does not match WIDTH x HEIGHT");
+    expect_file_error(dir / "points.pcd", header("binary", 10) + aos_bytes(organized_points()),
+                      "does not match WIDTH x HEIGHT");
 }
 
 TEST(PcdErrors, TruncatedBinary)
 {
     TempDir dir;
-    const auto path = dir / "short.pcd";
     const std::string head = header("binary");
     std::string data = aos_bytes(organized_points());
     data.resize(data.size() - 10);
-    write_file(path, head + data);
-    const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, "point 11 of the 12");
-    ASSERT_TRUE(e && e->offset());
-    EXPECT_EQ(*e->offset(), head.size() + std::size_t{11} * 11 * sizeof(float));
+    expect_file_error_at_offset(dir / "short.pcd", head + data, "point 11 of the 12",
+                                head.size() + std::size_t{11} * 11 * sizeof(float));
 }
 
 TEST(PcdErrors, BinaryLongerThanPoints)
 {
     TempDir dir;
-    const auto path = dir / "long.pcd";
-    write_file(path, header("binary") + aos_bytes(organized_points()) + "junk");
-    expect_io_error([&] { (void)read_geometry(path); }, path, "4 bytes after");
+    expect_file_error(dir / "long.pcd", header("binary") + aos_bytes(organized_points()) + "junk",
+                      "4 bytes after");
 }
 
 TEST(PcdErrors, CompressedSizesAndCorruptStream)
@@ -308,38 +301,36 @@ TEST(PcdErrors, CompressedSizesAndCorruptStream)
     const std::string raw = soa_bytes(points);
     const std::string lzf = lzf_literal_encode(raw);
 
-    const auto wrong_size = dir / "wrong_size.pcd";
-    write_file(wrong_size, Bytes()
-                               .text(header("binary_compressed"))
-                               .le(static_cast<std::uint32_t>(lzf.size()))
-                               .le(static_cast<std::uint32_t>(raw.size() - 4))
-                               .text(lzf)
-                               .str());
-    expect_io_error([&] { (void)read_geometry(wrong_size); }, wrong_size, "uncompressed size");
+    expect_file_error(dir / "wrong_size.pcd",
+                      Bytes()
+                          .text(header("binary_compressed"))
+                          .le(static_cast<std::uint32_t>(lzf.size()))
+                          .le(static_cast<std::uint32_t>(raw.size() - 4))
+                          .text(lzf)
+                          .str(),
+                      "uncompressed size");
 
-    const auto truncated = dir / "truncated.pcd";
-    write_file(truncated, Bytes()
-                              .text(header("binary_compressed"))
-                              .le(static_cast<std::uint32_t>(lzf.size()))
-                              .le(static_cast<std::uint32_t>(raw.size()))
-                              .text(std::string_view(lzf).substr(0, lzf.size() / 2))
-                              .str());
-    expect_io_error([&] { (void)read_geometry(truncated); }, truncated, "truncated");
+    expect_file_error(dir / "truncated.pcd",
+                      Bytes()
+                          .text(header("binary_compressed"))
+                          .le(static_cast<std::uint32_t>(lzf.size()))
+                          .le(static_cast<std::uint32_t>(raw.size()))
+                          .text(std::string_view(lzf).substr(0, lzf.size() / 2))
+                          .str(),
+                      "truncated");
 
-    const auto corrupt = dir / "corrupt.pcd";
     std::string bad = lzf;
     bad[0] = static_cast<char>(0x20); // a back reference before any output
-    write_file(corrupt, Bytes()
-                            .text(header("binary_compressed"))
-                            .le(static_cast<std::uint32_t>(bad.size()))
-                            .le(static_cast<std::uint32_t>(raw.size()))
-                            .text(bad)
-                            .str());
-    expect_io_error([&] { (void)read_geometry(corrupt); }, corrupt, "corrupt LZF");
+    expect_file_error(dir / "corrupt.pcd",
+                      Bytes()
+                          .text(header("binary_compressed"))
+                          .le(static_cast<std::uint32_t>(bad.size()))
+                          .le(static_cast<std::uint32_t>(raw.size()))
+                          .text(bad)
+                          .str(),
+                      "corrupt LZF");
 
-    const auto headless = dir / "headless.pcd";
-    write_file(headless, header("binary_compressed") + "ab");
-    expect_io_error([&] { (void)read_geometry(headless); }, headless, "truncated");
+    expect_file_error(dir / "headless.pcd", header("binary_compressed") + "ab", "truncated");
 }
 
 TEST(PcdErrors, AsciiLinesAndValues)
@@ -348,69 +339,54 @@ TEST(PcdErrors, AsciiLinesAndValues)
     const std::string head =
         "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 3\nHEIGHT 1\n"
         "POINTS 3\nDATA ascii\n";
-    const auto fewer = dir / "fewer.pcd";
-    write_file(fewer, head + "0 0 0\n1 1 1\n");
-    auto e = expect_io_error([&] { (void)read_geometry(fewer); }, fewer, "2 of the 3 POINTS");
-    ASSERT_TRUE(e && e->line());
-    EXPECT_EQ(*e->line(), 10U);
-
-    const auto more = dir / "more.pcd";
-    write_file(more, head + "0 0 0\n1 1 1\n2 2 2\n3 3 3\n");
-    e = expect_io_error([&] { (void)read_geometry(more); }, more, "more data lines");
-    ASSERT_TRUE(e && e->line());
-    EXPECT_EQ(*e->line(), 11U);
-
-    const auto values = dir / "values.pcd";
-    write_file(values, head + "0 0 0\n1 1\n2 2 2\n");
-    e = expect_io_error([&] { (void)read_geometry(values); }, values, "2 values, expected 3");
-    ASSERT_TRUE(e && e->line());
-    EXPECT_EQ(*e->line(), 9U);
-
-    const auto garbage = dir / "garbage.pcd";
-    write_file(garbage, head + "0 0 0\n1 one 1\n2 2 2\n");
-    expect_io_error([&] { (void)read_geometry(garbage); }, garbage, "'one'");
+    expect_file_error_at_line(dir / "fewer.pcd", head + "0 0 0\n1 1 1\n", "2 of the 3 POINTS", 10);
+    expect_file_error_at_line(dir / "more.pcd", head + "0 0 0\n1 1 1\n2 2 2\n3 3 3\n",
+                              "more data lines", 11);
+    expect_file_error_at_line(dir / "values.pcd", head + "0 0 0\n1 1\n2 2 2\n",
+                              "2 values, expected 3", 9);
+    expect_file_error(dir / "garbage.pcd", head + "0 0 0\n1 one 1\n2 2 2\n", "'one'");
 }
 
 TEST(PcdErrors, MalformedHeaders)
 {
     TempDir dir;
-    const auto check = [&](const std::string& name, const std::string& content,
-                           std::string_view fragment) {
-        const auto path = dir / name;
-        write_file(path, content);
-        expect_io_error([&] { (void)read_geometry(path); }, path, fragment);
-    };
-    check("nodata.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\n", "no DATA");
-    check("noxyz.pcd", "FIELDS x y\nSIZE 4 4\nTYPE F F\nWIDTH 1\nDATA ascii\n0 0\n",
-          "no x, y and z");
-    check("sizes.pcd", "FIELDS x y z\nSIZE 4 4\nTYPE F F F\nWIDTH 1\nDATA ascii\n0 0 0\n",
-          "SIZE has 2 values");
-    check("type.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F Q\nWIDTH 1\nDATA ascii\n0 0 0\n",
-          "unknown field type");
-    check("fsize.pcd", "FIELDS x y z\nSIZE 4 4 2\nTYPE F F F\nWIDTH 1\nDATA ascii\n0 0 0\n",
-          "unsupported size");
-    check("kind.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nDATA zip\n", "unknown DATA");
-    check("width.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nDATA ascii\n0 0 0\n", "no WIDTH");
+    expect_file_error(dir / "nodata.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\n",
+                      "no DATA");
+    expect_file_error(dir / "noxyz.pcd",
+                      "FIELDS x y\nSIZE 4 4\nTYPE F F\nWIDTH 1\nDATA ascii\n0 0\n",
+                      "no x, y and z");
+    expect_file_error(dir / "sizes.pcd",
+                      "FIELDS x y z\nSIZE 4 4\nTYPE F F F\nWIDTH 1\nDATA ascii\n0 0 0\n",
+                      "SIZE has 2 values");
+    expect_file_error(dir / "type.pcd",
+                      "FIELDS x y z\nSIZE 4 4 4\nTYPE F F Q\nWIDTH 1\nDATA ascii\n0 0 0\n",
+                      "unknown field type");
+    expect_file_error(dir / "fsize.pcd",
+                      "FIELDS x y z\nSIZE 4 4 2\nTYPE F F F\nWIDTH 1\nDATA ascii\n0 0 0\n",
+                      "unsupported size");
+    expect_file_error(dir / "kind.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nDATA zip\n",
+                      "unknown DATA");
+    expect_file_error(dir / "width.pcd",
+                      "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nDATA ascii\n0 0 0\n", "no WIDTH");
 }
 
 TEST(PcdErrors, HugeDeclaredCountsFailCleanly)
 {
     TempDir dir;
-    const auto path = dir / "huge.pcd";
-    write_file(path,
-               "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 100000000000\nHEIGHT 1\n"
-               "POINTS 100000000000\nDATA binary\n0123456789ab");
-    expect_io_error([&] { (void)read_geometry(path); }, path, "truncated");
+    expect_file_error(dir / "huge.pcd",
+                      "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 100000000000\nHEIGHT 1\n"
+                      "POINTS 100000000000\nDATA binary\n0123456789ab",
+                      "truncated");
 
-    const auto compressed = dir / "huge_compressed.pcd";
-    write_file(compressed, Bytes()
-                               .text("FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 300000000\n"
-                                     "HEIGHT 1\nPOINTS 300000000\nDATA binary_compressed\n")
-                               .le<std::uint32_t>(4)
-                               .le<std::uint32_t>(3600000000U)
-                               .text("abcd")
-                               .str());
-    expect_io_error([&] { (void)read_geometry(compressed); }, compressed, "too small");
+    expect_file_error(dir / "huge_compressed.pcd",
+                      Bytes()
+                          .text("FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 300000000\n"
+                                "HEIGHT 1\nPOINTS 300000000\nDATA binary_compressed\n")
+                          .le<std::uint32_t>(4)
+                          .le<std::uint32_t>(3600000000U)
+                          .text("abcd")
+                          .str(),
+                      "too small");
 }
 
 } // namespace

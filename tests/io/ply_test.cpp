@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 namespace pointform::test {
 namespace {
 
@@ -254,23 +256,17 @@ std::string small_binary_ply(std::uint64_t declared, std::size_t written)
 TEST(PlyErrors, TruncatedBinaryNamesTheByteOffset)
 {
     TempDir dir;
-    const auto path = dir / "truncated.ply";
     std::string bytes = small_binary_ply(10, 10);
     const std::size_t header = bytes.size() - 120;
     bytes.resize(bytes.size() - 5); // last vertex loses 5 bytes
-    write_file(path, bytes);
-    const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, "truncated");
-    ASSERT_TRUE(e);
-    ASSERT_TRUE(e->offset());
-    EXPECT_EQ(*e->offset(), header + std::size_t{9 * 12 + 4}); // x of vertex 9 read, y cut
+    expect_file_error_at_offset(dir / "truncated.ply", bytes, "truncated",
+                                header + std::size_t{9 * 12 + 4}); // x of vertex 9 read, y cut
 }
 
 TEST(PlyErrors, HeaderCountLargerThanBinaryData)
 {
     TempDir dir;
-    const auto path = dir / "lying.ply";
-    write_file(path, small_binary_ply(12, 8));
-    const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, "vertex 8 of 12");
+    const auto e = expect_file_error(dir / "lying.ply", small_binary_ply(12, 8), "vertex 8 of 12");
     ASSERT_TRUE(e);
     EXPECT_TRUE(e->offset());
 }
@@ -278,30 +274,23 @@ TEST(PlyErrors, HeaderCountLargerThanBinaryData)
 TEST(PlyErrors, HeaderCountSmallerThanBinaryData)
 {
     TempDir dir;
-    const auto path = dir / "short_count.ply";
-    write_file(path, small_binary_ply(3, 5));
-    expect_io_error([&] { (void)read_geometry(path); }, path, "do not match");
+    expect_file_error(dir / "short_count.ply", small_binary_ply(3, 5), "do not match");
 }
 
 TEST(PlyErrors, HugeDeclaredCountFailsCleanly)
 {
     TempDir dir;
-    const auto path = dir / "huge.ply";
-    write_file(path, small_binary_ply(1000000000000ULL, 2));
-    expect_io_error([&] { (void)read_geometry(path); }, path, "truncated");
-    const auto ascii = dir / "huge_ascii.ply";
-    write_file(ascii,
-               "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\n"
-               "property float y\nproperty float z\nelement face 999999999999\n"
-               "property list uchar int vertex_indices\nend_header\n0 0 0\n");
-    expect_io_error([&] { (void)read_geometry(ascii); }, ascii,
-                    "file ends after 1 of the 4000000000 vertex");
-    const auto indices = dir / "too_many.ply";
-    write_file(indices,
-               "ply\nformat ascii 1.0\nelement vertex 5000000000\nproperty float x\n"
-               "property float y\nproperty float z\nelement face 1\n"
-               "property list uchar int vertex_indices\nend_header\n0 0 0\n");
-    expect_io_error([&] { (void)read_geometry(indices); }, indices, "too many vertices");
+    expect_file_error(dir / "huge.ply", small_binary_ply(1000000000000ULL, 2), "truncated");
+    expect_file_error(dir / "huge_ascii.ply",
+                      "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\n"
+                      "property float y\nproperty float z\nelement face 999999999999\n"
+                      "property list uchar int vertex_indices\nend_header\n0 0 0\n",
+                      "file ends after 1 of the 4000000000 vertex");
+    expect_file_error(dir / "too_many.ply",
+                      "ply\nformat ascii 1.0\nelement vertex 5000000000\nproperty float x\n"
+                      "property float y\nproperty float z\nelement face 1\n"
+                      "property list uchar int vertex_indices\nend_header\n0 0 0\n",
+                      "too many vertices");
 }
 
 const char* const ascii_header =
@@ -311,110 +300,91 @@ const char* const ascii_header =
 TEST(PlyErrors, AsciiCountLargerThanData)
 {
     TempDir dir;
-    const auto path = dir / "lying.ply";
-    write_file(path, std::string(ascii_header) + "end_header\n0 0 0\n1 1 1\n");
-    const auto e = expect_io_error([&] { (void)read_geometry(path); }, path,
-                                   "file ends after 2 of the 3 vertex");
-    ASSERT_TRUE(e && e->line());
-    EXPECT_EQ(*e->line(), 10U);
+    expect_file_error_at_line(dir / "lying.ply",
+                              std::string(ascii_header) + "end_header\n0 0 0\n1 1 1\n",
+                              "file ends after 2 of the 3 vertex", 10);
 }
 
 TEST(PlyErrors, AsciiLineWithTooFewValues)
 {
     TempDir dir;
-    const auto path = dir / "few.ply";
-    write_file(path, std::string(ascii_header) + "end_header\n0 0 0\n1 1\n2 2 2\n");
-    const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, "fewer values");
-    ASSERT_TRUE(e && e->line());
-    EXPECT_EQ(*e->line(), 9U);
+    const auto e = expect_file_error_at_line(
+        dir / "few.ply", std::string(ascii_header) + "end_header\n0 0 0\n1 1\n2 2 2\n",
+        "fewer values", 9);
+    ASSERT_TRUE(e);
     EXPECT_NE(std::string(e->what()).find(":9"), std::string::npos);
 }
 
 TEST(PlyErrors, AsciiLineWithTooManyValues)
 {
     TempDir dir;
-    const auto path = dir / "many.ply";
-    write_file(path, std::string(ascii_header) + "end_header\n0 0 0\n1 1 1 1\n2 2 2\n");
-    const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, "more values");
-    ASSERT_TRUE(e && e->line());
-    EXPECT_EQ(*e->line(), 9U);
+    expect_file_error_at_line(dir / "many.ply",
+                              std::string(ascii_header) + "end_header\n0 0 0\n1 1 1 1\n2 2 2\n",
+                              "more values", 9);
 }
 
 TEST(PlyErrors, AsciiMoreLinesThanDeclared)
 {
     TempDir dir;
-    const auto path = dir / "extra.ply";
-    write_file(path, std::string(ascii_header) + "end_header\n0 0 0\n1 1 1\n2 2 2\n3 3 3\n");
-    const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, "more data");
-    ASSERT_TRUE(e && e->line());
-    EXPECT_EQ(*e->line(), 11U);
+    expect_file_error_at_line(
+        dir / "extra.ply", std::string(ascii_header) + "end_header\n0 0 0\n1 1 1\n2 2 2\n3 3 3\n",
+        "more data", 11);
 }
 
 TEST(PlyErrors, GarbageNumber)
 {
     TempDir dir;
-    const auto path = dir / "garbage.ply";
-    write_file(path, std::string(ascii_header) + "end_header\n0 0 0\n1 1.5x 1\n2 2 2\n");
-    const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, "'1.5x'");
-    ASSERT_TRUE(e && e->line());
-    EXPECT_EQ(*e->line(), 9U);
+    expect_file_error_at_line(dir / "garbage.ply",
+                              std::string(ascii_header) + "end_header\n0 0 0\n1 1.5x 1\n2 2 2\n",
+                              "'1.5x'", 9);
 }
 
 TEST(PlyErrors, NonFiniteCoordinates)
 {
     TempDir dir;
     const auto path = dir / "nan.ply";
-    write_file(path, std::string(ascii_header) + "end_header\n0 0 0\nnan 1 1\n2 inf 2\n");
-    const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, "non-finite");
-    ASSERT_TRUE(e && e->line());
-    EXPECT_EQ(*e->line(), 9U);
+    expect_file_error_at_line(
+        path, std::string(ascii_header) + "end_header\n0 0 0\nnan 1 1\n2 inf 2\n", "non-finite", 9);
 
     const ReadResult dropped = read_geometry(path, {.non_finite = NonFinitePolicy::Drop});
     EXPECT_EQ(dropped.points.size(), 1U);
     EXPECT_EQ(dropped.dropped_points, 2U);
 
-    const auto binary = dir / "nan_binary.ply";
     Bytes b;
     b.text(
         "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\n"
         "property float y\nproperty float z\nend_header\n");
     const std::size_t data = b.size();
     b.le(0.0F).le(0.0F).le(0.0F).le(1.0F).le(std::numeric_limits<float>::infinity()).le(1.0F);
-    write_file(binary, b.str());
-    const auto eb = expect_io_error([&] { (void)read_geometry(binary); }, binary, "non-finite");
-    ASSERT_TRUE(eb && eb->offset());
-    EXPECT_EQ(*eb->offset(), data + 12);
+    expect_file_error_at_offset(dir / "nan_binary.ply", b.str(), "non-finite", data + 12);
 }
 
 TEST(PlyErrors, DroppingVerticesOfAMeshIsAnError)
 {
     TempDir dir;
-    const auto path = dir / "nan_mesh.ply";
-    write_file(path, std::string(ascii_header) +
-                         "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                         "0 0 0\nnan 1 1\n2 2 2\n3 0 1 2\n");
-    expect_io_error([&] { (void)read_geometry(path, {.non_finite = NonFinitePolicy::Drop}); }, path,
-                    "face indices would be wrong");
+    expect_file_error(dir / "nan_mesh.ply",
+                      std::string(ascii_header) +
+                          "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                          "0 0 0\nnan 1 1\n2 2 2\n3 0 1 2\n",
+                      "face indices would be wrong", {.non_finite = NonFinitePolicy::Drop});
 }
 
 TEST(PlyErrors, FaceIndexOutOfRange)
 {
     TempDir dir;
-    const auto path = dir / "bad_face.ply";
-    write_file(path, std::string(ascii_header) +
-                         "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
-                         "0 0 0\n1 1 1\n2 2 2\n3 0 1 2\n3 0 1 3\n");
-    const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, "refers to vertex 3");
-    ASSERT_TRUE(e && e->line());
-    EXPECT_EQ(*e->line(), 14U);
+    expect_file_error_at_line(
+        dir / "bad_face.ply",
+        std::string(ascii_header) +
+            "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
+            "0 0 0\n1 1 1\n2 2 2\n3 0 1 2\n3 0 1 3\n",
+        "refers to vertex 3", 14);
 
-    const auto negative = dir / "negative_face.ply";
-    write_file(negative, std::string(ascii_header) +
-                             "element face 1\nproperty list uchar int vertex_indices\n"
-                             "end_header\n0 0 0\n1 1 1\n2 2 2\n3 0 -1 2\n");
-    expect_io_error([&] { (void)read_geometry(negative); }, negative, "refers to vertex -1");
+    expect_file_error(dir / "negative_face.ply",
+                      std::string(ascii_header) +
+                          "element face 1\nproperty list uchar int vertex_indices\n"
+                          "end_header\n0 0 0\n1 1 1\n2 2 2\n3 0 -1 2\n",
+                      "refers to vertex -1");
 
-    const auto binary = dir / "bad_face_binary.ply";
     Bytes b;
     b.text(
         "ply\nformat binary_big_endian 1.0\nelement vertex 1\nproperty float x\n"
@@ -423,37 +393,43 @@ TEST(PlyErrors, FaceIndexOutOfRange)
     b.be(0.0F).be(0.0F).be(0.0F);
     const std::size_t face_at = b.size();
     b.be<std::uint8_t>(3).be<std::int32_t>(0).be<std::int32_t>(0).be<std::int32_t>(7);
-    write_file(binary, b.str());
-    const auto eb =
-        expect_io_error([&] { (void)read_geometry(binary); }, binary, "refers to vertex 7");
-    ASSERT_TRUE(eb && eb->offset());
-    EXPECT_EQ(*eb->offset(), face_at);
+    expect_file_error_at_offset(dir / "bad_face_binary.ply", b.str(), "refers to vertex 7",
+                                face_at);
+
+    // Found by the fuzzer: an ascii value far beyond any integer type, or NaN, for an int index.
+    for (const std::string index : {"3.3e105", "nan"})
+        expect_file_error(dir / "huge_face_index.ply",
+                          std::string(ascii_header) +
+                              "element face 1\nproperty list uchar int vertex_indices\n"
+                              "end_header\n0 0 0\n1 1 1\n2 2 2\n3 0 1 " +
+                              index + "\n",
+                          "face 0");
 }
 
 TEST(PlyErrors, MalformedHeaders)
 {
     TempDir dir;
-    const auto check = [&](const std::string& name, const std::string& content,
-                           std::string_view fragment) {
-        const auto path = dir / name;
-        write_file(path, content);
-        expect_io_error([&] { (void)read_geometry(path); }, path, fragment);
-    };
-    check("magic.ply", "plx\nformat ascii 1.0\nend_header\n", "not a PLY file");
-    check("no_end.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n",
-          "no end_header");
-    check("type.ply",
-          "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n0\n",
-          "unknown property type");
-    check("format.ply", "ply\nformat binary_middle_endian 1.0\nend_header\n", "unknown PLY format");
-    check("noxyz.ply",
-          "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
-          "end_header\n0 0\n",
-          "no x, y and z");
-    check("count.ply", "ply\nformat ascii 1.0\nelement vertex -3\nend_header\n", "element line");
-    check("noformat.ply", "ply\nelement vertex 0\nend_header\n", "no format line");
-    check("orphan.ply", "ply\nformat ascii 1.0\nproperty float x\nend_header\n",
-          "before any element");
+    expect_file_error(dir / "magic.ply", "plx\nformat ascii 1.0\nend_header\n", "not a PLY file");
+    expect_file_error(dir / "no_end.ply",
+                      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n",
+                      "no end_header");
+    expect_file_error(
+        dir / "type.ply",
+        "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n0\n",
+        "unknown property type");
+    expect_file_error(dir / "format.ply", "ply\nformat binary_middle_endian 1.0\nend_header\n",
+                      "unknown PLY format");
+    expect_file_error(
+        dir / "noxyz.ply",
+        "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+        "end_header\n0 0\n",
+        "no x, y and z");
+    expect_file_error(dir / "count.ply", "ply\nformat ascii 1.0\nelement vertex -3\nend_header\n",
+                      "element line");
+    expect_file_error(dir / "noformat.ply", "ply\nelement vertex 0\nend_header\n",
+                      "no format line");
+    expect_file_error(dir / "orphan.ply", "ply\nformat ascii 1.0\nproperty float x\nend_header\n",
+                      "before any element");
 }
 
 } // namespace

@@ -152,49 +152,29 @@ TEST(XyzRead, FourColumnsAreXyzAndIgnored)
 TEST(XyzErrors, InconsistentColumnCountNamesTheLine)
 {
     TempDir dir;
-    const auto path = dir / "ragged.xyz";
-    write_file(path, "# header comment\n1 2 3\n4 5 6\n7 8\n");
-    auto e = expect_io_error([&] { (void)read_geometry(path); }, path, "2 values, expected 3");
-    ASSERT_TRUE(e && e->line());
-    EXPECT_EQ(*e->line(), 4U);
-
-    const auto longer = dir / "longer.xyz";
-    write_file(longer, "1 2 3\n4 5 6 7\n");
-    e = expect_io_error([&] { (void)read_geometry(longer); }, longer, "4 values, expected 3");
-    ASSERT_TRUE(e && e->line());
-    EXPECT_EQ(*e->line(), 2U);
+    expect_file_error_at_line(dir / "ragged.xyz", "# header comment\n1 2 3\n4 5 6\n7 8\n",
+                              "2 values, expected 3", 4);
+    expect_file_error_at_line(dir / "longer.xyz", "1 2 3\n4 5 6 7\n", "4 values, expected 3", 2);
 }
 
 TEST(XyzErrors, TooFewColumns)
 {
     TempDir dir;
-    const auto path = dir / "two.xyz";
-    write_file(path, "1 2\n3 4\n");
-    expect_io_error([&] { (void)read_geometry(path); }, path, "at least 3 values");
+    expect_file_error(dir / "two.xyz", "1 2\n3 4\n", "at least 3 values");
 }
 
 TEST(XyzErrors, GarbageNumbers)
 {
     TempDir dir;
-    const auto path = dir / "garbage.xyz";
-    write_file(path, "1 2 3\n4 5 6\n7 8e 9\n");
-    const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, "'8e'");
-    ASSERT_TRUE(e && e->line());
-    EXPECT_EQ(*e->line(), 3U);
-
-    const auto header = dir / "words.xyz";
-    write_file(header, "hello world again\n1 2 3\n");
-    expect_io_error([&] { (void)read_geometry(header); }, header, "header naming x, y and z");
+    expect_file_error_at_line(dir / "garbage.xyz", "1 2 3\n4 5 6\n7 8e 9\n", "'8e'", 3);
+    expect_file_error(dir / "words.xyz", "hello world again\n1 2 3\n", "header naming x, y and z");
 }
 
 TEST(XyzErrors, NonFiniteCoordinates)
 {
     TempDir dir;
     const auto path = dir / "nan.xyz";
-    write_file(path, "1 2 3\n-inf 2 3\n4 nan 6\n7 8 9\n");
-    const auto e = expect_io_error([&] { (void)read_geometry(path); }, path, "non-finite");
-    ASSERT_TRUE(e && e->line());
-    EXPECT_EQ(*e->line(), 2U);
+    expect_file_error_at_line(path, "1 2 3\n-inf 2 3\n4 nan 6\n7 8 9\n", "non-finite", 2);
 
     const ReadResult dropped = read_geometry(path, {.non_finite = NonFinitePolicy::Drop});
     EXPECT_EQ(dropped.points.size(), 2U);
@@ -205,20 +185,14 @@ TEST(XyzErrors, NonFiniteCoordinates)
 TEST(XyzErrors, PtsCountMismatch)
 {
     TempDir dir;
-    const auto path = dir / "count.pts";
-    write_file(path, "5\n1 2 3\n4 5 6\n");
-    const auto e = expect_io_error([&] { (void)read_geometry(path); }, path,
-                                   "declares 5 points but the file has 2");
-    ASSERT_TRUE(e && e->line());
-    EXPECT_EQ(*e->line(), 1U);
+    expect_file_error_at_line(dir / "count.pts", "5\n1 2 3\n4 5 6\n",
+                              "declares 5 points but the file has 2", 1);
 }
 
 TEST(XyzErrors, OnlyComments)
 {
     TempDir dir;
-    const auto path = dir / "comments.xyz";
-    write_file(path, "# nothing\n\n// here\n");
-    expect_io_error([&] { (void)read_geometry(path); }, path, "no data lines");
+    expect_file_error(dir / "comments.xyz", "# nothing\n\n// here\n", "no data lines");
 }
 
 } // namespace
