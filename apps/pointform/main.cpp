@@ -14,18 +14,13 @@
 
 namespace {
 
-/// Exit codes, documented in --help.
-enum ExitCode : int
-{
-    exit_ok = 0,
-    exit_invalid_input = 2, ///< data or option values that cannot be processed
-    exit_io = 3,            ///< a file could not be read or written
-    exit_failure = 4,       ///< any other failure
-};
+// Exit codes, documented in --help.
+constexpr int exit_ok = 0;
+constexpr int exit_invalid_input = 2; // data or option values that cannot be processed
+constexpr int exit_io = 3;            // a file could not be read or written
+constexpr int exit_failure = 4;       // any other failure
 
-} // namespace
-
-int main(int argc, char** argv)
+int run(int argc, char** argv)
 {
     CLI::App app{
         "pointform: multiresolution free-form modeling from point-sampled geometry.\n"
@@ -73,4 +68,19 @@ int main(int argc, char** argv)
         return exit_failure;
     }
     return exit_ok;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    try
+    {
+        return run(argc, argv);
+    }
+    catch (...)
+    {
+        std::fputs("pointform: error: unexpected failure\n", stderr);
+        return exit_failure;
+    }
 }

@@ -148,8 +148,8 @@ PointCloud sample_shape(Shape shape, const SampleOptions& options)
             p += Vec3d(gauss(rng), gauss(rng), gauss(rng));
         if (in_hole)
             continue;
-        cloud.positions.push_back(p.cast<float>());
-        cloud.normals.push_back(s.normal.cast<float>());
+        cloud.positions.emplace_back(p.cast<float>());
+        cloud.normals.emplace_back(s.normal.cast<float>());
     }
     return cloud;
 }

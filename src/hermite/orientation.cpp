@@ -478,7 +478,7 @@ OrientedNormals flip_normals(std::span<const Vec3f> normals)
     OrientedNormals result;
     result.normals.reserve(normals.size());
     for (const auto& n : normals)
-        result.normals.push_back(-n);
+        result.normals.emplace_back(-n);
     result.flipped = normals.size();
     return result;
 }

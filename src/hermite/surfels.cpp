@@ -65,7 +65,7 @@ void check_surfel_input(const PointCloud& cloud, std::size_t k)
         covariance.noalias() += d * d.transpose();
     }
     const Eigen::SelfAdjointEigenSolver<Mat3d> solver(covariance, Eigen::EigenvaluesOnly);
-    const Vec3d lambda = solver.eigenvalues();
+    const Vec3d& lambda = solver.eigenvalues();
     if (!(lambda[2] > 0.0))
         throw InvalidInput("all " + std::to_string(cloud.size()) +
                            " points coincide: no surface to estimate");
