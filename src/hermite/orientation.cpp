@@ -386,7 +386,38 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions, std::span<c
         if (patch[i] != RiemannianForest::none && patch_flip[patch[i]] == 1)
             result.normals[i] = -result.normals[i];
 
-    // 3. Samples without a normal of their own take their tree parent's; each component's root
+    // 3. Each sample re-decides its sign by its neighbours: flip if n_i disagrees with
+    //    m_i = Σ_j w_ij n_j over its k neighbours, w_ij = 1 − |n_i·ê_ij| (the edge's share in
+    //    i's tangent plane, ~0 for a neighbour across a thin wall). Averaging cancels the
+    //    neighbours' noise, so a poor normal takes the sign of its neighbourhood rather than of
+    //    the one tree edge that reached it. Jacobi sweeps over a snapshot: deterministic.
+    for (std::size_t sweep = 0; sweep < options.smoothing_sweeps; ++sweep)
+    {
+        const std::vector<Vec3f> snapshot = result.normals;
+        parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                const Vec3f& ni = snapshot[i];
+                if (!usable(ni) || patch[i] == RiemannianForest::none)
+                    continue;
+                Vec3f mean = Vec3f::Zero();
+                for (const std::uint32_t j : neighbors.neighbors(i))
+                {
+                    if (j == i || !usable(snapshot[j]))
+                        continue;
+                    const Vec3f e = positions[j] - positions[i];
+                    const float len2 = e.squaredNorm();
+                    const float tangential =
+                        len2 > 0.0F ? 1.0F - std::abs(ni.dot(e)) / std::sqrt(len2) : 1.0F;
+                    mean += tangential * snapshot[j];
+                }
+                if (ni.dot(mean) < 0.0F)
+                    result.normals[i] = -ni;
+            }
+        });
+    }
+
+    // 4. Samples without a normal of their own take their tree parent's; each component's root
     //    then faces +z.
     for (const std::uint32_t v : forest.order)
     {
@@ -405,7 +436,7 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions, std::span<c
         if (forest.component[i] != RiemannianForest::none && root_down[forest.component[i]] != 0)
             result.normals[i] = -result.normals[i];
 
-    // Flux test per component: Σ a_i n_i·(p_i − c), with a_i ≈ squared k-th neighbour distance.
+    // 5. Flux test per component: Σ a_i n_i·(p_i − c), a_i ≈ squared k-th neighbour distance.
     const std::size_t component_count = forest.roots.size();
     std::vector<Vec3d> centroid(component_count, Vec3d::Zero());
     std::vector<double> count(component_count, 0.0);

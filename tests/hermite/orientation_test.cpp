@@ -105,10 +105,11 @@ TEST(OrientNormalsMst, ThinPlateBothSidesOutward)
 TEST(OrientNormalsMst, ReflectionRuleOrientsPlateThinnerThanTheNeighbourhood)
 {
     // Half a sampling step thick: Hoppe's rule crosses the wall and flips one side (about 50%).
+    // Neighbourhood smoothing would average across a wall this thin (93%), so it is off here.
     const PointCloud plate =
         sample_shape(Shape::Plate, {.count = 40000, .seed = 4, .thickness = 0.01});
     const OrientedNormals result =
-        orient(plate, 16, {.k = 10, .rule = OrientationRule::Reflection});
+        orient(plate, 16, {.k = 10, .rule = OrientationRule::Reflection, .smoothing_sweeps = 0});
     std::vector<Vec3f> est;
     std::vector<Vec3f> truth;
     for (std::size_t i = 0; i < plate.size(); ++i)

@@ -47,6 +47,11 @@ struct OrientationOptions
     /// are then oriented against each other by the summed agreement of every graph edge between
     /// them. 0.3 trusts steps up to about 45°; 2 trusts every edge (plain propagation).
     double patch_cost = 0.3;
+    /// Sweeps in which every sample takes the sign of its neighbourhood's weighted mean normal,
+    /// after propagation (each sweep reads all k columns of the table). 0 = none. Measured on a
+    /// 1M-sample sphere with noise of twice the sampling step: 93.0% oriented with 0 sweeps,
+    /// 93.9% with 1, 94.1% with 2.
+    std::size_t smoothing_sweeps = 2;
     /// Optional progress report.
     ProgressCallback progress;
 };
@@ -103,12 +108,16 @@ struct OrientedNormals
 ///
 /// Every connected component is handled on its own: its seed is its highest point (largest z),
 /// whose normal is turned to +z, and orientation spreads from it along the minimum spanning
-/// tree, each sample taking the sign that agrees with its tree parent under `options.rule`. Then,
-/// so that closed surfaces come out with outward normals whatever their shape, the component's
-/// normals are flipped if the area-weighted flux Σ a_i n_i·(p_i − c) (3 × the enclosed volume for a
-/// closed surface, by the divergence theorem) is clearly negative; for open, flat components the
-/// flux says little and the seed's +z stands. Samples with a zero normal (degenerate
-/// neighbourhoods) take their tree parent's normal and are counted in `inherited`.
+/// tree, each sample taking the sign that agrees with its tree parent under `options.rule` —
+/// but only across tree edges cheaper than `options.patch_cost`. The dearer edges cut the trees
+/// into patches, which are flipped against each other by the summed agreement of every graph
+/// edge between them. Then `options.smoothing_sweeps` times, every sample takes the sign of its
+/// neighbours' weighted mean normal. Finally, so that closed surfaces come out with outward
+/// normals whatever their shape, the component's normals are flipped if the area-weighted flux
+/// Σ a_i n_i·(p_i − c) (3 × the enclosed volume for a closed surface, by the divergence
+/// theorem) is clearly negative; for open, flat components the flux says little and the seed's
+/// +z stands. Samples with a zero normal (degenerate neighbourhoods) take their tree parent's
+/// normal and are counted in `inherited`.
 ///
 /// \param positions  N points
 /// \param normals    N unoriented normals (unit, or zero where undefined)
