@@ -34,6 +34,12 @@ struct WeightedEdge
     [[nodiscard]] float cost() const { return std::bit_cast<float>(cost_bits); }
 };
 
+/// Columns of the neighbour table that make the Riemannian graph (OrientationOptions::k).
+std::size_t graph_columns(const OrientationOptions& options, const KnnTable& neighbors)
+{
+    return options.k == 0 ? neighbors.k : std::min(options.k, neighbors.k);
+}
+
 bool row_contains(const KnnTable& table, std::size_t row, std::size_t columns, std::uint32_t value)
 {
     const auto nbrs = table.neighbors(row).first(columns);
@@ -159,7 +165,7 @@ RiemannianForest riemannian_spanning_forest(std::span<const Vec3f> positions,
     if (n == 0)
         return forest;
     ProgressReporter progress(options.progress, "orientation");
-    const std::size_t columns = options.k == 0 ? neighbors.k : std::min(options.k, neighbors.k);
+    const std::size_t columns = graph_columns(options, neighbors);
 
     // 1. The Riemannian graph's edges, each once: {i, j} from row i unless row j lists i too and
     //    j < i. Built in parallel blocks and concatenated in order (deterministic).
@@ -299,7 +305,7 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions, std::span<c
     // 2. Patches vote on their relative orientation over every graph edge between them, and a
     //    maximum spanning forest of the patch graph (by the size of the vote) decides each
     //    patch's flip: many agreeing edges outweigh the single edge a tree happened to use.
-    const std::size_t columns = options.k == 0 ? neighbors.k : std::min(options.k, neighbors.k);
+    const std::size_t columns = graph_columns(options, neighbors);
     struct Vote
     {
         std::uint32_t a;
