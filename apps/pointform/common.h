@@ -78,5 +78,8 @@ void print_row(const std::string& label, const std::string& value);
 void register_info(CLI::App& app, const GlobalOptions& global);
 void register_normals(CLI::App& app, const GlobalOptions& global);
 void register_sample(CLI::App& app, const GlobalOptions& global);
+void register_mc(CLI::App& app, const GlobalOptions& global);
+void register_render(CLI::App& app, const GlobalOptions& global);
+void register_distance(CLI::App& app, const GlobalOptions& global);
 
 } // namespace pointform::cli

@@ -38,6 +38,9 @@ int run(int argc, char** argv)
     pointform::cli::register_info(app, global);
     pointform::cli::register_normals(app, global);
     pointform::cli::register_sample(app, global);
+    pointform::cli::register_mc(app, global);
+    pointform::cli::register_render(app, global);
+    pointform::cli::register_distance(app, global);
 
     try
     {

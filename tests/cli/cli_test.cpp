@@ -50,7 +50,7 @@ std::string quoted(const std::filesystem::path& path)
 
 TEST(Cli, HelpOnEverySubcommand)
 {
-    for (const std::string sub : {"", "info", "normals", "sample"})
+    for (const std::string sub : {"", "info", "normals", "sample", "mc", "distance", "render"})
     {
         const RunResult r = run(sub + " --help");
         EXPECT_EQ(r.exit_code, 0) << sub;

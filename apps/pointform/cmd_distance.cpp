@@ -1,0 +1,187 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+#include "pointform/io/io.h"
+#include "pointform/metrics/hausdorff.h"
+#include "pointform/metrics/surface_sampling.h"
+
+#include "common.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+namespace pointform::cli {
+namespace {
+
+struct DistanceCommandOptions
+{
+    std::string a;
+    std::string b;
+    std::size_t samples = 100000;
+    std::uint64_t seed = 1;
+    bool json = false;
+};
+
+/// Reads a shape: a mesh if the file has faces, else a point set (a mesh file without faces is
+/// a point set too).
+TriMesh read_shape(const std::string& path)
+{
+    ReadResult read = read_geometry(path);
+    if (read.points.empty())
+        throw InvalidInput(path + ": the file has no points");
+    TriMesh shape;
+    shape.vertices = std::move(read.points);
+    shape.triangles = std::move(read.triangles);
+    if (shape.face_count() > 0 && !(surface_area(shape) > 0.0))
+        throw InvalidInput(path + ": every triangle of the mesh has zero area");
+    return shape;
+}
+
+std::size_t sample_count(const TriMesh& shape, std::size_t samples)
+{
+    if (shape.face_count() == 0)
+        return shape.vertex_count();
+    std::vector<bool> used(shape.vertex_count(), false);
+    for (const auto& t : shape.triangles)
+        for (const auto v : t)
+            used[v] = true;
+    std::size_t count = samples;
+    for (const bool u : used)
+        count += u ? 1 : 0;
+    return count;
+}
+
+nlohmann::json stats_json(const DistanceStats& s)
+{
+    return {{"count", s.count}, {"min", s.min}, {"max", s.max}, {"mean", s.mean},
+            {"rms", s.rms},     {"p50", s.p50}, {"p90", s.p90}, {"p99", s.p99}};
+}
+
+nlohmann::json summary_json(const DistanceSummary& s)
+{
+    return {{"a_to_b", stats_json(s.a_to_b)},
+            {"b_to_a", stats_json(s.b_to_a)},
+            {"symmetric", stats_json(s.symmetric)},
+            {"hausdorff", s.hausdorff},
+            {"chamfer", s.chamfer}};
+}
+
+nlohmann::json shape_json(const std::string& file, const TriMesh& shape, std::size_t samples)
+{
+    return {{"file", file},
+            {"kind", shape.face_count() > 0 ? "mesh" : "points"},
+            {"points", shape.vertex_count()},
+            {"faces", shape.face_count()},
+            {"samples", sample_count(shape, samples)}};
+}
+
+void print_table(const char* title, const DistanceSummary& s)
+{
+    std::printf("  %s\n", title);
+    std::printf("    %-16s %14s %14s %14s\n", "", "A -> B", "B -> A", "symmetric");
+    const auto row = [](const char* label, double x, double y, double z) {
+        std::printf("    %-16s %14s %14s %14s\n", label, format_number(x).c_str(),
+                    format_number(y).c_str(), format_number(z).c_str());
+    };
+    row("max (Hausdorff)", s.a_to_b.max, s.b_to_a.max, s.symmetric.max);
+    row("mean", s.a_to_b.mean, s.b_to_a.mean, s.symmetric.mean);
+    row("rms", s.a_to_b.rms, s.b_to_a.rms, s.symmetric.rms);
+    row("p50", s.a_to_b.p50, s.b_to_a.p50, s.symmetric.p50);
+    row("p90", s.a_to_b.p90, s.b_to_a.p90, s.symmetric.p90);
+    row("p99", s.a_to_b.p99, s.b_to_a.p99, s.symmetric.p99);
+    std::printf("    %-16s %14s\n", "chamfer", format_number(s.chamfer).c_str());
+}
+
+std::string shape_text(const TriMesh& shape, std::size_t samples)
+{
+    if (shape.face_count() == 0)
+        return "point set, " + std::to_string(shape.vertex_count()) + " points";
+    return "mesh, " + std::to_string(shape.vertex_count()) + " vertices, " +
+           std::to_string(shape.face_count()) + " faces, " +
+           std::to_string(sample_count(shape, samples)) + " samples";
+}
+
+void run_distance(const DistanceCommandOptions& options, const GlobalOptions& global)
+{
+    set_thread_count(global.threads);
+    TerminalProgress progress(!global.quiet && !options.json);
+    Timings timings;
+    const TriMesh a = read_shape(options.a);
+    const TriMesh b = read_shape(options.b);
+    timings.lap("read");
+    const DistanceComparison result = compare(a, b,
+                                              {.samples = options.samples,
+                                               .seed = options.seed,
+                                               .include_vertices = true,
+                                               .progress = progress.callback()});
+    timings.lap("measure");
+    progress.clear();
+
+    if (options.json)
+    {
+        nlohmann::json out;
+        out["a"] = shape_json(options.a, a, options.samples);
+        out["b"] = shape_json(options.b, b, options.samples);
+        out["samples_per_mesh"] = options.samples;
+        out["seed"] = options.seed;
+        out["diagonal"] = result.diagonal;
+        out["absolute"] = summary_json(result.absolute);
+        out["relative_to_diagonal"] = summary_json(result.relative);
+        nlohmann::json stages = nlohmann::json::object();
+        for (const auto& [stage, seconds] : timings.stages())
+            stages[stage] = seconds;
+        stages["total"] = timings.total();
+        out["timings_s"] = stages;
+        out["threads"] = thread_count();
+        std::printf("%s\n", out.dump(2).c_str());
+        return;
+    }
+    if (global.quiet)
+        return;
+    std::printf("A: %s (%s)\n", options.a.c_str(), shape_text(a, options.samples).c_str());
+    std::printf("B: %s (%s)\n", options.b.c_str(), shape_text(b, options.samples).c_str());
+    print_row("bounding box diagonal", format_number(result.diagonal) + " (of A and B together)");
+    print_row("Hausdorff", format_number(result.absolute.hausdorff) + " (" +
+                               format_number(result.relative.hausdorff) + " of the diagonal)");
+    print_row("Chamfer", format_number(result.absolute.chamfer) + " (" +
+                             format_number(result.relative.chamfer) + " of the diagonal)");
+    print_table("absolute (input units)", result.absolute);
+    print_table("relative to the bounding box diagonal", result.relative);
+    std::string times;
+    for (const auto& [stage, seconds] : timings.stages())
+        times += (times.empty() ? "" : ", ") + stage + " " + format_number(seconds);
+    print_row("seconds", times + " (total " + format_number(timings.total()) + ")");
+}
+
+} // namespace
+
+void register_distance(CLI::App& app, const GlobalOptions& global)
+{
+    auto options = std::make_shared<DistanceCommandOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "distance",
+        "Measure two shapes against each other as MeshLab's Metro does: one-sided and symmetric "
+        "Hausdorff (max), mean, RMS, Chamfer (mean A->B + mean B->A) and the 50/90/99th "
+        "percentiles, absolute and relative to the diagonal of the bounding box of both");
+    cmd->add_option("a", options->a,
+                    "Shape A: a mesh (a file with faces: sampled area-uniformly, plus its "
+                    "vertices, and measured against exactly, point to triangle) or a point set "
+                    "(a file without faces, used as it is; measured against by nearest point)")
+        ->required();
+    cmd->add_option("b", options->b, "Shape B, as A")->required();
+    cmd->add_option("--samples", options->samples,
+                    "Random area-uniform samples on each mesh, besides its vertices")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--seed", options->seed, "Seed of the sampling")->capture_default_str();
+    cmd->add_flag("--json", options->json, "Print the statistics as JSON");
+    cmd->callback([options, &global] { run_distance(*options, global); });
+}
+
+} // namespace pointform::cli

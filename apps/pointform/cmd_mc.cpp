@@ -1,0 +1,172 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+#include "pointform/geometry/mesh_topology.h"
+#include "pointform/implicit/point_field.h"
+#include "pointform/io/io.h"
+#include "pointform/metrics/hausdorff.h"
+#include "pointform/polygonize/marching_cubes.h"
+
+#include "common.h"
+#include "surfel_input.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <memory>
+
+namespace pointform::cli {
+namespace {
+
+struct McCommandOptions
+{
+    std::string input;
+    std::string output;
+    int resolution = 0;
+    double cell = 0.0;
+    std::string fit = "blend";
+    SurfelInputOptions surfels;
+    bool ascii = false;
+    bool json = false;
+};
+
+void run_mc(const McCommandOptions& options, const GlobalOptions& global)
+{
+    set_thread_count(global.threads);
+    TerminalProgress progress(!global.quiet && !options.json);
+    Timings timings;
+    SurfelInput input = load_surfels(options.input, options.surfels, progress.callback());
+    timings.lap(input.estimated_normals ? "read + surfels" : "read");
+
+    const PointField field(input.surfels, {.fit = parse_plane_fit(options.fit)});
+    timings.lap("field");
+    const Aabb box = field.bounds();
+    double cell = options.cell;
+    if (options.resolution > 0)
+    {
+        cell = cell_for_resolution(input.surfels.bounds(), options.resolution);
+    }
+    else if (cell <= 0.0)
+    {
+        cell = default_cell_size(field);
+    }
+    MarchingCubesResult result =
+        marching_cubes(field, grid_over(box, cell), {.progress = progress.callback()});
+    timings.lap("marching cubes");
+    if (result.mesh.face_count() == 0)
+    {
+        throw Error(
+            "marching cubes made no triangles: the field has no defined zero crossing "
+            "at this cell size (try a smaller --cell or a larger --radius-scale)");
+    }
+    write_mesh(options.output, result.mesh, {.ascii = options.ascii});
+    timings.lap("write");
+
+    const MeshTopology topo = analyze_topology(result.mesh);
+    const DistanceStats distance =
+        summarize_distances(distances_to_mesh(input.surfels, result.mesh));
+    timings.lap("distance");
+    progress.clear();
+    const double diagonal = input.surfels.bounds().diagonal();
+
+    if (options.json)
+    {
+        nlohmann::json out;
+        out["input"] = options.input;
+        out["output"] = options.output;
+        out["samples"] = input.surfels.size();
+        out["estimated_normals"] = input.estimated_normals;
+        out["fit"] = options.fit;
+        out["cell"] = cell;
+        out["vertices"] = result.mesh.vertex_count();
+        out["faces"] = result.mesh.face_count();
+        out["components"] = topo.components;
+        out["boundary_loops"] = topo.boundary_loops;
+        out["euler_characteristic"] = topo.euler_characteristic;
+        out["manifold"] = topo.is_oriented_manifold();
+        out["cells_visited"] = result.stats.cells_visited;
+        out["surface_cells"] = result.stats.surface_cells;
+        out["undefined_cells"] = result.stats.undefined_cells;
+        out["field_evaluations"] = result.stats.field_evaluations;
+        out["hausdorff_samples_to_mesh"] = distance.max;
+        out["mean_samples_to_mesh"] = distance.mean;
+        out["rms_samples_to_mesh"] = distance.rms;
+        out["hausdorff_relative"] = diagonal > 0.0 ? distance.max / diagonal : 0.0;
+        nlohmann::json stages = nlohmann::json::object();
+        for (const auto& [stage, seconds] : timings.stages())
+        {
+            stages[stage] = seconds;
+        }
+        stages["total"] = timings.total();
+        out["timings_s"] = stages;
+        out["threads"] = thread_count();
+        out["peak_rss_bytes"] = peak_rss_bytes();
+        std::printf("%s\n", out.dump(2).c_str());
+        return;
+    }
+    if (global.quiet)
+    {
+        return;
+    }
+    std::printf("%s -> %s\n", options.input.c_str(), options.output.c_str());
+    print_row("samples", std::to_string(input.surfels.size()) +
+                             (input.estimated_normals ? " (normals estimated)" : " (surfels)"));
+    print_row("cell", format_number(cell) + " (" + options.fit + " planes)");
+    print_row("vertices", std::to_string(result.mesh.vertex_count()));
+    print_row("faces", std::to_string(result.mesh.face_count()));
+    print_row("components", std::to_string(topo.components));
+    print_row("boundary loops", std::to_string(topo.boundary_loops));
+    print_row("Euler characteristic", std::to_string(topo.euler_characteristic));
+    print_row("Hausdorff samples->mesh",
+              format_number(distance.max) + " (" + format_number(100.0 * distance.max / diagonal) +
+                  "% of the diagonal; mean " + format_number(distance.mean) + ")");
+    std::string times;
+    for (const auto& [stage, seconds] : timings.stages())
+    {
+        times += (times.empty() ? "" : ", ") + stage + " " + format_number(seconds);
+    }
+    print_row("seconds", times + " (total " + format_number(timings.total()) + ")");
+    if (input.unoriented > 0)
+    {
+        std::fprintf(stderr, "pointform: warning: %zu samples without a normal were left out\n",
+                     input.unoriented);
+    }
+}
+
+} // namespace
+
+void register_mc(CLI::App& app, const GlobalOptions& global)
+{
+    auto options = std::make_shared<McCommandOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "mc",
+        "Level 2 -> mesh: marching cubes on the point field over the cells near the samples "
+        "(paper §4, Fig. 4); prints counts, boundary loops and the Hausdorff distance from the "
+        "samples to the mesh");
+    cmd->add_option("input", options->input,
+                    "Raw points (normals are estimated and oriented) or surfels (a file with "
+                    "normals, and radius if present)")
+        ->required();
+    cmd->add_option("-o,--output", options->output, "Output mesh (.ply, .obj or .off)")->required();
+    auto* resolution = cmd->add_option("--resolution", options->resolution,
+                                       "Cells along the longest side of the bounding box")
+                           ->check(CLI::Range(2, 100000));
+    cmd->add_option("--cell", options->cell,
+                    "Cell size in the input's units (default: from the sampling density: "
+                    "0.4 of the median influence radius)")
+        ->check(CLI::PositiveNumber)
+        ->excludes(resolution);
+    cmd->add_option("--fit", options->fit,
+                    "Tangent planes of the field: blend (smooth blend of nearby centroid planes, "
+                    "most accurate on noisy scans), centroid (Hoppe) or raw (the paper's)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"blend", "centroid", "raw"}));
+    add_surfel_input_options(*cmd, options->surfels);
+    cmd->add_flag("--ascii", options->ascii, "Write ascii PLY instead of binary");
+    cmd->add_flag("--json", options->json, "Print the report as JSON");
+    cmd->callback([options, &global] { run_mc(*options, global); });
+}
+
+} // namespace pointform::cli

@@ -1,0 +1,163 @@
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 the pointform authors
+"""Side-by-side benchmark of surfaces from oriented samples: pointform mc against Open3D's
+Poisson (several depths) and ball pivoting, on the same surfels, in one run.
+
+For every input (an analytic shape sampled by `pointform sample`, clean or with noise and
+holes) it makes surfels once with `pointform normals`, gives the same surfels to every tool,
+and reports per tool: reconstruction time, peak memory (/usr/bin/time), vertex count, and the
+accuracy against the true analytic surface: symmetric Hausdorff, Chamfer (mean both ways) and
+F-score at 0.5% and 1% of the diagonal. Distances from the mesh to the truth are exact
+(analytic); from the truth to the mesh they are exact point-to-triangle distances by Open3D's
+RaycastingScene, cross-checked against `pointform distance` on the same points. "Spurious"
+is the share of the mesh's area farther than 1% of the diagonal from every input sample:
+surface where there are no samples.
+
+Run with /usr/bin/python3 (Debian's python3-open3d):
+  /usr/bin/python3 bench/peers/run_surface_bench.py --pointform build/release/apps/pointform/pointform
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import open3d as o3d
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from plyio import read_ply  # noqa: E402
+from run_normals_bench import run_measured  # noqa: E402
+
+HERE = Path(__file__).resolve().parent
+VARIANTS = {"clean": [], "noisy+holes": ["--noise", "0.002", "--holes", "8", "--hole-radius", "0.04"]}
+
+
+def true_distance(shape: str, p: np.ndarray) -> np.ndarray:
+    """Unsigned distance to the analytic surface `pointform sample` draws from."""
+    if shape == "sphere":
+        return np.abs(np.linalg.norm(p, axis=1) - 1.0)
+    if shape == "torus":
+        rho = np.hypot(p[:, 0], p[:, 1])
+        return np.abs(np.hypot(rho - 1.0, p[:, 2]) - 0.35)
+    raise ValueError(shape)
+
+
+def load_points(path: Path) -> np.ndarray:
+    v = read_ply(str(path))
+    return np.stack([v["x"], v["y"], v["z"]], 1).astype(np.float64)
+
+
+def evaluate(shape, mesh_path: Path, truth: np.ndarray, samples: np.ndarray, diag: float,
+             pointform: str, work: Path) -> dict:
+    mesh = o3d.io.read_triangle_mesh(str(mesh_path))
+    if len(mesh.triangles) == 0:
+        return {}
+    area = mesh.get_surface_area()
+    surface = np.asarray(mesh.sample_points_uniformly(200000).points)
+    mesh_to_truth = true_distance(shape, surface)
+    scene = o3d.t.geometry.RaycastingScene()
+    scene.add_triangles(o3d.t.geometry.TriangleMesh.from_legacy(mesh))
+    truth_to_mesh = scene.compute_distance(o3d.core.Tensor(truth.astype(np.float32))).numpy()
+    # Cross-check: pointform distance from the same truth points to the same mesh.
+    pf = run_measured([pointform, "distance", work / "truth.ply", mesh_path, "--json"],
+                      os.environ.copy(), 600, work / "distance")
+    pf_report = pf[3] or {}
+    pf_max = pf_report.get("absolute", {}).get("a_to_b", {}).get("max")
+    tree = o3d.geometry.KDTreeFlann(o3d.geometry.PointCloud(o3d.utility.Vector3dVector(samples)))
+    spurious = 0
+    for p in surface[::20]:
+        _, _, d2 = tree.search_knn_vector_3d(p, 1)
+        spurious += d2[0] > (0.01 * diag) ** 2
+    out = {
+        "hausdorff": max(mesh_to_truth.max(), truth_to_mesh.max()) / diag,
+        "chamfer": (mesh_to_truth.mean() + truth_to_mesh.mean()) / diag,
+        "area": area,
+        "spurious": spurious / len(surface[::20]),
+        "o3d_truth_to_mesh_max": float(truth_to_mesh.max()),
+        "pf_truth_to_mesh_max": pf_max,
+        "pf_distance_s": pf[1],
+    }
+    for tau in (0.005, 0.01):
+        precision = np.mean(mesh_to_truth < tau * diag)
+        recall = np.mean(truth_to_mesh < tau * diag)
+        out[f"f{tau}"] = 2 * precision * recall / max(precision + recall, 1e-12)
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--pointform", default="build/release/apps/pointform/pointform")
+    ap.add_argument("--shapes", default="sphere,torus")
+    ap.add_argument("--variants", default="clean,noisy+holes")
+    ap.add_argument("--size", type=int, default=100000)
+    ap.add_argument("--depths", default="8,9,10")
+    ap.add_argument("--bpa", action="store_true", help="also ball pivoting (slow)")
+    ap.add_argument("--mc-args", default="", help="extra arguments for pointform mc")
+    ap.add_argument("--timeout", type=float, default=900)
+    args = ap.parse_args(argv)
+    env = os.environ.copy()
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="pf-surface-") as tmp:
+        work = Path(tmp)
+        for shape in args.shapes.split(","):
+            # The truth: exact samples of the analytic surface.
+            truth_path = work / "truth.ply"
+            run_measured([args.pointform, "sample", shape, "-n", "200000", "--seed", "99", "-o",
+                          truth_path], env, 600, work / "truth")
+            truth = load_points(truth_path)
+            for variant in args.variants.split(","):
+                raw = work / "raw.ply"
+                surfels = work / "surfels.ply"
+                run_measured([args.pointform, "sample", shape, "-n", str(args.size), "-o", raw,
+                              *VARIANTS[variant]], env, 600, work / "sample")
+                status, wall, _, rep = run_measured(
+                    [args.pointform, "normals", raw, "-o", surfels, "--radius-scale", "1.5",
+                     "--json"], env, 600, work / "normals")
+                samples = load_points(surfels)
+                diag = float(np.linalg.norm(samples.max(0) - samples.min(0)))
+                tools = [("pointform mc", [args.pointform, "mc", surfels, "-o", work / "mc.ply",
+                                           "--json", *args.mc_args.split()], work / "mc.ply")]
+                for d in args.depths.split(","):
+                    tools.append((f"Open3D Poisson {d}",
+                                  ["/usr/bin/python3", HERE / "open3d_surface.py", surfels,
+                                   work / f"poisson{d}.ply", "poisson", d], work / f"poisson{d}.ply"))
+                if args.bpa:
+                    tools.append(("Open3D ball pivoting",
+                                  ["/usr/bin/python3", HERE / "open3d_surface.py", surfels,
+                                   work / "bpa.ply", "bpa"], work / "bpa.ply"))
+                for name, cmd, out in tools:
+                    status, wall, peak, report = run_measured(cmd, env, args.timeout, work / "tool")
+                    row = {"shape": shape, "variant": variant, "size": args.size, "tool": name,
+                           "status": status, "wall_s": wall, "peak_mib": peak}
+                    if report:
+                        t = report.get("timings_s", {})
+                        row["surface_s"] = (t.get("marching cubes", 0) + t.get("field", 0)) \
+                            if "marching cubes" in t else t.get("surface")
+                        row["vertices"] = report.get("vertices")
+                        row.update(evaluate(shape, out, truth, samples, diag, args.pointform, work))
+                    rows.append(row)
+                    print(json.dumps(row), flush=True)
+    print()
+    header = ["shape", "variant", "tool", "surface s", "peak MiB", "vertices", "Hausdorff %diag",
+              "Chamfer %diag", "F@0.5%", "F@1%", "spurious area", "pf/o3d max dist"]
+    print("| " + " | ".join(header) + " |")
+    print("|" + "---|" * len(header))
+    for r in rows:
+        if "chamfer" not in r:
+            print(f"| {r['shape']} | {r['variant']} | {r['tool']} | {r['status']} |" + " |" * 8)
+            continue
+        check = (r["pf_truth_to_mesh_max"] or float("nan")) / max(r["o3d_truth_to_mesh_max"], 1e-300)
+        print(f"| {r['shape']} | {r['variant']} | {r['tool']} | {r['surface_s']:.2f} | "
+              f"{r['peak_mib']:.0f} | {r['vertices']} | {100 * r['hausdorff']:.3f} | "
+              f"{100 * r['chamfer']:.4f} | {r['f0.005']:.4f} | {r['f0.01']:.4f} | "
+              f"{100 * r['spurious']:.2f}% | {check:.6f} |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,120 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#pragma once
+
+#include "pointform/core/progress.h"
+#include "pointform/geometry/point_cloud.h"
+#include "pointform/geometry/tri_mesh.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace pointform {
+
+/// \brief Options for the distance functions.
+struct DistanceOptions
+{
+    /// Optional progress report, called from one thread.
+    ProgressCallback progress;
+};
+
+/// \brief Exact distance from every point to a triangle mesh (closest point on a triangle, found
+/// through a TriangleBvh), in parallel, in world units. Same result whatever the thread count.
+/// \cite §5.2.4: the one-sided Hausdorff distance from the samples S to a mesh is the max.
+/// \param points  N points (world = origin + position)
+/// \param mesh    F >= 1 triangles; degenerate triangles count as their edges or point
+/// \return N distances, in the order of the points
+/// \throw InvalidInput if the mesh has no triangles, an index is out of range, or a coordinate is
+///        not finite
+[[nodiscard]] std::vector<double> distances_to_mesh(const PointCloud& points, const TriMesh& mesh,
+                                                    const DistanceOptions& options = {});
+
+/// \brief Distance from every point to the nearest point of `targets` (kd-tree), in parallel.
+///
+/// The nearest target is searched in float precision relative to the targets' origin; the
+/// distance to it is then computed exactly in double, in world units.
+/// \return points.size() distances, in the order of the points
+/// \throw InvalidInput if targets is empty or a coordinate is not finite
+[[nodiscard]] std::vector<double> distances_to_points(const PointCloud& points,
+                                                      const PointCloud& targets,
+                                                      const DistanceOptions& options = {});
+
+/// \brief Summary of a set of distances (all in the same unit).
+///
+/// Percentiles interpolate linearly between the two nearest order statistics (the default of
+/// NumPy and R's type 7): p50 of {0, 1} is 0.5; p99 of N values is the value of rank 0.99 (N - 1).
+struct DistanceStats
+{
+    std::size_t count = 0;
+    double min = 0.0;
+    double max = 0.0; ///< one-sided Hausdorff distance when the distances are point-to-set
+    double mean = 0.0;
+    double rms = 0.0; ///< √(mean of squares)
+    double p50 = 0.0; ///< median
+    double p90 = 0.0;
+    double p99 = 0.0;
+};
+
+/// \brief Summarises distances; the order of the input does not matter.
+/// \throw InvalidInput if `distances` is empty or holds a negative or non-finite value
+[[nodiscard]] DistanceStats summarize_distances(std::span<const double> distances);
+
+/// \brief Every statistic multiplied by `factor` (count unchanged): e.g. 1 / diagonal.
+[[nodiscard]] DistanceStats scaled(const DistanceStats& stats, double factor);
+
+/// \brief Options for compare.
+struct CompareOptions
+{
+    /// Random area-uniform samples drawn on each input that is a mesh (B's generator is seeded
+    /// from `seed` too, differently from A's). Point sets are used as they are. 0 = vertices only
+    /// (then include_vertices must be set).
+    std::size_t samples = 100000;
+    /// Seed of the sampling; the same inputs, samples and seed give the same result.
+    std::uint64_t seed = 1;
+    /// Add a mesh's vertices to its samples, as Metro does (corners are then measured exactly).
+    bool include_vertices = true;
+    /// Optional progress report, called from one thread.
+    ProgressCallback progress;
+};
+
+/// \brief One direction, the other, and both together, all in one unit.
+struct DistanceSummary
+{
+    DistanceStats a_to_b; ///< distances from the samples of A to B
+    DistanceStats b_to_a; ///< distances from the samples of B to A
+    /// Both distance sets pooled (a_to_b.count + b_to_a.count values): its max is the symmetric
+    /// Hausdorff distance; its mean weighs each direction by its sample count.
+    DistanceStats symmetric;
+    double hausdorff = 0.0; ///< symmetric Hausdorff distance: max(a_to_b.max, b_to_a.max)
+    /// Chamfer distance, defined here as mean(A→B) + mean(B→A) (unsquared distances; some
+    /// authors halve it or use squared distances, which we do not).
+    double chamfer = 0.0;
+};
+
+/// \brief Result of compare: the statistics in world units and relative to the diagonal.
+struct DistanceComparison
+{
+    DistanceSummary absolute; ///< world units
+    DistanceSummary relative; ///< absolute / diagonal (all zero when the diagonal is zero)
+    /// Diagonal of the bounding box of A and B together (all points of both inputs, vertices
+    /// for meshes), like the bounding box MeshLab's Metro uses for its "wrt bounding box
+    /// diagonal" figures.
+    double diagonal = 0.0;
+};
+
+/// \brief Compares two shapes the way MeshLab's Metro does: samples both, measures each set of
+/// samples against the other shape, and reports one-sided and symmetric statistics.
+///
+/// A shape is given as a TriMesh: with triangles it is a surface, sampled area-uniformly
+/// (options.samples random points plus, if include_vertices, its vertices) and measured against
+/// exactly (point-to-triangle, through a TriangleBvh); without triangles it is a point set,
+/// used as its own samples and measured against by nearest point (kd-tree).
+/// \throw InvalidInput if a shape has no points, a mesh has zero area or a bad index, a
+///        coordinate is not finite, or a mesh would get no samples
+[[nodiscard]] DistanceComparison compare(const TriMesh& a, const TriMesh& b,
+                                         const CompareOptions& options = {});
+
+} // namespace pointform

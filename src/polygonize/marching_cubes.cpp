@@ -1,0 +1,805 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/polygonize/marching_cubes.h"
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+#include "pointform/geometry/mesh_topology.h"
+#include "pointform/implicit/point_field.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace pointform {
+
+namespace {
+
+// Grid coordinates are packed 20 bits per axis; an edge key adds 2 bits for its axis.
+constexpr int coord_bits = 20;
+constexpr std::int64_t max_cells = (std::int64_t{1} << coord_bits) - 2;
+constexpr std::uint64_t coord_mask = (std::uint64_t{1} << coord_bits) - 1;
+
+using Coord = std::array<std::int64_t, 3>;
+
+std::uint64_t pack(const Coord& c)
+{
+    return static_cast<std::uint64_t>(c[0]) | (static_cast<std::uint64_t>(c[1]) << coord_bits) |
+           (static_cast<std::uint64_t>(c[2]) << (2 * coord_bits));
+}
+
+Coord unpack(std::uint64_t key)
+{
+    return {static_cast<std::int64_t>(key & coord_mask),
+            static_cast<std::int64_t>((key >> coord_bits) & coord_mask),
+            static_cast<std::int64_t>((key >> (2 * coord_bits)) & coord_mask)};
+}
+
+// ---------------------------------------------------------------------------------------------
+// The unit cube. Corner c has offset (c & 1, (c >> 1) & 1, (c >> 2) & 1). Edge e joins corner
+// edge_base[e] to edge_base[e] + e_axis. Face f lists its corners counter-clockwise as seen from
+// outside the cube, and face_edge[f][i] joins face corner i to face corner i + 1.
+
+struct CubeTables
+{
+    std::array<int, 12> edge_base{};
+    std::array<int, 12> edge_axis{};
+    std::array<std::array<int, 8>, 8> edge_between{};
+    std::array<std::array<int, 4>, 6> face_corner{};
+    std::array<std::array<int, 4>, 6> face_edge{};
+    std::array<int, 6> face_axis{};
+    std::array<int, 6> face_side{};
+    /// The two faces (axis · 2 + side) that contain edge e.
+    std::array<std::array<int, 2>, 12> edge_face{};
+
+    CubeTables()
+    {
+        int e = 0;
+        for (auto& row : edge_between)
+        {
+            row.fill(-1);
+        }
+        for (int axis = 0; axis < 3; ++axis)
+        {
+            for (int c = 0; c < 8; ++c)
+            {
+                if ((c >> axis & 1) == 0)
+                {
+                    const int d = c | (1 << axis);
+                    edge_base[static_cast<std::size_t>(e)] = c;
+                    edge_axis[static_cast<std::size_t>(e)] = axis;
+                    edge_between[static_cast<std::size_t>(c)][static_cast<std::size_t>(d)] = e;
+                    const int b = (axis + 1) % 3;
+                    const int c2 = (axis + 2) % 3;
+                    edge_face[static_cast<std::size_t>(e)] = {2 * b + (c >> b & 1),
+                                                              2 * c2 + (c >> c2 & 1)};
+                    edge_between[static_cast<std::size_t>(d)][static_cast<std::size_t>(c)] = e;
+                    ++e;
+                }
+            }
+        }
+        int f = 0;
+        for (int axis = 0; axis < 3; ++axis)
+        {
+            const int b = (axis + 1) % 3;
+            const int c = (axis + 2) % 3;
+            for (int side = 0; side < 2; ++side)
+            {
+                // (b, c) = (0,0), (1,0), (1,1), (0,1) turns counter-clockwise about e_b × e_c =
+                // e_a, i.e. as seen from outside the face on the side = 1 face; reversed on side =
+                // 0.
+                constexpr std::array<std::array<int, 2>, 4> square = {
+                    {{0, 0}, {1, 0}, {1, 1}, {0, 1}}};
+                auto& corners = face_corner[static_cast<std::size_t>(f)];
+                for (std::size_t i = 0; i < 4; ++i)
+                {
+                    const auto& uv = side == 1 ? square[i] : square[3 - i];
+                    corners[i] = (side << axis) | (uv[0] << b) | (uv[1] << c);
+                }
+                for (std::size_t i = 0; i < 4; ++i)
+                {
+                    face_edge[static_cast<std::size_t>(f)][i] =
+                        edge_between[static_cast<std::size_t>(corners[i])]
+                                    [static_cast<std::size_t>(corners[(i + 1) % 4])];
+                }
+                face_axis[static_cast<std::size_t>(f)] = axis;
+                face_side[static_cast<std::size_t>(f)] = side;
+                ++f;
+            }
+        }
+    }
+};
+
+const CubeTables& cube()
+{
+    static const CubeTables tables;
+    return tables;
+}
+
+Coord corner_of(const Coord& cell, int c)
+{
+    return {cell[0] + (c & 1), cell[1] + (c >> 1 & 1), cell[2] + (c >> 2 & 1)};
+}
+
+std::uint64_t edge_key(const Coord& base, int axis)
+{
+    return pack(base) << 2 | static_cast<std::uint64_t>(axis);
+}
+
+/// Appends the triangles of one cell, as global edge keys, counter-clockwise seen from f > 0.
+/// `value` are the eight corner values (all defined). The zero set draws segments on the six
+/// faces, each directed with the inside on its right as seen from outside the cube; a face with
+/// two diagonal inside corners is split by the asymptotic decider. Every crossed edge starts one
+/// segment and ends another, so the segments close into loops, which are fanned into triangles.
+void triangulate_cell(const Coord& cell, const std::array<float, 8>& value,
+                      std::vector<std::uint64_t>& out)
+{
+    const CubeTables& t = cube();
+    std::array<int, 12> next{};
+    next.fill(-1);
+    auto inside = [&](int c) {
+        return value[static_cast<std::size_t>(c)] < 0.0F;
+    };
+    for (std::size_t f = 0; f < 6; ++f)
+    {
+        const auto& q = t.face_corner[f];
+        const auto& fe = t.face_edge[f];
+        std::array<bool, 4> in{};
+        int inside_count = 0;
+        for (std::size_t i = 0; i < 4; ++i)
+        {
+            in[i] = inside(q[i]);
+            inside_count += in[i] ? 1 : 0;
+        }
+        if (inside_count == 0 || inside_count == 4)
+        {
+            continue;
+        }
+        if (inside_count == 2 && in[0] == in[2])
+        {
+            // Ambiguous face: the bilinear interpolant's saddle decides whether the two inside
+            // corners are joined (saddle inside) or cut off separately.
+            const double v0 = value[static_cast<std::size_t>(q[0])];
+            const double v1 = value[static_cast<std::size_t>(q[1])];
+            const double v2 = value[static_cast<std::size_t>(q[2])];
+            const double v3 = value[static_cast<std::size_t>(q[3])];
+            const double denominator = v0 + v2 - v1 - v3;
+            const double saddle = denominator != 0.0 ? (v0 * v2 - v1 * v3) / denominator : 0.0;
+            const bool cut_inside = saddle >= 0.0;
+            for (std::size_t i = 0; i < 4; ++i)
+            {
+                if (in[i] != cut_inside)
+                {
+                    continue;
+                }
+                const int before = fe[(i + 3) % 4];
+                const int after = fe[i];
+                // Inside corner: before → after; outside corner: after → before.
+                if (in[i])
+                {
+                    next[static_cast<std::size_t>(before)] = after;
+                }
+                else
+                {
+                    next[static_cast<std::size_t>(after)] = before;
+                }
+            }
+            continue;
+        }
+        // One segment: from the crossing entering the inside (walking counter-clockwise) to the
+        // crossing leaving it.
+        int enter = -1;
+        int leave = -1;
+        for (std::size_t i = 0; i < 4; ++i)
+        {
+            const bool a = in[i];
+            const bool b = in[(i + 1) % 4];
+            if (!a && b)
+            {
+                enter = fe[i];
+            }
+            else if (a && !b)
+            {
+                leave = fe[i];
+            }
+        }
+        next[static_cast<std::size_t>(enter)] = leave;
+    }
+
+    std::array<bool, 12> used{};
+    std::array<int, 12> loop{};
+    for (int start = 0; start < 12; ++start)
+    {
+        if (next[static_cast<std::size_t>(start)] < 0 || used[static_cast<std::size_t>(start)])
+        {
+            continue;
+        }
+        std::size_t n = 0;
+        for (int e = start; !used[static_cast<std::size_t>(e)];
+             e = next[static_cast<std::size_t>(e)])
+        {
+            used[static_cast<std::size_t>(e)] = true;
+            loop[n++] = e;
+        }
+        auto key = [&](int e) {
+            const auto ue = static_cast<std::size_t>(e);
+            return edge_key(corner_of(cell, t.edge_base[ue]), t.edge_axis[ue]);
+        };
+        // A chord between two vertices on one face of the cube (two crossings of an ambiguous
+        // face) could be drawn by the neighbouring cell too, giving an edge with four
+        // triangles; clip ears whose chord is not on a face.
+        auto shares_face = [&](int a, int b) {
+            const auto& fa = t.edge_face[static_cast<std::size_t>(a)];
+            const auto& fb = t.edge_face[static_cast<std::size_t>(b)];
+            return fa[0] == fb[0] || fa[0] == fb[1] || fa[1] == fb[0] || fa[1] == fb[1];
+        };
+        auto emit = [&](int a, int b, int c) {
+            out.push_back(key(a));
+            out.push_back(key(b));
+            out.push_back(key(c));
+        };
+        while (n > 3)
+        {
+            std::size_t ear = n;
+            for (std::size_t i = 0; i < n && ear == n; ++i)
+            {
+                if (!shares_face(loop[(i + n - 1) % n], loop[(i + 1) % n]))
+                {
+                    ear = i;
+                }
+            }
+            if (ear == n)
+            {
+                ear = 0; // no chord avoids the faces; never seen, but stay total
+            }
+            emit(loop[(ear + n - 1) % n], loop[ear], loop[(ear + 1) % n]);
+            std::copy(loop.begin() + static_cast<std::ptrdiff_t>(ear) + 1,
+                      loop.begin() + static_cast<std::ptrdiff_t>(n),
+                      loop.begin() + static_cast<std::ptrdiff_t>(ear));
+            --n;
+        }
+        if (n == 3)
+        {
+            emit(loop[0], loop[1], loop[2]);
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sparse storage of corner values and visited cells in blocks of 8³ grid points.
+
+constexpr int block_shift = 3;
+constexpr int block_side = 1 << block_shift;
+constexpr std::size_t block_volume = block_side * block_side * block_side;
+
+enum : std::uint8_t
+{
+    evaluated = 1,
+    defined = 2,
+    visited = 4,
+};
+
+struct Block
+{
+    std::array<float, block_volume> value{};
+    std::array<std::uint8_t, block_volume> state{};
+};
+
+class SparseGrid
+{
+public:
+    struct Slot
+    {
+        float* value = nullptr;
+        std::uint8_t* state = nullptr;
+    };
+
+    /// The slot of grid point c, creating its block (not thread-safe).
+    Slot get_or_create(const Coord& c)
+    {
+        const std::uint64_t key = block_key(c);
+        auto [it, inserted] = index_.try_emplace(key, static_cast<std::uint32_t>(blocks_.size()));
+        if (inserted)
+        {
+            blocks_.push_back(std::make_unique<Block>());
+        }
+        Block& b = *blocks_[it->second];
+        const std::size_t i = local(c);
+        return {&b.value[i], &b.state[i]};
+    }
+
+    /// The slot of grid point c, or null pointers if its block does not exist (thread-safe
+    /// while nobody creates blocks).
+    [[nodiscard]] Slot find(const Coord& c) const
+    {
+        const auto it = index_.find(block_key(c));
+        if (it == index_.end())
+        {
+            return {};
+        }
+        Block& b = *blocks_[it->second];
+        const std::size_t i = local(c);
+        return {&b.value[i], &b.state[i]};
+    }
+
+private:
+    static std::uint64_t block_key(const Coord& c)
+    {
+        return pack({c[0] >> block_shift, c[1] >> block_shift, c[2] >> block_shift});
+    }
+    static std::size_t local(const Coord& c)
+    {
+        constexpr std::int64_t m = block_side - 1;
+        return static_cast<std::size_t>((c[0] & m) | (c[1] & m) << block_shift |
+                                        (c[2] & m) << (2 * block_shift));
+    }
+
+    std::unordered_map<std::uint64_t, std::uint32_t> index_;
+    std::vector<std::unique_ptr<Block>> blocks_;
+};
+
+Vec3d grid_point(const CellGrid& grid, const Coord& c)
+{
+    return grid.origin + grid.cell * Vec3d(static_cast<double>(c[0]), static_cast<double>(c[1]),
+                                           static_cast<double>(c[2]));
+}
+
+bool in_grid(const CellGrid& grid, const Coord& c)
+{
+    for (std::size_t a = 0; a < 3; ++a)
+    {
+        if (c[a] < 0 || c[a] >= grid.cells[a])
+        {
+            return false;
+        }
+    }
+    return true;
+}
+
+void sort_unique(std::vector<std::uint64_t>& keys)
+{
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+}
+
+/// Runs `body(begin, end, out)` over fixed blocks of [0, n) in parallel and concatenates each
+/// block's output in block order, so the result does not depend on the thread count.
+template <typename T, typename Body>
+std::vector<T> parallel_collect(std::size_t n, std::size_t block, const Body& body)
+{
+    const std::size_t blocks = (n + block - 1) / block;
+    std::vector<std::vector<T>> parts(blocks);
+    parallel_blocks(blocks, 1, [&](std::size_t b0, std::size_t b1) {
+        for (std::size_t b = b0; b < b1; ++b)
+        {
+            body(b * block, std::min(n, (b + 1) * block), parts[b]);
+        }
+    });
+    std::size_t total = 0;
+    for (const auto& p : parts)
+    {
+        total += p.size();
+    }
+    std::vector<T> out;
+    out.reserve(total);
+    for (auto& p : parts)
+    {
+        out.insert(out.end(), p.begin(), p.end());
+    }
+    return out;
+}
+
+} // namespace
+
+CellGrid grid_over(const Aabb& box, double cell)
+{
+    if (box.is_empty() || !box.min.allFinite() || !box.max.allFinite())
+    {
+        throw InvalidInput("marching cubes: the region to polygonize is empty or not finite");
+    }
+    if (!(cell > 0.0) || !std::isfinite(cell))
+    {
+        throw InvalidInput("marching cubes: the cell size must be positive");
+    }
+    CellGrid grid;
+    grid.cell = cell;
+    grid.origin = box.min - Vec3d::Constant(cell);
+    for (std::size_t a = 0; a < 3; ++a)
+    {
+        const double extent =
+            (box.max[static_cast<Eigen::Index>(a)] - box.min[static_cast<Eigen::Index>(a)]) / cell;
+        if (extent > static_cast<double>(max_cells - 2))
+        {
+            throw InvalidInput("marching cubes: " + std::to_string(std::llround(extent)) +
+                               " cells along an axis is more than the grid supports (" +
+                               std::to_string(max_cells - 2) + "); use a larger cell size");
+        }
+        grid.cells[a] = static_cast<std::int64_t>(std::ceil(extent)) + 2;
+    }
+    return grid;
+}
+
+double cell_for_resolution(const Aabb& box, int resolution)
+{
+    if (resolution < 2)
+    {
+        throw InvalidInput("marching cubes: the resolution must be at least 2 cells");
+    }
+    if (box.is_empty() || !(box.size().maxCoeff() > 0.0))
+    {
+        throw InvalidInput("marching cubes: the region to polygonize is empty");
+    }
+    return box.size().maxCoeff() / resolution;
+}
+
+double default_cell_size(const PointField& field)
+{
+    return 0.4 * field.median_radius();
+}
+
+MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
+                                   const MarchingCubesOptions& options)
+{
+    if (!(grid.cell > 0.0) || grid.cells[0] < 1 || grid.cells[1] < 1 || grid.cells[2] < 1 ||
+        grid.cells[0] > max_cells || grid.cells[1] > max_cells || grid.cells[2] > max_cells)
+    {
+        throw InvalidInput("marching cubes: invalid grid");
+    }
+    MarchingCubesResult result;
+    MarchingCubesStats& stats = result.stats;
+    SparseGrid store;
+
+    // Seeds: the cells that contain the field's seeds; or, without seeds, every cell.
+    std::vector<std::uint64_t> frontier;
+    {
+        std::vector<Vec3d> seeds;
+        field.append_seeds(seeds);
+        if (!seeds.empty())
+        {
+            frontier.reserve(seeds.size());
+            for (const Vec3d& s : seeds)
+            {
+                const Vec3d g = (s - grid.origin) / grid.cell;
+                if (!g.allFinite())
+                {
+                    continue;
+                }
+                const Coord c = {static_cast<std::int64_t>(std::floor(g.x())),
+                                 static_cast<std::int64_t>(std::floor(g.y())),
+                                 static_cast<std::int64_t>(std::floor(g.z()))};
+                if (in_grid(grid, c))
+                {
+                    frontier.push_back(pack(c));
+                }
+            }
+        }
+        else
+        {
+            stats.dense = true;
+            const double total = static_cast<double>(grid.cells[0]) *
+                                 static_cast<double>(grid.cells[1]) *
+                                 static_cast<double>(grid.cells[2]);
+            if (total > static_cast<double>(std::int64_t{1} << 27))
+            {
+                throw InvalidInput(
+                    "marching cubes: the field gives no seed points and a dense "
+                    "sweep of " +
+                    std::to_string(std::llround(total)) +
+                    " cells is too large; use a coarser grid");
+            }
+            for (std::int64_t k = 0; k < grid.cells[2]; ++k)
+            {
+                for (std::int64_t j = 0; j < grid.cells[1]; ++j)
+                {
+                    for (std::int64_t i = 0; i < grid.cells[0]; ++i)
+                    {
+                        frontier.push_back(pack({i, j, k}));
+                    }
+                }
+            }
+        }
+        sort_unique(frontier);
+    }
+
+    ProgressReporter progress(options.progress, "marching cubes");
+    std::vector<std::uint64_t> surface_cells;
+    std::vector<Vec3d> points;
+    std::vector<FieldSample> samples;
+    const CubeTables& t = cube();
+
+    for (bool first_wave = true; !frontier.empty(); first_wave = false)
+    {
+        // Mark the wave visited and collect the corners it still needs.
+        std::vector<std::uint64_t> wave;
+        wave.reserve(frontier.size());
+        std::vector<std::uint64_t> needed;
+        for (const std::uint64_t key : frontier)
+        {
+            const Coord cell = unpack(key);
+            const SparseGrid::Slot slot = store.get_or_create(cell);
+            if ((*slot.state & visited) != 0)
+            {
+                continue;
+            }
+            *slot.state |= visited;
+            wave.push_back(key);
+            for (int c = 0; c < 8; ++c)
+            {
+                const Coord corner = corner_of(cell, c);
+                const SparseGrid::Slot s = store.find(corner);
+                if (s.state == nullptr || (*s.state & evaluated) == 0)
+                {
+                    needed.push_back(pack(corner));
+                }
+            }
+        }
+        sort_unique(needed);
+        points.resize(needed.size());
+        samples.resize(needed.size());
+        for (std::size_t i = 0; i < needed.size(); ++i)
+        {
+            points[i] = grid_point(grid, unpack(needed[i]));
+        }
+        field.evaluate(points, samples);
+        stats.field_evaluations += needed.size();
+        for (std::size_t i = 0; i < needed.size(); ++i)
+        {
+            const SparseGrid::Slot s = store.get_or_create(unpack(needed[i]));
+            *s.value = static_cast<float>(samples[i].value);
+            *s.state |= static_cast<std::uint8_t>(evaluated | (samples[i].defined ? defined : 0));
+        }
+        stats.cells_visited += wave.size();
+
+        // Classify the wave's cells; a surface cell passes the surface on to the neighbours
+        // across each face that the zero set crosses.
+        struct Outcome
+        {
+            std::uint64_t key;
+            bool surface;
+        };
+        std::size_t undefined_here = 0;
+        std::vector<std::size_t> undefined_per_block((wave.size() + 4095) / 4096, 0);
+        const std::vector<Outcome> outcomes = parallel_collect<Outcome>(
+            wave.size(), 4096, [&](std::size_t begin, std::size_t end, std::vector<Outcome>& out) {
+                std::size_t undefined_count = 0;
+                for (std::size_t w = begin; w < end; ++w)
+                {
+                    const Coord cell = unpack(wave[w]);
+                    int mask = 0;
+                    bool all_defined = true;
+                    for (int c = 0; c < 8; ++c)
+                    {
+                        const SparseGrid::Slot s = store.find(corner_of(cell, c));
+                        all_defined = all_defined && (*s.state & defined) != 0;
+                        mask |= (*s.value < 0.0F ? 1 : 0) << c;
+                    }
+                    if (mask == 0 || mask == 255)
+                    {
+                        // A seed whose cell the surface only touches (e.g. at an extreme
+                        // point): try the six neighbours once.
+                        if (first_wave && all_defined)
+                        {
+                            for (std::size_t f = 0; f < 6; ++f)
+                            {
+                                Coord neighbour = cell;
+                                neighbour[static_cast<std::size_t>(t.face_axis[f])] +=
+                                    t.face_side[f] == 1 ? 1 : -1;
+                                if (in_grid(grid, neighbour))
+                                {
+                                    out.push_back({pack(neighbour), false});
+                                }
+                            }
+                        }
+                        continue;
+                    }
+                    if (!all_defined)
+                    {
+                        ++undefined_count;
+                        continue;
+                    }
+                    out.push_back({wave[w], true});
+                    for (std::size_t f = 0; f < 6; ++f)
+                    {
+                        int face_inside = 0;
+                        for (const int c : t.face_corner[f])
+                        {
+                            face_inside += mask >> c & 1;
+                        }
+                        if (face_inside == 0 || face_inside == 4)
+                        {
+                            continue;
+                        }
+                        Coord neighbour = cell;
+                        const auto axis = static_cast<std::size_t>(t.face_axis[f]);
+                        neighbour[axis] += t.face_side[f] == 1 ? 1 : -1;
+                        if (in_grid(grid, neighbour))
+                        {
+                            out.push_back({pack(neighbour), false});
+                        }
+                    }
+                }
+                undefined_per_block[begin / 4096] = undefined_count;
+            });
+        for (const std::size_t u : undefined_per_block)
+        {
+            undefined_here += u;
+        }
+        stats.undefined_cells += undefined_here;
+
+        frontier.clear();
+        for (const Outcome& o : outcomes)
+        {
+            if (o.surface)
+            {
+                surface_cells.push_back(o.key);
+            }
+            else
+            {
+                const SparseGrid::Slot s = store.find(unpack(o.key));
+                if (s.state == nullptr || (*s.state & visited) == 0)
+                {
+                    frontier.push_back(o.key);
+                }
+            }
+        }
+        sort_unique(frontier);
+        progress.update(static_cast<double>(stats.cells_visited),
+                        static_cast<double>(stats.cells_visited + frontier.size()));
+    }
+    sort_unique(surface_cells);
+    stats.surface_cells = surface_cells.size();
+
+    // Triangles as global edge keys, cell by cell in key order.
+    std::vector<std::uint64_t> corners_of_triangles = parallel_collect<std::uint64_t>(
+        surface_cells.size(), 2048,
+        [&](std::size_t begin, std::size_t end, std::vector<std::uint64_t>& out) {
+            std::array<float, 8> value{};
+            for (std::size_t s = begin; s < end; ++s)
+            {
+                const Coord cell = unpack(surface_cells[s]);
+                for (int c = 0; c < 8; ++c)
+                {
+                    const SparseGrid::Slot slot = store.find(corner_of(cell, c));
+                    PF_ASSERT(slot.value != nullptr);
+                    value[static_cast<std::size_t>(c)] = slot.value == nullptr ? 0.0F : *slot.value;
+                }
+                triangulate_cell(cell, value, out);
+            }
+        });
+
+    // One vertex per crossed edge, in key order.
+    std::vector<std::uint64_t> edges = corners_of_triangles;
+    sort_unique(edges);
+    const std::size_t nv = edges.size();
+
+    // Vertex positions: linear interpolation, then regula falsi (Illinois) along the edge.
+    std::vector<Vec3d> a_point(nv);
+    std::vector<Vec3d> b_point(nv);
+    std::vector<double> lo_t(nv, 0.0);
+    std::vector<double> hi_t(nv, 1.0);
+    std::vector<double> lo_f(nv);
+    std::vector<double> hi_f(nv);
+    std::vector<double> vertex_t(nv);
+    for (std::size_t v = 0; v < nv; ++v)
+    {
+        const Coord base = unpack(edges[v] >> 2);
+        const auto axis = static_cast<std::size_t>(edges[v] & 3);
+        Coord tip = base;
+        tip[axis] += 1;
+        a_point[v] = grid_point(grid, base);
+        b_point[v] = grid_point(grid, tip);
+        lo_f[v] = *store.find(base).value;
+        hi_f[v] = *store.find(tip).value;
+    }
+    auto interpolate = [&](std::size_t v) {
+        const double denominator = lo_f[v] - hi_f[v];
+        const double s = denominator != 0.0 ? lo_f[v] / denominator : 0.5;
+        return lo_t[v] + std::clamp(s, 0.0, 1.0) * (hi_t[v] - lo_t[v]);
+    };
+    for (std::size_t v = 0; v < nv; ++v)
+    {
+        vertex_t[v] = interpolate(v);
+    }
+    std::vector<int> last_side(nv, 0);
+    for (int step = 0; step < options.refine_steps; ++step)
+    {
+        points.resize(nv);
+        samples.resize(nv);
+        for (std::size_t v = 0; v < nv; ++v)
+        {
+            points[v] = a_point[v] + vertex_t[v] * (b_point[v] - a_point[v]);
+        }
+        field.evaluate(points, samples);
+        stats.field_evaluations += nv;
+        for (std::size_t v = 0; v < nv; ++v)
+        {
+            const FieldSample& s = samples[v];
+            if (!s.defined || !std::isfinite(s.value))
+            {
+                continue;
+            }
+            const bool lo_inside = lo_f[v] < 0.0;
+            const bool here_inside = s.value < 0.0;
+            if (here_inside == lo_inside)
+            {
+                lo_t[v] = vertex_t[v];
+                lo_f[v] = s.value;
+                if (last_side[v] == -1)
+                {
+                    hi_f[v] *= 0.5; // Illinois: the same end twice, halve the other
+                }
+                last_side[v] = -1;
+            }
+            else
+            {
+                hi_t[v] = vertex_t[v];
+                hi_f[v] = s.value;
+                if (last_side[v] == 1)
+                {
+                    lo_f[v] *= 0.5;
+                }
+                last_side[v] = 1;
+            }
+            vertex_t[v] = interpolate(v);
+        }
+    }
+
+    // Keep vertices off the grid corners, so that no two vertices coincide.
+    constexpr double corner_margin = 1e-4;
+    TriMesh& mesh = result.mesh;
+    mesh.vertices.origin =
+        choose_origin(grid_point(grid, {grid.cells[0] / 2, grid.cells[1] / 2, grid.cells[2] / 2}));
+    mesh.vertices.positions.resize(nv);
+    points.resize(nv);
+    for (std::size_t v = 0; v < nv; ++v)
+    {
+        const double s = std::clamp(vertex_t[v], corner_margin, 1.0 - corner_margin);
+        points[v] = a_point[v] + s * (b_point[v] - a_point[v]);
+        mesh.vertices.positions[v] = (points[v] - mesh.vertices.origin).cast<float>();
+    }
+    if (options.vertex_normals)
+    {
+        samples.resize(nv);
+        field.evaluate(points, samples);
+        stats.field_evaluations += nv;
+        mesh.vertices.normals.resize(nv);
+        for (std::size_t v = 0; v < nv; ++v)
+        {
+            const Vec3d g = samples[v].gradient;
+            const double norm = g.norm();
+            mesh.vertices.normals[v] =
+                norm > 0.0 && std::isfinite(norm) ? Vec3f((g / norm).cast<float>()) : Vec3f::Zero();
+        }
+    }
+
+    // Triangles, without the zero-area ones.
+    const double min_double_area = 1e-12 * grid.cell * grid.cell;
+    mesh.triangles.reserve(corners_of_triangles.size() / 3);
+    for (std::size_t i = 0; i + 2 < corners_of_triangles.size(); i += 3)
+    {
+        Triangle tri{};
+        for (std::size_t j = 0; j < 3; ++j)
+        {
+            const auto it =
+                std::lower_bound(edges.begin(), edges.end(), corners_of_triangles[i + j]);
+            tri[j] = static_cast<std::uint32_t>(it - edges.begin());
+        }
+        const Vec3d n = (points[tri[1]] - points[tri[0]]).cross(points[tri[2]] - points[tri[0]]);
+        if (!(n.norm() > min_double_area))
+        {
+            ++stats.dropped_degenerate;
+            continue;
+        }
+        mesh.triangles.push_back(tri);
+    }
+    // Where undefined cells meet diagonally, two sheets touch at one vertex; give each its own.
+    stats.split_vertices = split_nonmanifold_vertices(mesh);
+    progress.finish();
+    return result;
+}
+
+} // namespace pointform

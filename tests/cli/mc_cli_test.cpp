@@ -1,0 +1,115 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+// `pointform mc` end to end: raw points and surfels in, a mesh and its report out.
+
+#include "pointform/geometry/mesh_topology.h"
+#include "pointform/io/io.h"
+
+#include "cli_run.h"
+#include "support/test_support.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+
+namespace pointform {
+namespace {
+
+using test::quoted;
+using test::run;
+
+TEST(McCli, BunnyScanToAMesh)
+{
+    test::TempDir dir;
+    const auto output = dir / "bunny.ply";
+    const auto r = run("mc " + quoted(test::data_path("bunny/bun_zipper.ply")) + " -o " +
+                       quoted(output) + " --json");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const auto report = nlohmann::json::parse(r.out);
+    const TriMesh mesh = read_mesh(output);
+    EXPECT_EQ(report["faces"].get<std::size_t>(), mesh.face_count());
+    EXPECT_EQ(report["vertices"].get<std::size_t>(), mesh.vertex_count());
+    const MeshTopology topo = analyze_topology(mesh);
+    EXPECT_TRUE(topo.is_oriented_manifold());
+    EXPECT_EQ(report["boundary_loops"].get<std::size_t>(), topo.boundary_loops);
+    // The scan has open holes underneath, which the field leaves open.
+    EXPECT_GE(topo.boundary_loops, 1U);
+    // Every sample lies within about a cell of the mesh.
+    EXPECT_LT(report["hausdorff_samples_to_mesh"].get<double>(),
+              2.0 * report["cell"].get<double>());
+    EXPECT_GT(report["hausdorff_samples_to_mesh"].get<double>(), 0.0);
+}
+
+TEST(McCli, SurfelsWithoutRadiiAndEveryMeshFormat)
+{
+    test::TempDir dir;
+    // A sampled sphere with exact normals but no radius property.
+    ASSERT_EQ(run("sample sphere -n 5000 -o " + quoted(dir / "sphere.ply")).exit_code, 0);
+    for (const std::string ext : {".ply", ".obj", ".off"})
+    {
+        const auto output = dir / ("sphere" + ext);
+        const auto r = run("mc " + quoted(dir / "sphere.ply") + " -o " + quoted(output) +
+                           " --resolution 40 --json");
+        ASSERT_EQ(r.exit_code, 0) << r.out;
+        const auto report = nlohmann::json::parse(r.out);
+        EXPECT_FALSE(report["estimated_normals"].get<bool>());
+        EXPECT_EQ(report["boundary_loops"].get<int>(), 0);
+        EXPECT_EQ(report["euler_characteristic"].get<int>(), 2);
+        const TriMesh mesh = read_mesh(output);
+        EXPECT_EQ(mesh.face_count(), report["faces"].get<std::size_t>());
+        for (std::size_t v = 0; v < mesh.vertex_count(); v += 17)
+        {
+            EXPECT_NEAR(mesh.vertices.world(v).norm(), 1.0, 0.05);
+        }
+    }
+}
+
+TEST(McCli, HolesInTheSamplesStayOpen)
+{
+    test::TempDir dir;
+    ASSERT_EQ(run("sample sphere -n 20000 --holes 3 --hole-radius 0.06 --seed 4 -o " +
+                  quoted(dir / "holey.ply"))
+                  .exit_code,
+              0);
+    const auto r = run("mc " + quoted(dir / "holey.ply") + " -o " + quoted(dir / "out.ply") +
+                       " --reestimate --json");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const auto report = nlohmann::json::parse(r.out);
+    EXPECT_TRUE(report["estimated_normals"].get<bool>());
+    // Three separate holes (they may overlap into fewer loops, never more).
+    EXPECT_GE(report["boundary_loops"].get<int>(), 1);
+    EXPECT_LE(report["boundary_loops"].get<int>(), 3);
+    EXPECT_EQ(report["euler_characteristic"].get<int>(), 2 - report["boundary_loops"].get<int>());
+}
+
+TEST(McCli, BadOptionsAndInputsFailCleanly)
+{
+    test::TempDir dir;
+    const auto output = dir / "out.ply";
+    const std::string bunny = quoted(test::data_path("bunny/bun_zipper.ply"));
+    struct Case
+    {
+        std::string arguments;
+        std::string message;
+    };
+    const std::vector<Case> cases = {
+        {"mc " + quoted(dir / "missing.ply") + " -o " + quoted(output), "missing.ply"},
+        {"mc " + bunny + " -o " + quoted(output) + " --cell -1", "--cell"},
+        {"mc " + bunny + " -o " + quoted(output) + " --cell 0.01 --resolution 10", "excludes"},
+        {"mc " + bunny + " -o " + quoted(output) + " --fit smooth", "--fit"},
+        {"mc " + bunny + " -o " + quoted(output) + " --cell 1e-9", "cells along an axis"},
+    };
+    for (const Case& c : cases)
+    {
+        const auto r = run(c.arguments);
+        EXPECT_NE(r.exit_code, 0) << c.arguments;
+        EXPECT_NE(r.out.find(c.message), std::string::npos) << c.arguments << ": " << r.out;
+        EXPECT_FALSE(std::filesystem::exists(output)) << c.arguments;
+    }
+}
+
+} // namespace
+} // namespace pointform

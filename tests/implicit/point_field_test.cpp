@@ -1,0 +1,236 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/implicit/point_field.h"
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+#include "pointform/geometry/shapes.h"
+#include "pointform/hermite/surfels.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace pointform {
+namespace {
+
+/// A unit sphere sampled exactly, with its true normals and a fixed radius.
+PointCloud sphere_surfels(std::size_t count, float radius, Vec3d origin = Vec3d::Zero())
+{
+    PointCloud cloud = sample_shape(Shape::Sphere, {.count = count, .seed = 3});
+    cloud.normals.resize(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+    {
+        cloud.normals[i] = cloud.positions[i].normalized();
+    }
+    cloud.radii.assign(cloud.size(), radius);
+    // Move the whole cloud far away, as georeferenced scans are.
+    cloud.origin += origin;
+    return cloud;
+}
+
+/// A square patch of the plane z = 0.5 sampled on a jittered grid, normals +z.
+PointCloud plane_surfels(int side, double spacing, float radius)
+{
+    PointCloud cloud;
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> jitter(-0.3 * spacing, 0.3 * spacing);
+    for (int i = 0; i < side; ++i)
+    {
+        for (int j = 0; j < side; ++j)
+        {
+            cloud.positions.emplace_back(static_cast<float>(i * spacing + jitter(rng)),
+                                         static_cast<float>(j * spacing + jitter(rng)), 0.5F);
+            cloud.normals.emplace_back(0.0F, 0.0F, 1.0F);
+        }
+    }
+    cloud.radii.assign(cloud.size(), radius);
+    return cloud;
+}
+
+TEST(PointField, RawFieldIsSignedDistanceToTheNearestTangentPlane)
+{
+    const PointCloud surfels = sphere_surfels(4000, 0.2F);
+    const PointField field(surfels, {.fit = PlaneFit::Raw});
+    for (std::size_t i = 0; i < surfels.size(); i += 97)
+    {
+        const Vec3d s = surfels.world(i);
+        const Vec3d n = surfels.normals[i].cast<double>();
+        for (const double d : {-0.004, 0.0, 0.003})
+        {
+            // Just above or below a sample, that sample is the nearest one.
+            const FieldSample f = field.evaluate(s + d * n);
+            ASSERT_TRUE(f.defined);
+            EXPECT_NEAR(f.value, d, 1e-6);
+            EXPECT_NEAR((f.gradient - n).norm(), 0.0, 1e-6);
+        }
+    }
+}
+
+TEST(PointField, UndefinedBeyondTheRadiusButKeepsItsSign)
+{
+    const PointCloud surfels = sphere_surfels(4000, 0.1F);
+    for (const PlaneFit fit : {PlaneFit::Raw, PlaneFit::Centroid, PlaneFit::Blend})
+    {
+        const PointField field(surfels, {.fit = fit});
+        const FieldSample centre = field.evaluate(Vec3d::Zero());
+        EXPECT_FALSE(centre.defined);
+        EXPECT_LT(centre.value, -0.8); // deep inside: about minus the distance to the samples
+        const FieldSample far = field.evaluate(Vec3d(3.0, 1.0, -2.0));
+        EXPECT_FALSE(far.defined);
+        EXPECT_GT(far.value, 2.0);
+        const FieldSample near = field.evaluate(Vec3d(0.0, 0.0, 1.02));
+        EXPECT_TRUE(near.defined);
+        EXPECT_NEAR(near.value, 0.02, 0.01);
+    }
+}
+
+TEST(PointField, BlendIsExactOnAPlaneAndItsGradientIsTheNormal)
+{
+    const PointCloud surfels = plane_surfels(40, 0.025, 0.08F);
+    for (const PlaneFit fit : {PlaneFit::Centroid, PlaneFit::Blend})
+    {
+        const PointField field(surfels, {.fit = fit});
+        std::mt19937_64 rng(11);
+        std::uniform_real_distribution<double> xy(0.2, 0.8);
+        std::uniform_real_distribution<double> z(0.44, 0.56);
+        for (int i = 0; i < 200; ++i)
+        {
+            const Vec3d p(xy(rng), xy(rng), z(rng));
+            const FieldSample f = field.evaluate(p);
+            ASSERT_TRUE(f.defined);
+            EXPECT_NEAR(f.value, p.z() - 0.5, 1e-5);
+            EXPECT_NEAR((f.gradient - Vec3d::UnitZ()).norm(), 0.0, 1e-4);
+        }
+    }
+}
+
+TEST(PointField, BlendGradientMatchesFiniteDifferences)
+{
+    // A curved surface, so that the blended planes disagree and the weights matter.
+    const PointCloud surfels = sphere_surfels(3000, 0.25F);
+    const PointField field(surfels, {.fit = PlaneFit::Blend});
+    std::mt19937_64 rng(5);
+    std::normal_distribution<double> gauss;
+    const double h = 1e-6;
+    for (int i = 0; i < 100; ++i)
+    {
+        const Vec3d dir = Vec3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+        const Vec3d p = dir * (1.0 + 0.02 * gauss(rng));
+        const FieldSample f = field.evaluate(p);
+        Vec3d numeric;
+        for (int a = 0; a < 3; ++a)
+        {
+            const Vec3d e = Vec3d::Unit(a) * h;
+            const FieldSample fp = field.evaluate(p + e);
+            const FieldSample fm = field.evaluate(p - e);
+            numeric[a] = (fp.value - fm.value) / (2.0 * h);
+        }
+        // The bandwidth's own derivative is left out, so allow a small difference.
+        EXPECT_NEAR((f.gradient - numeric).norm(), 0.0, 0.05) << "at " << p.transpose();
+        EXPECT_GT(f.gradient.dot(dir), 0.9);
+    }
+}
+
+TEST(PointField, FarFromTheOriginKeepsPrecision)
+{
+    const PointCloud surfels = sphere_surfels(4000, 0.2F, Vec3d(6.0e5, 4.2e6, 120.0));
+    const PointField field(surfels, {.fit = PlaneFit::Raw});
+    const Vec3d s = surfels.world(10);
+    const Vec3d n = surfels.normals[10].cast<double>();
+    EXPECT_NEAR(field.evaluate(s + 0.001 * n).value, 0.001, 1e-6);
+}
+
+TEST(PointField, BatchEqualsSingleWhateverTheThreadCount)
+{
+    const PointCloud surfels = sphere_surfels(5000, 0.15F);
+    const PointField field(surfels);
+    std::vector<Vec3d> points;
+    std::mt19937_64 rng(9);
+    std::uniform_real_distribution<double> u(-1.3, 1.3);
+    for (int i = 0; i < 5000; ++i)
+    {
+        points.emplace_back(u(rng), u(rng), u(rng));
+    }
+    const int saved = thread_count();
+    std::vector<FieldSample> one(points.size());
+    std::vector<FieldSample> two(points.size());
+    set_thread_count(1);
+    field.evaluate(points, one);
+    set_thread_count(2);
+    field.evaluate(points, two);
+    set_thread_count(saved);
+    for (std::size_t i = 0; i < points.size(); ++i)
+    {
+        const FieldSample single = field.evaluate(points[i]);
+        ASSERT_EQ(one[i].value, single.value);
+        ASSERT_EQ(two[i].value, single.value);
+        ASSERT_EQ(two[i].defined, single.defined);
+        ASSERT_EQ(two[i].gradient, single.gradient);
+    }
+}
+
+/// RMS of the field over points of the true unit sphere: how far the zero set lies from it.
+double rms_on_true_sphere(const PointField& field)
+{
+    std::mt19937_64 rng(21);
+    std::normal_distribution<double> gauss;
+    double sum = 0.0;
+    int count = 0;
+    for (int i = 0; i < 4000; ++i)
+    {
+        const Vec3d p = Vec3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+        const FieldSample f = field.evaluate(p);
+        if (f.defined)
+        {
+            sum += f.value * f.value;
+            ++count;
+        }
+    }
+    EXPECT_GT(count, 3900);
+    return std::sqrt(sum / count);
+}
+
+TEST(PointField, SmoothPlanesAreMoreAccurateOnNoisyScans)
+{
+    // Noise of σ = 0.1% of the diagonal (about a third of the sample spacing), through the
+    // whole pipeline: PCA normals, MST orientation, automatic radii.
+    const PointCloud noisy =
+        sample_shape(Shape::Sphere, {.count = 30000, .seed = 4, .noise = 0.001});
+    const PointCloud surfels = compute_surfels(noisy).surfels;
+    const double sigma = 0.001 * 2.0 * std::sqrt(3.0);
+    const double raw = rms_on_true_sphere(PointField(surfels, {.fit = PlaneFit::Raw}));
+    const double centroid = rms_on_true_sphere(PointField(surfels, {.fit = PlaneFit::Centroid}));
+    const double blend = rms_on_true_sphere(PointField(surfels, {.fit = PlaneFit::Blend}));
+    // The raw planes carry the noise; averaging over a neighbourhood removes most of it.
+    EXPECT_GT(raw, 0.7 * sigma);
+    EXPECT_LT(centroid, 0.6 * raw);
+    EXPECT_LT(blend, 0.6 * raw);
+    EXPECT_LE(blend, centroid * 1.05);
+}
+
+TEST(PointField, RejectsSurfelsItCannotUse)
+{
+    PointCloud cloud = sphere_surfels(100, 0.2F);
+    PointCloud no_normals = cloud;
+    no_normals.normals.clear();
+    EXPECT_THROW(PointField{no_normals}, InvalidInput);
+    PointCloud no_radii = cloud;
+    no_radii.radii.clear();
+    EXPECT_THROW(PointField{no_radii}, InvalidInput);
+    PointCloud zero_radius = cloud;
+    zero_radius.radii[5] = 0.0F;
+    EXPECT_THROW(PointField{zero_radius}, InvalidInput);
+    PointCloud nan_position = cloud;
+    nan_position.positions[3].x() = std::nanf("");
+    EXPECT_THROW(PointField{nan_position}, InvalidInput);
+    EXPECT_THROW(PointField{PointCloud{}}, InvalidInput);
+    EXPECT_THROW(PointField(cloud, {.fit = PlaneFit::Blend, .blend_k = 1}), InvalidInput);
+    EXPECT_THROW((void)parse_plane_fit("smooth"), InvalidInput);
+    EXPECT_EQ(parse_plane_fit("centroid"), PlaneFit::Centroid);
+}
+
+} // namespace
+} // namespace pointform

@@ -1,0 +1,312 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/polygonize/marching_cubes.h"
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+#include "pointform/geometry/mesh_topology.h"
+#include "pointform/geometry/shapes.h"
+#include "pointform/hermite/surfels.h"
+#include "pointform/implicit/point_field.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+namespace pointform {
+namespace {
+
+/// Exact signed distance to a sphere; seeds on its surface unless told otherwise.
+class SphereField final : public Field
+{
+public:
+    SphereField(Vec3d centre, double radius, bool seeds = true)
+        : centre_(std::move(centre)), radius_(radius), seeds_(seeds)
+    {}
+    [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override
+    {
+        const Vec3d d = p - centre_;
+        const double r = d.norm();
+        return {r - radius_, r > 0.0 ? Vec3d(d / r) : Vec3d::UnitZ(), true};
+    }
+    using Field::evaluate;
+    [[nodiscard]] Aabb bounds() const override
+    {
+        return {centre_ - Vec3d::Constant(radius_), centre_ + Vec3d::Constant(radius_)};
+    }
+    void append_seeds(std::vector<Vec3d>& seeds) const override
+    {
+        if (seeds_)
+        {
+            seeds.push_back(centre_ + radius_ * Vec3d::UnitX());
+        }
+    }
+
+private:
+    Vec3d centre_;
+    double radius_;
+    bool seeds_;
+};
+
+/// Exact signed distance to a torus about z (major R, minor r), seeded.
+class TorusField final : public Field
+{
+public:
+    TorusField(double major, double minor) : major_(major), minor_(minor) {}
+    [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override
+    {
+        const double rho = std::hypot(p.x(), p.y());
+        const Vec3d ring = rho > 0.0 ? Vec3d(p.x() * major_ / rho, p.y() * major_ / rho, 0.0)
+                                     : Vec3d(major_, 0.0, 0.0);
+        const Vec3d d = p - ring;
+        return {d.norm() - minor_, d.normalized(), true};
+    }
+    using Field::evaluate;
+    [[nodiscard]] Aabb bounds() const override
+    {
+        const double e = major_ + minor_;
+        return {Vec3d(-e, -e, -minor_), Vec3d(e, e, minor_)};
+    }
+    void append_seeds(std::vector<Vec3d>& seeds) const override
+    {
+        seeds.emplace_back(major_ + minor_, 0.0, 0.0);
+    }
+
+private:
+    double major_;
+    double minor_;
+};
+
+/// Trilinear interpolation of random values on a lattice: defined everywhere, full of ambiguous
+/// faces. No seeds, so it is swept densely.
+class RandomLatticeField final : public Field
+{
+public:
+    RandomLatticeField(int n, std::uint64_t seed) : n_(n), values_((n + 1) * (n + 1) * (n + 1))
+    {
+        std::mt19937_64 rng(seed);
+        std::uniform_real_distribution<double> u(-1.0, 1.0);
+        for (double& v : values_)
+        {
+            v = u(rng);
+        }
+    }
+    [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override
+    {
+        const Vec3d q = p.cwiseMax(Vec3d::Zero()).cwiseMin(Vec3d::Constant(n_ - 1e-9));
+        const int i = static_cast<int>(q.x());
+        const int j = static_cast<int>(q.y());
+        const int k = static_cast<int>(q.z());
+        const double x = q.x() - i;
+        const double y = q.y() - j;
+        const double z = q.z() - k;
+        double value = 0.0;
+        for (int c = 0; c < 8; ++c)
+        {
+            const int dx = c & 1;
+            const int dy = c >> 1 & 1;
+            const int dz = c >> 2 & 1;
+            value +=
+                at(i + dx, j + dy, k + dz) * (dx ? x : 1 - x) * (dy ? y : 1 - y) * (dz ? z : 1 - z);
+        }
+        return {value, Vec3d::UnitZ(), true};
+    }
+    using Field::evaluate;
+    [[nodiscard]] Aabb bounds() const override { return {Vec3d::Zero(), Vec3d::Constant(n_)}; }
+
+private:
+    [[nodiscard]] double at(int i, int j, int k) const
+    {
+        return values_[static_cast<std::size_t>((k * (n_ + 1) + j) * (n_ + 1) + i)];
+    }
+    int n_;
+    std::vector<double> values_;
+};
+
+double signed_volume(const TriMesh& mesh)
+{
+    double volume = 0.0;
+    for (const Triangle& t : mesh.triangles)
+    {
+        const Vec3d a = mesh.vertices.world(t[0]);
+        const Vec3d b = mesh.vertices.world(t[1]);
+        const Vec3d c = mesh.vertices.world(t[2]);
+        volume += a.dot(b.cross(c)) / 6.0;
+    }
+    return volume;
+}
+
+TEST(MarchingCubes, SphereIsClosedOutwardAndOnTheSurface)
+{
+    const SphereField sphere(Vec3d(0.1, -0.2, 0.3), 1.0);
+    const double cell = 0.05;
+    const auto result = marching_cubes(sphere, grid_over(sphere.bounds(), cell));
+    const TriMesh& mesh = result.mesh;
+    const MeshTopology topo = analyze_topology(mesh);
+    EXPECT_TRUE(topo.is_oriented_manifold());
+    EXPECT_TRUE(topo.is_closed());
+    EXPECT_EQ(topo.components, 1U);
+    EXPECT_EQ(topo.euler_characteristic, 2);
+    EXPECT_EQ(result.stats.dropped_degenerate, 0U);
+    // Vertices on the sphere (the field is exact, so regula falsi converges).
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+    {
+        const Vec3d p = mesh.vertices.world(v);
+        // Within the margin that keeps vertices off the grid corners (1e-4 of a cell).
+        ASSERT_NEAR((p - Vec3d(0.1, -0.2, 0.3)).norm(), 1.0, 2e-4 * cell) << v;
+        const Vec3d n = mesh.vertices.normals[v].cast<double>();
+        ASSERT_NEAR(n.dot((p - Vec3d(0.1, -0.2, 0.3)).normalized()), 1.0, 1e-5);
+    }
+    // Outward: positive volume, close to the ball's (an inscribed polyhedron is a bit smaller).
+    const double ball = 4.0 / 3.0 * std::numbers::pi;
+    EXPECT_GT(signed_volume(mesh), 0.99 * ball);
+    EXPECT_LT(signed_volume(mesh), ball);
+    // Sparse: besides the cells the surface passes through, only the few cells probed around
+    // the seed were visited.
+    EXPECT_LE(result.stats.cells_visited, result.stats.surface_cells + 7);
+    EXPECT_FALSE(result.stats.dense);
+}
+
+TEST(MarchingCubes, TorusHasGenusOne)
+{
+    const TorusField torus(1.0, 0.3);
+    const auto result = marching_cubes(torus, grid_over(torus.bounds(), 0.04));
+    const MeshTopology topo = analyze_topology(result.mesh);
+    EXPECT_TRUE(topo.is_oriented_manifold());
+    EXPECT_TRUE(topo.is_closed());
+    EXPECT_EQ(topo.components, 1U);
+    EXPECT_EQ(topo.euler_characteristic, 0);
+    const double volume = 2.0 * std::numbers::pi * std::numbers::pi * 1.0 * 0.3 * 0.3;
+    EXPECT_NEAR(signed_volume(result.mesh), volume, 0.02 * volume);
+}
+
+TEST(MarchingCubes, AmbiguousFacesResolveToAManifold)
+{
+    // Random lattices are full of ambiguous faces and cubes; the mesh must still be an oriented
+    // manifold whose only boundary is where it meets the end of the grid.
+    for (std::uint64_t seed = 1; seed <= 4; ++seed)
+    {
+        const RandomLatticeField field(12, seed);
+        // Cells of 1/3 of a lattice cell, offset so that grid corners are off the lattice.
+        CellGrid grid = grid_over(field.bounds(), 1.0 / 3.0);
+        grid.origin += Vec3d::Constant(0.01);
+        const auto result = marching_cubes(field, grid);
+        EXPECT_TRUE(result.stats.dense);
+        const TriMesh& mesh = result.mesh;
+        const MeshTopology topo = analyze_topology(mesh);
+        EXPECT_GT(topo.faces, 1000U);
+        EXPECT_EQ(topo.non_manifold_edges, 0U);
+        EXPECT_EQ(topo.non_manifold_vertices, 0U);
+        EXPECT_EQ(topo.misoriented_edges, 0U);
+        EXPECT_EQ(topo.degenerate_faces, 0U);
+        // Every triangle's normal agrees with the field's growth direction, checked by the
+        // field's values a little off the triangle's centre on either side.
+        std::size_t against = 0;
+        for (const Triangle& t : mesh.triangles)
+        {
+            const Vec3d a = mesh.vertices.world(t[0]);
+            const Vec3d b = mesh.vertices.world(t[1]);
+            const Vec3d c = mesh.vertices.world(t[2]);
+            const Vec3d centre = (a + b + c) / 3.0;
+            const Vec3d n = (b - a).cross(c - a).normalized();
+            const double step = 0.02;
+            if (field.evaluate(centre + step * n).value < field.evaluate(centre - step * n).value)
+            {
+                ++against;
+            }
+        }
+        EXPECT_LT(static_cast<double>(against), 0.01 * static_cast<double>(mesh.face_count()));
+    }
+}
+
+TEST(MarchingCubes, UndefinedCellsLeaveAHole)
+{
+    // A sphere whose field is undefined above z = 0.5: the cap is cut away and its rim is the
+    // only boundary.
+    class CappedSphere final : public Field
+    {
+    public:
+        [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override
+        {
+            FieldSample s = sphere_.evaluate(p);
+            s.defined = p.z() < 0.5;
+            return s;
+        }
+        using Field::evaluate;
+        [[nodiscard]] Aabb bounds() const override { return sphere_.bounds(); }
+        void append_seeds(std::vector<Vec3d>& seeds) const override { sphere_.append_seeds(seeds); }
+
+    private:
+        SphereField sphere_{Vec3d::Zero(), 1.0};
+    };
+    const CappedSphere field;
+    const auto result = marching_cubes(field, grid_over(field.bounds(), 0.05));
+    const MeshTopology topo = analyze_topology(result.mesh);
+    EXPECT_TRUE(topo.is_oriented_manifold());
+    EXPECT_EQ(topo.boundary_loops, 1U);
+    EXPECT_EQ(topo.euler_characteristic, 1); // a disc
+    EXPECT_GT(result.stats.undefined_cells, 0U);
+    for (std::size_t v = 0; v < result.mesh.vertex_count(); ++v)
+    {
+        ASSERT_LT(result.mesh.vertices.world(v).z(), 0.5);
+    }
+}
+
+TEST(MarchingCubes, SampledSphereThroughThePointField)
+{
+    const PointCloud samples = sample_shape(Shape::Sphere, {.count = 20000, .seed = 8});
+    const PointField field(
+        compute_surfels(samples, {.radius_scale = default_field_radius_scale}).surfels);
+    const auto result = marching_cubes(field, grid_over(field.bounds(), default_cell_size(field)));
+    const MeshTopology topo = analyze_topology(result.mesh);
+    EXPECT_TRUE(topo.is_oriented_manifold());
+    EXPECT_TRUE(topo.is_closed());
+    EXPECT_EQ(topo.components, 1U);
+    EXPECT_EQ(topo.euler_characteristic, 2);
+    EXPECT_EQ(result.stats.dropped_degenerate, 0U);
+    const double spacing = std::sqrt(4.0 * std::numbers::pi / 20000.0);
+    double worst = 0.0;
+    for (std::size_t v = 0; v < result.mesh.vertex_count(); ++v)
+    {
+        worst = std::max(worst, std::abs(result.mesh.vertices.world(v).norm() - 1.0));
+    }
+    EXPECT_LT(worst, 0.25 * spacing);
+    EXPECT_GT(signed_volume(result.mesh), 0.0);
+}
+
+TEST(MarchingCubes, SameMeshWhateverTheThreadCount)
+{
+    const PointCloud samples = sample_shape(Shape::Torus, {.count = 20000, .seed = 2});
+    const PointField field(
+        compute_surfels(samples, {.radius_scale = default_field_radius_scale}).surfels);
+    const CellGrid grid = grid_over(field.bounds(), default_cell_size(field));
+    const int saved = thread_count();
+    set_thread_count(1);
+    const TriMesh one = marching_cubes(field, grid).mesh;
+    set_thread_count(2);
+    const TriMesh two = marching_cubes(field, grid).mesh;
+    set_thread_count(saved);
+    ASSERT_EQ(one.triangles, two.triangles);
+    ASSERT_EQ(one.vertices.positions, two.vertices.positions);
+    EXPECT_EQ(analyze_topology(one).euler_characteristic, 0);
+}
+
+TEST(MarchingCubes, RejectsBadGrids)
+{
+    const SphereField sphere(Vec3d::Zero(), 1.0);
+    EXPECT_THROW((void)grid_over(sphere.bounds(), 0.0), InvalidInput);
+    EXPECT_THROW((void)grid_over(sphere.bounds(), -1.0), InvalidInput);
+    EXPECT_THROW((void)grid_over(sphere.bounds(), 1e-9), InvalidInput);
+    EXPECT_THROW((void)grid_over(Aabb{}, 0.1), InvalidInput);
+    EXPECT_THROW((void)cell_for_resolution(sphere.bounds(), 1), InvalidInput);
+    EXPECT_NEAR(cell_for_resolution(sphere.bounds(), 100), 0.02, 1e-12);
+    // A dense sweep that would not fit is refused rather than attempted.
+    const SphereField unseeded(Vec3d::Zero(), 1.0, false);
+    EXPECT_THROW((void)marching_cubes(unseeded, grid_over(unseeded.bounds(), 0.002)), InvalidInput);
+}
+
+} // namespace
+} // namespace pointform

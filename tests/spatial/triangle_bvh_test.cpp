@@ -1,0 +1,321 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+// TriangleBvh: exact closest points against an independent brute-force oracle, degenerate
+// triangles, bad input, and determinism.
+
+#include "pointform/spatial/triangle_bvh.h"
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+namespace pointform {
+namespace {
+
+using Real = long double;
+using Vec3r = Eigen::Matrix<Real, 3, 1>;
+
+/// Independent oracle: the minimum over the plane projection (when it falls inside, solved from
+/// the 2x2 normal equations in long double) and the three edges (clamped projections).
+double oracle_distance(const Vec3d& pd, const Vec3d& ad, const Vec3d& bd, const Vec3d& cd)
+{
+    const Vec3r p = pd.cast<Real>();
+    const Vec3r a = ad.cast<Real>();
+    const Vec3r b = bd.cast<Real>();
+    const Vec3r c = cd.cast<Real>();
+    const auto segment = [&](const Vec3r& s, const Vec3r& e) {
+        const Vec3r d = e - s;
+        const Real len2 = d.squaredNorm();
+        const Real t = len2 > 0 ? std::clamp((p - s).dot(d) / len2, Real(0), Real(1)) : Real(0);
+        return (p - (s + t * d)).norm();
+    };
+    Real best = std::min({segment(a, b), segment(b, c), segment(c, a)});
+    const Vec3r ab = b - a;
+    const Vec3r ac = c - a;
+    const Vec3r ap = p - a;
+    const Real g00 = ab.dot(ab);
+    const Real g01 = ab.dot(ac);
+    const Real g11 = ac.dot(ac);
+    const Real det = g00 * g11 - g01 * g01;
+    if (det > Real(1e-24) * g00 * g11)
+    {
+        const Real r0 = ab.dot(ap);
+        const Real r1 = ac.dot(ap);
+        const Real v = (g11 * r0 - g01 * r1) / det;
+        const Real w = (g00 * r1 - g01 * r0) / det;
+        if (v >= 0 && w >= 0 && v + w <= 1)
+            best = std::min(best, (ap - v * ab - w * ac).norm());
+    }
+    return static_cast<double>(best);
+}
+
+double brute_force_distance(const TriMesh& mesh, const Vec3d& world)
+{
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& t : mesh.triangles)
+        best =
+            std::min(best, oracle_distance(world, mesh.vertices.world(t[0]),
+                                           mesh.vertices.world(t[1]), mesh.vertices.world(t[2])));
+    return best;
+}
+
+/// A triangle soup over shared random vertices in [-1, 1]³, with degenerate triangles mixed in:
+/// repeated vertices, single points and exactly collinear triples.
+TriMesh random_mesh(std::size_t vertices, std::size_t faces, std::uint64_t seed)
+{
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<float> uni(-1.0F, 1.0F);
+    std::uniform_int_distribution<std::uint32_t> pick(0, static_cast<std::uint32_t>(vertices - 1));
+    TriMesh mesh;
+    for (std::size_t i = 0; i < vertices; ++i)
+        mesh.vertices.positions.emplace_back(uni(rng), uni(rng), uni(rng));
+    for (std::size_t f = 0; f < faces; ++f)
+    {
+        const std::uint32_t i = pick(rng);
+        const std::uint32_t j = pick(rng);
+        const std::uint32_t k = pick(rng);
+        switch (f % 16)
+        {
+            case 0:
+                mesh.triangles.push_back({i, i, j});
+                break;
+            case 1:
+                mesh.triangles.push_back({k, k, k});
+                break;
+            default:
+                mesh.triangles.push_back({i, j, k});
+                break;
+        }
+    }
+    // Exactly collinear: three points on one line with exactly representable coordinates.
+    const auto base = static_cast<std::uint32_t>(mesh.vertices.size());
+    mesh.vertices.positions.emplace_back(0.25F, -0.5F, 0.125F);
+    mesh.vertices.positions.emplace_back(0.5F, -0.25F, 0.125F);
+    mesh.vertices.positions.emplace_back(0.75F, 0.0F, 0.125F);
+    mesh.triangles.push_back({base, base + 1, base + 2});
+    mesh.triangles.push_back({base, base + 2, base + 1});
+    return mesh;
+}
+
+std::vector<Vec3d> random_queries(std::size_t n, double spread, std::uint64_t seed)
+{
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> uni(-spread, spread);
+    std::vector<Vec3d> queries(n);
+    for (auto& q : queries)
+        q = Vec3d(uni(rng), uni(rng), uni(rng));
+    return queries;
+}
+
+TEST(ClosestPointOnTriangle, EveryRegion)
+{
+    const Vec3d a(0, 0, 0);
+    const Vec3d b(1, 0, 0);
+    const Vec3d c(0, 1, 0);
+    struct Case
+    {
+        Vec3d p;
+        Vec3d expected;
+    };
+    const Case cases[] = {
+        {{-1, -1, 1}, a},                // vertex a
+        {{2, -0.5, 0}, b},               // vertex b
+        {{-0.5, 3, -2}, c},              // vertex c
+        {{0.5, -1, 2}, {0.5, 0, 0}},     // edge ab
+        {{-1, 0.25, 0}, {0, 0.25, 0}},   // edge ac
+        {{1, 1, 0.5}, {0.5, 0.5, 0}},    // edge bc
+        {{0.2, 0.3, 5}, {0.2, 0.3, 0}},  // face, above
+        {{0.1, 0.1, -2}, {0.1, 0.1, 0}}, // face, below
+    };
+    for (const Case& k : cases)
+    {
+        const Vec3d w = closest_point_barycentric(k.p, a, b, c);
+        const Vec3d q = w[0] * a + w[1] * b + w[2] * c;
+        EXPECT_NEAR((q - k.expected).norm(), 0.0, 1e-15) << k.p.transpose();
+        EXPECT_NEAR(w.sum(), 1.0, 1e-15);
+        EXPECT_GE(w.minCoeff(), 0.0);
+    }
+}
+
+TEST(ClosestPointOnTriangle, DegenerateTriangles)
+{
+    const Vec3d p(0.3, 2.0, 0.0);
+    // Collinear, a point, a repeated vertex, and a needle 1e-12 wide.
+    const Vec3d a(0, 0, 0);
+    const Vec3d b(1, 0, 0);
+    const Vec3d m(2, 0, 0);
+    for (const auto& [u, v, w] : {std::array<Vec3d, 3>{a, b, m}, std::array<Vec3d, 3>{a, m, b},
+                                  std::array<Vec3d, 3>{b, b, a}, std::array<Vec3d, 3>{a, a, m},
+                                  std::array<Vec3d, 3>{a, Vec3d(0.5, 1e-12, 0), m}})
+    {
+        const Vec3d bary = closest_point_barycentric(p, u, v, w);
+        ASSERT_TRUE(bary.allFinite());
+        const Vec3d q = bary[0] * u + bary[1] * v + bary[2] * w;
+        EXPECT_NEAR((p - q).norm(), 2.0, 1e-11);
+    }
+    const Vec3d point(1, 2, 3);
+    const Vec3d bary = closest_point_barycentric(Vec3d(1, 2, 5), point, point, point);
+    ASSERT_TRUE(bary.allFinite());
+    EXPECT_NEAR((bary[0] + bary[1] + bary[2]), 1.0, 1e-15);
+}
+
+TEST(TriangleBvh, MatchesBruteForceOnRandomMeshes)
+{
+    for (const std::size_t leaf : {1U, 4U, 16U})
+    {
+        const TriMesh mesh = random_mesh(300, 600, 11 + leaf);
+        const TriangleBvh bvh(mesh, {.leaf_size = leaf});
+        EXPECT_EQ(bvh.face_count(), mesh.face_count());
+        // Queries inside, near and far outside the mesh's box.
+        for (const double spread : {0.5, 1.5, 20.0})
+        {
+            for (const Vec3d& q : random_queries(80, spread, 5))
+            {
+                const TriangleBvh::Hit hit = bvh.closest(q);
+                ASSERT_TRUE(hit.found());
+                const double truth = brute_force_distance(mesh, q);
+                EXPECT_NEAR(hit.distance, truth, 1e-12 * std::max(1.0, truth));
+                // The hit is consistent: its point lies on its face at its distance.
+                const auto& t = mesh.triangles[hit.face.value];
+                const Vec3d on_face = hit.barycentric[0] * mesh.vertices.world(t[0]) +
+                                      hit.barycentric[1] * mesh.vertices.world(t[1]) +
+                                      hit.barycentric[2] * mesh.vertices.world(t[2]);
+                EXPECT_NEAR((on_face - hit.point).norm(), 0.0, 1e-14);
+                EXPECT_NEAR((q - hit.point).norm(), hit.distance, 1e-14 * std::max(1.0, truth));
+                EXPECT_GE(hit.barycentric.minCoeff(), 0.0);
+                EXPECT_NEAR(hit.barycentric.sum(), 1.0, 1e-14);
+            }
+        }
+    }
+}
+
+TEST(TriangleBvh, GridPlaneAnalyticDistances)
+{
+    // A 20 x 20 grid of the square [-1, 1]² at z = 0: distance is |z| above it and the distance
+    // to the square's border beyond it.
+    constexpr std::uint32_t n = 20;
+    TriMesh mesh;
+    for (std::uint32_t j = 0; j <= n; ++j)
+        for (std::uint32_t i = 0; i <= n; ++i)
+            mesh.vertices.positions.emplace_back(-1.0F + 2.0F * static_cast<float>(i) / n,
+                                                 -1.0F + 2.0F * static_cast<float>(j) / n, 0.0F);
+    for (std::uint32_t j = 0; j < n; ++j)
+        for (std::uint32_t i = 0; i < n; ++i)
+        {
+            const std::uint32_t v = j * (n + 1) + i;
+            mesh.triangles.push_back({v, v + 1, v + n + 2});
+            mesh.triangles.push_back({v, v + n + 2, v + n + 1});
+        }
+    const TriangleBvh bvh(mesh);
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> uni(-3.0, 3.0);
+    for (int k = 0; k < 2000; ++k)
+    {
+        const Vec3d q(uni(rng), uni(rng), uni(rng));
+        const double dx = std::max(std::abs(q.x()) - 1.0, 0.0);
+        const double dy = std::max(std::abs(q.y()) - 1.0, 0.0);
+        const double truth = std::sqrt(dx * dx + dy * dy + q.z() * q.z());
+        EXPECT_NEAR(bvh.distance(q), truth, 1e-12);
+    }
+}
+
+TEST(TriangleBvh, OnlyDegenerateTriangles)
+{
+    TriMesh mesh;
+    mesh.vertices.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(2, 0, 0), Vec3f(5, 5, 5)};
+    mesh.triangles = {{0, 1, 2}, {3, 3, 3}};
+    const TriangleBvh bvh(mesh);
+    EXPECT_NEAR(bvh.distance(Vec3d(1.5, 0, 2)), 2.0, 1e-15);
+    EXPECT_NEAR(bvh.distance(Vec3d(-3, 4, 0)), 5.0, 1e-15);
+    EXPECT_NEAR(bvh.distance(Vec3d(5, 5, 7)), 2.0, 1e-15);
+    const auto hit = bvh.closest(Vec3d(5, 6, 5));
+    EXPECT_EQ(hit.face, FaceId(1));
+}
+
+TEST(TriangleBvh, MaxDistanceLimitsTheSearch)
+{
+    const TriMesh mesh = random_mesh(100, 200, 4);
+    const TriangleBvh bvh(mesh);
+    for (const Vec3d& q : random_queries(200, 3.0, 9))
+    {
+        const double truth = bvh.distance(q);
+        const auto near = bvh.closest(q, truth * 1.01 + 1e-12);
+        ASSERT_TRUE(near.found());
+        EXPECT_EQ(near.distance, truth);
+        const auto far = bvh.closest(q, truth * 0.99);
+        EXPECT_FALSE(far.found());
+        EXPECT_TRUE(std::isinf(far.distance));
+    }
+}
+
+TEST(TriangleBvh, GeoreferencedOriginKeepsPrecision)
+{
+    TriMesh local = random_mesh(100, 200, 21);
+    TriMesh geo = local;
+    const Vec3d origin(512345.0, 4123456.0, 250.0);
+    geo.vertices.origin = origin;
+    const TriangleBvh bvh_local(local);
+    const TriangleBvh bvh_geo(geo);
+    EXPECT_NEAR((bvh_geo.bounds().min - bvh_local.bounds().min - origin).norm(), 0.0, 1e-8);
+    for (const Vec3d& q : random_queries(200, 2.0, 22))
+    {
+        const auto a = bvh_local.closest(q);
+        const auto b = bvh_geo.closest(q + origin);
+        EXPECT_NEAR(a.distance, b.distance, 1e-9);
+        EXPECT_NEAR((a.point + origin - b.point).norm(), 0.0, 1e-8);
+    }
+}
+
+TEST(TriangleBvh, BatchMatchesSingleWhateverTheThreadCount)
+{
+    const TriMesh mesh = random_mesh(300, 600, 31);
+    const TriangleBvh bvh(mesh);
+    const auto queries = random_queries(2000, 1.5, 32);
+    set_thread_count(1);
+    const auto one = closest_points(bvh, queries);
+    set_thread_count(3);
+    const auto three = closest_points(bvh, queries);
+    set_thread_count(0);
+    ASSERT_EQ(one.size(), queries.size());
+    for (std::size_t i = 0; i < queries.size(); ++i)
+    {
+        EXPECT_EQ(one[i].distance, three[i].distance);
+        EXPECT_EQ(one[i].face, three[i].face);
+        EXPECT_EQ(one[i].distance, bvh.closest(queries[i]).distance);
+    }
+    PointCloud cloud;
+    for (const Vec3d& q : queries)
+        cloud.positions.push_back(q.cast<float>());
+    const auto distances = distances_to_mesh(bvh, cloud);
+    ASSERT_EQ(distances.size(), queries.size());
+    for (std::size_t i = 0; i < queries.size(); ++i)
+        EXPECT_EQ(distances[i], bvh.distance(cloud.world(i)));
+}
+
+TEST(TriangleBvh, BadInputIsRejected)
+{
+    TriMesh empty;
+    empty.vertices.positions = {Vec3f(0, 0, 0)};
+    EXPECT_THROW(TriangleBvh{empty}, InvalidInput);
+
+    TriMesh out_of_range;
+    out_of_range.vertices.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0)};
+    out_of_range.triangles = {{0, 1, 3}};
+    EXPECT_THROW(TriangleBvh{out_of_range}, InvalidInput);
+
+    TriMesh not_finite = out_of_range;
+    not_finite.triangles = {{0, 1, 2}};
+    not_finite.vertices.positions[1].x() = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_THROW(TriangleBvh{not_finite}, InvalidInput);
+}
+
+} // namespace
+} // namespace pointform
