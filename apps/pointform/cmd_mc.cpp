@@ -52,8 +52,10 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
     {
         cell = default_cell_size(field);
     }
+    const CellGrid grid = grid_over(box, cell);
+    check_marching_cubes_memory(field, cell);
     MarchingCubesResult result =
-        marching_cubes(field, grid_over(box, cell), {.progress = progress.callback()});
+        marching_cubes(field, grid, {.progress = progress.callback()});
     timings.lap("marching cubes");
     if (result.mesh.face_count() == 0)
     {
@@ -152,7 +154,7 @@ void register_mc(CLI::App& app, const GlobalOptions& global)
     cmd->add_option("-o,--output", options->output, "Output mesh (.ply, .obj or .off)")->required();
     auto* resolution = cmd->add_option("--resolution", options->resolution,
                                        "Cells along the longest side of the bounding box")
-                           ->check(CLI::Range(2, 100000));
+                           ->check(CLI::Range(2, 1000000));
     cmd->add_option("--cell", options->cell,
                     "Cell size in the input's units (default: from the sampling density: "
                     "0.4 of the median influence radius)")

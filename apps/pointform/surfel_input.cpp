@@ -100,6 +100,13 @@ SurfelInput load_surfels(const std::string& path, const SurfelInputOptions& opti
     }
     check_surfel_input(cloud, options.k);
     out.unoriented = drop_unoriented(cloud);
+    if (cloud.size() <= options.k)
+    {
+        throw InvalidInput(path + ": " + std::to_string(out.unoriented) +
+                           " samples have a zero or non-finite normal, and too few usable ones "
+                           "are left; orient the samples (pointform normals) or pass "
+                           "--reestimate");
+    }
     if (!cloud.has_radii())
     {
         const KdTree tree(cloud.positions);

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 namespace pointform {
@@ -99,6 +100,7 @@ struct PointField::Impl
     std::vector<float> plane_offset;
     Aabb box;
     double median_radius = 0.0;
+    double area = 0.0;
 
     Impl(PointCloud cloud, const PointFieldOptions& opts)
         : surfels(std::move(cloud)), options(opts), tree(surfels.positions)
@@ -134,23 +136,28 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
     }
 
     m.plane_offset.assign(n, 0.0F);
-    if (options.fit != PlaneFit::Raw)
+    const std::size_t k = std::min(std::max<std::size_t>(options.centroid_k, 2) + 1, n);
+    const KnnTable knn = knn_batch(m.tree, m.surfels.positions, k);
+    double area = 0.0;
+    for (std::size_t i = 0; i < n; ++i)
     {
-        const std::size_t k = std::min(options.centroid_k + 1, n);
-        const KnnTable knn = knn_batch(m.tree, m.surfels.positions, k);
-        for (std::size_t i = 0; i < n; ++i)
+        // The ball to the last neighbour holds k samples: π d² / k of surface per sample.
+        area += std::numbers::pi * static_cast<double>(knn.distances2(i)[k - 1]) /
+                static_cast<double>(k);
+        if (options.fit == PlaneFit::Raw)
         {
-            Vec3d centroid = Vec3d::Zero();
-            for (const std::uint32_t j : knn.neighbors(i))
-            {
-                centroid += m.surfels.positions[j].cast<double>();
-            }
-            centroid /= static_cast<double>(k);
-            m.plane_offset[i] =
-                static_cast<float>((centroid - m.surfels.positions[i].cast<double>())
-                                       .dot(m.surfels.normals[i].cast<double>()));
+            continue;
         }
+        Vec3d centroid = Vec3d::Zero();
+        for (const std::uint32_t j : knn.neighbors(i))
+        {
+            centroid += m.surfels.positions[j].cast<double>();
+        }
+        centroid /= static_cast<double>(k);
+        m.plane_offset[i] = static_cast<float>((centroid - m.surfels.positions[i].cast<double>())
+                                                   .dot(m.surfels.normals[i].cast<double>()));
     }
+    m.area = area;
 
     float max_radius = 0.0F;
     for (const float r : m.surfels.radii)
@@ -291,6 +298,11 @@ const PointFieldOptions& PointField::options() const
 double PointField::median_radius() const
 {
     return impl_->median_radius;
+}
+
+double PointField::estimated_area() const
+{
+    return impl_->area;
 }
 
 } // namespace pointform

@@ -8,8 +8,11 @@
 #include "pointform/geometry/mesh_topology.h"
 #include "pointform/implicit/point_field.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -439,6 +442,38 @@ double cell_for_resolution(const Aabb& box, int resolution)
 double default_cell_size(const PointField& field)
 {
     return 0.4 * field.median_radius();
+}
+
+double estimate_marching_cubes_bytes(const PointField& field, double cell)
+{
+    // A surface of area A cuts about 1.5 A / h² cells (the mean of |nx| + |ny| + |nz|); each
+    // costs about 400 bytes: its share of the 8³ corner blocks (~120), wave keys (~40), two
+    // triangles as edge keys (~50), 1.5 vertices with their refinement state (~190).
+    constexpr double bytes_per_cell = 400.0;
+    return bytes_per_cell * 1.5 * field.estimated_area() / (cell * cell);
+}
+
+void check_marching_cubes_memory(const PointField& field, double cell)
+{
+    const double need = estimate_marching_cubes_bytes(field, cell);
+    const long pages = ::sysconf(_SC_PHYS_PAGES);
+    const long page_size = ::sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || page_size <= 0)
+    {
+        return;
+    }
+    const double have = static_cast<double>(pages) * static_cast<double>(page_size);
+    if (need > 0.8 * have)
+    {
+        constexpr double gib = 1024.0 * 1024.0 * 1024.0;
+        char text[200];
+        std::snprintf(text, sizeof text,
+                      "marching cubes at a cell of %g would need about %.1f GiB, more than the "
+                      "%.1f GiB of memory this machine has; use a larger cell or a lower "
+                      "resolution",
+                      cell, need / gib, have / gib);
+        throw InvalidInput(text);
+    }
 }
 
 MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,

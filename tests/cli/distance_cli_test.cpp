@@ -6,12 +6,11 @@
 
 #include "pointform/io/io.h"
 
+#include "cli_run.h"
 #include "support/test_support.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
-
-#include <sys/wait.h>
 
 #include <array>
 #include <cmath>
@@ -22,32 +21,9 @@
 namespace pointform {
 namespace {
 
-struct RunResult
-{
-    int exit_code = -1;
-    std::string out; ///< stdout and stderr together
-};
-
-RunResult run(const std::string& arguments)
-{
-    const std::string command = std::string(PF_CLI_PATH) + " " + arguments + " 2>&1";
-    RunResult result;
-    FILE* pipe = ::popen(command.c_str(), "r");
-    if (pipe == nullptr)
-        return result;
-    std::array<char, 4096> buffer{};
-    std::size_t n = 0;
-    while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-        result.out.append(buffer.data(), n);
-    const int status = ::pclose(pipe);
-    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return result;
-}
-
-std::string quoted(const std::filesystem::path& path)
-{
-    return "'" + path.string() + "'";
-}
+using test::quoted;
+using test::run;
+using test::RunResult;
 
 /// Axis-aligned box [lo, hi] as 12 triangles.
 TriMesh box_mesh(const Vec3d& lo, const Vec3d& hi)

@@ -95,13 +95,31 @@ TEST(McCli, BadOptionsAndInputsFailCleanly)
         std::string arguments;
         std::string message;
     };
-    const std::vector<Case> cases = {
+    std::vector<Case> cases = {
         {"mc " + quoted(dir / "missing.ply") + " -o " + quoted(output), "missing.ply"},
         {"mc " + bunny + " -o " + quoted(output) + " --cell -1", "--cell"},
         {"mc " + bunny + " -o " + quoted(output) + " --cell 0.01 --resolution 10", "excludes"},
         {"mc " + bunny + " -o " + quoted(output) + " --fit smooth", "--fit"},
         {"mc " + bunny + " -o " + quoted(output) + " --cell 1e-9", "cells along an axis"},
     };
+    // Surfels whose normals are all zero.
+    std::string zero_normals = "ply\nformat ascii 1.0\nelement vertex 40\nproperty float x\n"
+                               "property float y\nproperty float z\nproperty float nx\n"
+                               "property float ny\nproperty float nz\nend_header\n";
+    for (int i = 0; i < 40; ++i)
+    {
+        zero_normals += std::to_string(std::cos(i)) + " " + std::to_string(std::sin(i)) + " " +
+                        std::to_string(0.1 * i) + " 0 0 0\n";
+    }
+    test::write_file(dir / "zero_normals.ply", zero_normals);
+    cases.push_back({"mc " + quoted(dir / "zero_normals.ply") + " -o " + quoted(output),
+                     "zero or non-finite normal"});
+    // A mesh whose face points past its vertices.
+    test::write_file(dir / "bad_index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
+    cases.push_back({"mc " + quoted(dir / "bad_index.off") + " -o " + quoted(output), "bad_index.off"});
+    cases.push_back({"mc " + bunny + " -o " + quoted(output) + " --resolution 0", "--resolution"});
+    // Far more cells than memory: refused before anything is allocated.
+    cases.push_back({"mc " + bunny + " -o " + quoted(output) + " --resolution 200000", "GiB"});
     for (const Case& c : cases)
     {
         const auto r = run(c.arguments);

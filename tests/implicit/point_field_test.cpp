@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <random>
 
 namespace pointform {
@@ -66,6 +67,35 @@ TEST(PointField, RawFieldIsSignedDistanceToTheNearestTangentPlane)
             EXPECT_NEAR(f.value, d, 1e-6);
             EXPECT_NEAR((f.gradient - n).norm(), 0.0, 1e-6);
         }
+    }
+}
+
+TEST(PointField, MatchesTheTrueSignedDistanceNearTheSurface)
+{
+    // Exact samples of the unit sphere: near the surface every plane choice is within a small
+    // fraction of the sample spacing of |p| − 1, and has its sign.
+    const std::size_t count = 20000;
+    const double spacing = std::sqrt(4.0 * std::numbers::pi / static_cast<double>(count));
+    const PointCloud surfels = sphere_surfels(count, static_cast<float>(3.0 * spacing));
+    std::mt19937_64 rng(17);
+    std::normal_distribution<double> gauss;
+    std::uniform_real_distribution<double> offset(-spacing, spacing);
+    for (const PlaneFit fit : {PlaneFit::Raw, PlaneFit::Centroid, PlaneFit::Blend})
+    {
+        const PointField field(surfels, {.fit = fit});
+        double worst = 0.0;
+        for (int i = 0; i < 2000; ++i)
+        {
+            const Vec3d p = Vec3d(gauss(rng), gauss(rng), gauss(rng)).normalized() *
+                            (1.0 + offset(rng));
+            const FieldSample f = field.evaluate(p);
+            ASSERT_TRUE(f.defined);
+            worst = std::max(worst, std::abs(f.value - (p.norm() - 1.0)));
+            EXPECT_GT(f.gradient.dot(p.normalized()), 0.95);
+        }
+        RecordProperty(std::string("worst_") + std::string(to_string(fit)), std::to_string(worst));
+        // Curvature: a plane through a sample ½ spacing away is off by about d²/2R.
+        EXPECT_LT(worst, 0.1 * spacing) << to_string(fit);
     }
 }
 
@@ -204,6 +234,9 @@ TEST(PointField, SmoothPlanesAreMoreAccurateOnNoisyScans)
     const double raw = rms_on_true_sphere(PointField(surfels, {.fit = PlaneFit::Raw}));
     const double centroid = rms_on_true_sphere(PointField(surfels, {.fit = PlaneFit::Centroid}));
     const double blend = rms_on_true_sphere(PointField(surfels, {.fit = PlaneFit::Blend}));
+    RecordProperty("rms_raw", std::to_string(raw));
+    RecordProperty("rms_centroid", std::to_string(centroid));
+    RecordProperty("rms_blend", std::to_string(blend));
     // The raw planes carry the noise; averaging over a neighbourhood removes most of it.
     EXPECT_GT(raw, 0.7 * sigma);
     EXPECT_LT(centroid, 0.6 * raw);

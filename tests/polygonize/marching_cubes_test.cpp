@@ -7,11 +7,14 @@
 #include "pointform/core/parallel.h"
 #include "pointform/geometry/mesh_topology.h"
 #include "pointform/geometry/shapes.h"
+#include "pointform/hermite/radius.h"
 #include "pointform/hermite/surfels.h"
+#include "pointform/spatial/kd_tree.h"
 #include "pointform/implicit/point_field.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -275,6 +278,50 @@ TEST(MarchingCubes, SampledSphereThroughThePointField)
     }
     EXPECT_LT(worst, 0.25 * spacing);
     EXPECT_GT(signed_volume(result.mesh), 0.0);
+}
+
+/// A unit sphere sampled with exact normals, without its cap above z = 0.8, radii = the 16th
+/// neighbour's distance times `scale`.
+PointCloud capless_sphere(double scale)
+{
+    const PointCloud all = sample_shape(Shape::Sphere, {.count = 6000, .seed = 12});
+    PointCloud cloud;
+    for (std::size_t i = 0; i < all.size(); ++i)
+    {
+        if (all.positions[i].z() <= 0.8F)
+        {
+            cloud.positions.push_back(all.positions[i]);
+            cloud.normals.push_back(all.positions[i].normalized());
+        }
+    }
+    const KdTree tree(cloud.positions);
+    cloud.radii = influence_radii(knn_batch(tree, cloud.positions, 17), scale);
+    return cloud;
+}
+
+TEST(MarchingCubes, RemovedCapStaysOpenAtASmallRadiusAndClosesAtALargeOne)
+{
+    // The cap's rim has radius 0.6: radii of ~0.1 leave it open, radii near 0.9 reach across.
+    const PointField small(capless_sphere(1.5));
+    const auto open = marching_cubes(small, grid_over(small.bounds(), default_cell_size(small)));
+    const MeshTopology open_topo = analyze_topology(open.mesh);
+    EXPECT_TRUE(open_topo.is_oriented_manifold());
+    EXPECT_EQ(open_topo.boundary_loops, 1U);
+    EXPECT_EQ(open_topo.euler_characteristic, 1);
+    // The surface reaches at most one influence radius past the rim samples.
+    const auto& radii = small.surfels().radii;
+    const double reach = 0.8 + static_cast<double>(*std::max_element(radii.begin(), radii.end()));
+    for (std::size_t v = 0; v < open.mesh.vertex_count(); ++v)
+    {
+        ASSERT_LT(open.mesh.vertices.world(v).z(), reach);
+    }
+
+    const PointField large(capless_sphere(8.0));
+    const auto closed = marching_cubes(large, grid_over(large.bounds(), 0.04));
+    const MeshTopology closed_topo = analyze_topology(closed.mesh);
+    EXPECT_TRUE(closed_topo.is_oriented_manifold());
+    EXPECT_TRUE(closed_topo.is_closed());
+    EXPECT_EQ(closed_topo.euler_characteristic, 2);
 }
 
 TEST(MarchingCubes, SameMeshWhateverTheThreadCount)

@@ -72,6 +72,9 @@ public:
     [[nodiscard]] const PointFieldOptions& options() const;
     /// \brief Median influence radius over the samples.
     [[nodiscard]] double median_radius() const;
+    /// \brief The area of the sampled surface, estimated from the sampling density (each sample
+    /// stands for π d² / k, d its distance to the k-th of its `centroid_k` neighbours).
+    [[nodiscard]] double estimated_area() const;
 
 private:
     struct Impl;

@@ -37,6 +37,16 @@ class PointField;
 /// (0.4 of the median radius), so a clean scan comes out closed.
 [[nodiscard]] double default_cell_size(const PointField& field);
 
+/// \brief About how many bytes marching cubes needs on a point field at this cell size (the
+/// cells on a surface of the field's estimated area, with their corner values, triangles and
+/// vertices).
+[[nodiscard]] double estimate_marching_cubes_bytes(const PointField& field, double cell);
+
+/// \brief Refuses, before anything is allocated, a cell size whose marching cubes would need
+/// more memory than this machine has.
+/// \throw InvalidInput saying how much it would need and how much there is
+void check_marching_cubes_memory(const PointField& field, double cell);
+
 struct MarchingCubesOptions
 {
     /// Refine each vertex by regula falsi on the field along its grid edge (evaluations per

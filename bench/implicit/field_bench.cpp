@@ -1,0 +1,94 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+// Point-field evaluation and sparse marching cubes on a 1M-sample sphere (exact normals, radii
+// 1.5 × the 16th neighbour's distance). Run single-threaded for per-core throughput:
+//   OMP_NUM_THREADS=1 build/bench/bench/implicit/implicit_bench
+
+#include "pointform/core/parallel.h"
+#include "pointform/geometry/shapes.h"
+#include "pointform/hermite/radius.h"
+#include "pointform/implicit/point_field.h"
+#include "pointform/polygonize/marching_cubes.h"
+#include "pointform/spatial/kd_tree.h"
+
+#include <benchmark/benchmark.h>
+
+#include <memory>
+#include <random>
+
+namespace pointform {
+namespace {
+
+PointCloud million_surfels()
+{
+    PointCloud cloud = sample_shape(Shape::Sphere, {.count = 1000000, .seed = 1});
+    cloud.normals.resize(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+    {
+        cloud.normals[i] = cloud.positions[i].normalized();
+    }
+    const KdTree tree(cloud.positions);
+    cloud.radii = influence_radii(knn_batch(tree, cloud.positions, 17), 1.5);
+    return cloud;
+}
+
+const PointCloud& surfels()
+{
+    static const PointCloud cloud = million_surfels();
+    return cloud;
+}
+
+/// Queries within ±2% of the radius around the sphere, as polygonization asks.
+std::vector<Vec3d> near_surface_queries(std::size_t n)
+{
+    std::mt19937_64 rng(3);
+    std::normal_distribution<double> gauss;
+    std::uniform_real_distribution<double> shell(0.98, 1.02);
+    std::vector<Vec3d> points(n);
+    for (Vec3d& p : points)
+    {
+        p = Vec3d(gauss(rng), gauss(rng), gauss(rng)).normalized() * shell(rng);
+    }
+    return points;
+}
+
+void BM_FieldEvaluate(benchmark::State& state)
+{
+    const auto fit = static_cast<PlaneFit>(state.range(0));
+    const PointField field(surfels(), {.fit = fit});
+    const std::vector<Vec3d> points = near_surface_queries(1 << 20);
+    std::vector<FieldSample> out(points.size());
+    for (auto _ : state)
+    {
+        field.evaluate(points, out);
+        benchmark::DoNotOptimize(out.data());
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * points.size()));
+    state.SetLabel(std::string(to_string(fit)) + ", " + std::to_string(thread_count()) +
+                   " thread(s)");
+}
+BENCHMARK(BM_FieldEvaluate)
+    ->Arg(static_cast<int>(PlaneFit::Raw))
+    ->Arg(static_cast<int>(PlaneFit::Centroid))
+    ->Arg(static_cast<int>(PlaneFit::Blend))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+void BM_MarchingCubes512(benchmark::State& state)
+{
+    const PointField field(surfels());
+    const double cell = cell_for_resolution(surfels().bounds(), 512);
+    std::size_t faces = 0;
+    for (auto _ : state)
+    {
+        const auto result = marching_cubes(field, grid_over(field.bounds(), cell));
+        faces = result.mesh.face_count();
+        benchmark::DoNotOptimize(faces);
+    }
+    state.counters["faces"] = static_cast<double>(faces);
+}
+BENCHMARK(BM_MarchingCubes512)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+
+} // namespace
+} // namespace pointform
