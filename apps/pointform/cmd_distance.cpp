@@ -133,12 +133,7 @@ void run_distance(const DistanceCommandOptions& options, const GlobalOptions& gl
         out["diagonal"] = result.diagonal;
         out["absolute"] = summary_json(result.absolute);
         out["relative_to_diagonal"] = summary_json(result.relative);
-        nlohmann::json stages = nlohmann::json::object();
-        for (const auto& [stage, seconds] : timings.stages())
-            stages[stage] = seconds;
-        stages["total"] = timings.total();
-        out["timings_s"] = stages;
-        out["threads"] = thread_count();
+        add_run_report(out, timings);
         std::printf("%s\n", out.dump(2).c_str());
         return;
     }
@@ -153,10 +148,7 @@ void run_distance(const DistanceCommandOptions& options, const GlobalOptions& gl
                              format_number(result.relative.chamfer) + " of the diagonal)");
     print_table("absolute (input units)", result.absolute);
     print_table("relative to the bounding box diagonal", result.relative);
-    std::string times;
-    for (const auto& [stage, seconds] : timings.stages())
-        times += (times.empty() ? "" : ", ") + stage + " " + format_number(seconds);
-    print_row("seconds", times + " (total " + format_number(timings.total()) + ")");
+    print_timings(timings);
 }
 
 } // namespace

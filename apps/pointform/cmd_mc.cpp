@@ -54,8 +54,7 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
     }
     const CellGrid grid = grid_over(box, cell);
     check_marching_cubes_memory(field, cell);
-    MarchingCubesResult result =
-        marching_cubes(field, grid, {.progress = progress.callback()});
+    MarchingCubesResult result = marching_cubes(field, grid, {.progress = progress.callback()});
     timings.lap("marching cubes");
     if (result.mesh.face_count() == 0)
     {
@@ -96,15 +95,7 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
         out["mean_samples_to_mesh"] = distance.mean;
         out["rms_samples_to_mesh"] = distance.rms;
         out["hausdorff_relative"] = diagonal > 0.0 ? distance.max / diagonal : 0.0;
-        nlohmann::json stages = nlohmann::json::object();
-        for (const auto& [stage, seconds] : timings.stages())
-        {
-            stages[stage] = seconds;
-        }
-        stages["total"] = timings.total();
-        out["timings_s"] = stages;
-        out["threads"] = thread_count();
-        out["peak_rss_bytes"] = peak_rss_bytes();
+        add_run_report(out, timings);
         std::printf("%s\n", out.dump(2).c_str());
         return;
     }
@@ -124,12 +115,7 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
     print_row("Hausdorff samples->mesh",
               format_number(distance.max) + " (" + format_number(100.0 * distance.max / diagonal) +
                   "% of the diagonal; mean " + format_number(distance.mean) + ")");
-    std::string times;
-    for (const auto& [stage, seconds] : timings.stages())
-    {
-        times += (times.empty() ? "" : ", ") + stage + " " + format_number(seconds);
-    }
-    print_row("seconds", times + " (total " + format_number(timings.total()) + ")");
+    print_timings(timings);
     if (input.unoriented > 0)
     {
         std::fprintf(stderr, "pointform: warning: %zu samples without a normal were left out\n",

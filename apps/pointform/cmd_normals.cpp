@@ -113,13 +113,7 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
                                                  orientation.unoriented.size(), 100)));
         out["radius"] = {
             {"min", radii.front()}, {"median", radii[radii.size() / 2]}, {"max", radii.back()}};
-        nlohmann::json stages = nlohmann::json::object();
-        for (const auto& [stage, seconds] : timings.stages())
-            stages[stage] = seconds;
-        stages["total"] = timings.total();
-        out["timings_s"] = stages;
-        out["threads"] = thread_count();
-        out["peak_rss_bytes"] = peak_rss_bytes();
+        add_run_report(out, timings);
         std::printf("%s\n", out.dump(2).c_str());
         return;
     }
@@ -134,10 +128,7 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
     print_row("radius min/median/max", format_number(radii.front()) + " / " +
                                            format_number(radii[radii.size() / 2]) + " / " +
                                            format_number(radii.back()));
-    std::string times;
-    for (const auto& [stage, seconds] : timings.stages())
-        times += (times.empty() ? "" : ", ") + stage + " " + format_number(seconds);
-    print_row("seconds", times + " (total " + format_number(timings.total()) + ")");
+    print_timings(timings);
     if (!orientation.unoriented.empty())
         std::fprintf(stderr,
                      "pointform: warning: %zu samples could not be oriented (first index %u); "

@@ -151,12 +151,7 @@ void run_render(const RenderCommandOptions& options, const GlobalOptions& global
         out["width"] = image.width;
         out["height"] = image.height;
         out["view"] = {render_options.azimuth, render_options.elevation};
-        nlohmann::json stages = nlohmann::json::object();
-        for (const auto& [stage, seconds] : timings.stages())
-            stages[stage] = seconds;
-        stages["total"] = timings.total();
-        out["timings_s"] = stages;
-        out["threads"] = thread_count();
+        add_run_report(out, timings);
         std::printf("%s\n", out.dump(2).c_str());
         return;
     }
@@ -166,10 +161,7 @@ void run_render(const RenderCommandOptions& options, const GlobalOptions& global
     print_row("drawn as", as_mesh ? kind + " (" + std::to_string(face_count) + " faces)"
                                   : kind + " (" + std::to_string(vertex_count) + ")");
     print_row("image", std::to_string(image.width) + " x " + std::to_string(image.height));
-    std::string times;
-    for (const auto& [stage, seconds] : timings.stages())
-        times += (times.empty() ? "" : ", ") + stage + " " + format_number(seconds);
-    print_row("seconds", times + " (total " + format_number(timings.total()) + ")");
+    print_timings(timings);
 }
 
 } // namespace

@@ -3,6 +3,10 @@
 
 #include "common.h"
 
+#include "pointform/core/parallel.h"
+
+#include <nlohmann/json.hpp>
+
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -99,6 +103,29 @@ std::string format_number(double value)
 void print_row(const std::string& label, const std::string& value)
 {
     std::printf("  %-22s %s\n", (label + ":").c_str(), value.c_str());
+}
+
+void add_run_report(nlohmann::json& out, const Timings& timings)
+{
+    nlohmann::json stages = nlohmann::json::object();
+    for (const auto& [stage, seconds] : timings.stages())
+    {
+        stages[stage] = seconds;
+    }
+    stages["total"] = timings.total();
+    out["timings_s"] = stages;
+    out["threads"] = thread_count();
+    out["peak_rss_bytes"] = peak_rss_bytes();
+}
+
+void print_timings(const Timings& timings)
+{
+    std::string times;
+    for (const auto& [stage, seconds] : timings.stages())
+    {
+        times += (times.empty() ? "" : ", ") + stage + " " + format_number(seconds);
+    }
+    print_row("seconds", times + " (total " + format_number(timings.total()) + ")");
 }
 
 } // namespace pointform::cli

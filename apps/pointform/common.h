@@ -7,6 +7,7 @@
 #include "pointform/core/types.h"
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include <chrono>
 #include <string>
@@ -62,6 +63,13 @@ private:
     std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
 
+/// \brief Adds what every JSON report ends with: "timings_s" (each stage and the total),
+/// "threads" and "peak_rss_bytes".
+void add_run_report(nlohmann::json& out, const Timings& timings);
+
+/// \brief Prints the "seconds" row: each stage, then the total.
+void print_timings(const Timings& timings);
+
 /// \brief Peak resident memory of this process so far, in bytes.
 [[nodiscard]] std::size_t peak_rss_bytes();
 
@@ -81,5 +89,7 @@ void register_sample(CLI::App& app, const GlobalOptions& global);
 void register_mc(CLI::App& app, const GlobalOptions& global);
 void register_render(CLI::App& app, const GlobalOptions& global);
 void register_distance(CLI::App& app, const GlobalOptions& global);
+void register_model(CLI::App& app, const GlobalOptions& global);
+void register_morph(CLI::App& app, const GlobalOptions& global);
 
 } // namespace pointform::cli

@@ -41,6 +41,8 @@ int run(int argc, char** argv)
     pointform::cli::register_mc(app, global);
     pointform::cli::register_render(app, global);
     pointform::cli::register_distance(app, global);
+    pointform::cli::register_model(app, global);
+    pointform::cli::register_morph(app, global);
 
     try
     {

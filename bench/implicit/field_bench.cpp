@@ -11,6 +11,7 @@
 #include "pointform/implicit/point_field.h"
 #include "pointform/polygonize/marching_cubes.h"
 #include "pointform/spatial/kd_tree.h"
+#include "pointform/spatial/spatial_sort.h"
 
 #include <benchmark/benchmark.h>
 
@@ -39,8 +40,9 @@ const PointCloud& surfels()
     return cloud;
 }
 
-/// Queries within ±2% of the radius around the sphere, as polygonization asks.
-std::vector<Vec3d> near_surface_queries(std::size_t n)
+/// Queries within ±2% of the radius around the sphere, in Morton order when `coherent` (as
+/// polygonization asks: cell by cell along the surface) or in random order.
+std::vector<Vec3d> near_surface_queries(std::size_t n, bool coherent)
 {
     std::mt19937_64 rng(3);
     std::normal_distribution<double> gauss;
@@ -50,14 +52,30 @@ std::vector<Vec3d> near_surface_queries(std::size_t n)
     {
         p = Vec3d(gauss(rng), gauss(rng), gauss(rng)).normalized() * shell(rng);
     }
-    return points;
+    if (!coherent)
+    {
+        return points;
+    }
+    std::vector<Vec3f> as_float(n);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+        as_float[i] = points[i].cast<float>();
+    }
+    std::vector<Vec3d> sorted(n);
+    const std::vector<std::uint32_t> order = spatial_order(as_float);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+        sorted[i] = points[order[i]];
+    }
+    return sorted;
 }
 
 void BM_FieldEvaluate(benchmark::State& state)
 {
     const auto fit = static_cast<PlaneFit>(state.range(0));
+    const bool coherent = state.range(1) != 0;
     const PointField field(surfels(), {.fit = fit});
-    const std::vector<Vec3d> points = near_surface_queries(1 << 20);
+    const std::vector<Vec3d> points = near_surface_queries(1 << 20, coherent);
     std::vector<FieldSample> out(points.size());
     for (auto _ : state)
     {
@@ -65,13 +83,14 @@ void BM_FieldEvaluate(benchmark::State& state)
         benchmark::DoNotOptimize(out.data());
     }
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * points.size()));
-    state.SetLabel(std::string(to_string(fit)) + ", " + std::to_string(thread_count()) +
-                   " thread(s)");
+    state.SetLabel(std::string(to_string(fit)) +
+                   (coherent ? ", Morton order, " : ", random order, ") +
+                   std::to_string(thread_count()) + " thread(s)");
 }
 BENCHMARK(BM_FieldEvaluate)
-    ->Arg(static_cast<int>(PlaneFit::Raw))
-    ->Arg(static_cast<int>(PlaneFit::Centroid))
-    ->Arg(static_cast<int>(PlaneFit::Blend))
+    ->ArgsProduct({{static_cast<int>(PlaneFit::Raw), static_cast<int>(PlaneFit::Centroid),
+                    static_cast<int>(PlaneFit::Blend)},
+                   {1, 0}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

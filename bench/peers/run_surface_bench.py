@@ -100,7 +100,7 @@ def _evaluate_child(queue, args):
 def evaluate_isolated(*args) -> dict:
     """evaluate() in a child process: Debian's Open3D aborts on an internal assertion on some
     meshes, which must cost one row, not the run."""
-    context = multiprocessing.get_context("fork")
+    context = multiprocessing.get_context("spawn")
     queue = context.Queue()
     child = context.Process(target=_evaluate_child, args=(queue, args))
     child.start()

@@ -119,6 +119,13 @@ FileFormat resolve_format(const std::filesystem::path& path, FileFormat format)
 
 } // namespace
 
+void write_file_atomically(const std::filesystem::path& path, std::span<const std::uint8_t> bytes)
+{
+    write_atomically(path, [&](detail::OutputBuffer& out) {
+        out.write(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+    });
+}
+
 std::string format_name(FileFormat format)
 {
     switch (format)

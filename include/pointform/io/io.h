@@ -8,7 +8,9 @@
 #include "pointform/io/io_options.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -57,6 +59,11 @@ void write_point_cloud(const std::filesystem::path& path, const PointCloud& clou
 /// \brief Writes a triangle mesh as PLY, OFF or OBJ, atomically like write_point_cloud.
 void write_mesh(const std::filesystem::path& path, const TriMesh& mesh,
                 const WriteOptions& options = {});
+
+/// \brief Writes `bytes` to `path` through a temporary file beside it that is renamed into
+/// place, so a failure never leaves a half-written file (any output format can use this).
+/// \throw IoError naming the file
+void write_file_atomically(const std::filesystem::path& path, std::span<const std::uint8_t> bytes);
 
 /// \brief The format `Auto` resolves to for this path. \throw IoError for unknown extensions.
 [[nodiscard]] FileFormat format_from_extension(const std::filesystem::path& path);

@@ -1,0 +1,210 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "scene_input.h"
+
+#include "pointform/core/error.h"
+#include "pointform/io/io.h"
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <system_error>
+#include <utility>
+
+namespace pointform::cli {
+namespace {
+
+Aabb parse_bounds(const std::string& text)
+{
+    std::istringstream in(text);
+    std::array<double, 6> v{};
+    for (std::size_t i = 0; i < v.size(); ++i)
+    {
+        char comma = ',';
+        if (!(in >> v[i]) || (i + 1 < v.size() && !(in >> comma)) || comma != ',' ||
+            !std::isfinite(v[i]))
+        {
+            throw CLI::ValidationError("--bounds",
+                                       "expected six finite numbers "
+                                       "xmin,ymin,zmin,xmax,ymax,zmax, got '" +
+                                           text + "'");
+        }
+    }
+    if (!(in >> std::ws).eof())
+    {
+        throw CLI::ValidationError("--bounds",
+                                   "expected six numbers xmin,ymin,zmin,xmax,ymax,zmax, "
+                                   "got '" +
+                                       text + "'");
+    }
+    Aabb box;
+    box.min = Vec3d(v[0], v[1], v[2]);
+    box.max = Vec3d(v[3], v[4], v[5]);
+    if (!(box.min.array() < box.max.array()).all())
+    {
+        throw CLI::ValidationError("--bounds",
+                                   "each minimum must be below its maximum, got '" + text + "'");
+    }
+    return box;
+}
+
+SceneArgumentKind classify(const std::string& argument)
+{
+    if (!looks_like_file(argument))
+    {
+        return SceneArgumentKind::Expression;
+    }
+    try
+    {
+        (void)format_from_extension(argument);
+        return SceneArgumentKind::Scan;
+    }
+    catch (const IoError&)
+    {
+        return SceneArgumentKind::SceneFile;
+    }
+}
+
+} // namespace
+
+void add_scene_command_options(CLI::App& cmd, SceneCommandOptions& options)
+{
+    auto* resolution = cmd.add_option("--resolution", options.resolution,
+                                      "Cells along the longest side of the polygonized box")
+                           ->check(CLI::Range(2, 1000000));
+    cmd.add_option("--cell", options.cell,
+                   "Cell size in the input's units (default: 0.4 of the smallest median "
+                   "influence radius of the scans, or the longest side / 128 without scans)")
+        ->check(CLI::PositiveNumber)
+        ->excludes(resolution);
+    cmd.add_option("--bounds", options.bounds,
+                   "Box to polygonize, xmin,ymin,zmin,xmax,ymax,zmax (default: the scene's "
+                   "bounds; required when the scene is unbounded, e.g. a half_space in a union)");
+    cmd.add_option("--fit", options.fit,
+                   "Tangent planes of the scans' fields: blend, centroid or raw (see `mc`)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"blend", "centroid", "raw"}));
+    add_surfel_input_options(cmd, options.surfels);
+    cmd.add_flag("--ascii", options.ascii, "Write ascii PLY instead of binary");
+    cmd.add_flag("--json", options.json, "Print the report as JSON");
+}
+
+const char* to_string(SceneArgumentKind kind)
+{
+    switch (kind)
+    {
+        case SceneArgumentKind::Expression:
+            return "expression";
+        case SceneArgumentKind::SceneFile:
+            return "scene file";
+        case SceneArgumentKind::Scan:
+            return "scan";
+    }
+    return "?";
+}
+
+SceneArguments::SceneArguments(const SceneCommandOptions& options, ProgressCallback progress)
+    : options_(options), progress_(std::move(progress))
+{}
+
+SceneArguments::Loaded SceneArguments::load(const std::string& argument)
+{
+    Loaded loaded;
+    loaded.kind = classify(argument);
+    ScanLoader loader = [this](const std::string& path) {
+        return load_scan(path);
+    };
+    switch (loaded.kind)
+    {
+        case SceneArgumentKind::Scan:
+            loaded.field = load_scan(argument);
+            break;
+        case SceneArgumentKind::SceneFile:
+            loaded.field = read_scene(argument, loader).field;
+            break;
+        case SceneArgumentKind::Expression:
+        {
+            SceneOptions scene_options;
+            scene_options.source_name = "expression";
+            scene_options.load_scan = loader;
+            loaded.field = parse_scene(argument, scene_options).field;
+            break;
+        }
+    }
+    return loaded;
+}
+
+std::shared_ptr<const Field> SceneArguments::load_scan(const std::string& path)
+{
+    std::error_code error;
+    std::string key = std::filesystem::weakly_canonical(path, error).string();
+    if (error)
+    {
+        key = path;
+    }
+    const auto it = index_.find(key);
+    if (it != index_.end())
+    {
+        return scans_[it->second].field;
+    }
+    SurfelInput input = load_surfels(path, options_.surfels, progress_);
+    LoadedScan scan;
+    scan.path = path;
+    scan.samples = input.surfels.size();
+    scan.estimated_normals = input.estimated_normals;
+    scan.unoriented = input.unoriented;
+    scan.field = std::make_shared<const PointField>(
+        std::move(input.surfels), PointFieldOptions{.fit = parse_plane_fit(options_.fit)});
+    index_.emplace(key, scans_.size());
+    scans_.push_back(std::move(scan));
+    return scans_.back().field;
+}
+
+SceneGrid choose_scene_grid(const Aabb& field_bounds, const SceneCommandOptions& options,
+                            std::span<const LoadedScan> scans)
+{
+    SceneGrid out;
+    out.box = options.bounds.empty() ? field_bounds : parse_bounds(options.bounds);
+    if (out.box.is_empty())
+    {
+        throw InvalidInput(
+            "the scene is empty: its bounds are empty (an intersection of shapes "
+            "that do not overlap?)");
+    }
+    if (!out.box.min.allFinite() || !out.box.max.allFinite())
+    {
+        throw InvalidInput(
+            "the scene is unbounded (a half_space that is not intersected with a "
+            "bounded shape): pass --bounds xmin,ymin,zmin,xmax,ymax,zmax, or "
+            "intersect it with a bounded shape");
+    }
+    if (options.cell > 0.0)
+    {
+        out.cell = options.cell;
+    }
+    else if (options.resolution > 0)
+    {
+        out.cell = cell_for_resolution(out.box, options.resolution);
+    }
+    else if (!scans.empty())
+    {
+        out.cell = default_cell_size(*scans.front().field);
+        for (const LoadedScan& scan : scans)
+        {
+            out.cell = std::min(out.cell, default_cell_size(*scan.field));
+        }
+    }
+    else
+    {
+        out.cell = cell_for_resolution(out.box, 128);
+    }
+    out.grid = grid_over(out.box, out.cell);
+    for (const LoadedScan& scan : scans)
+    {
+        check_marching_cubes_memory(*scan.field, out.cell);
+    }
+    return out;
+}
+
+} // namespace pointform::cli
