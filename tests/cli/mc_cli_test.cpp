@@ -103,9 +103,10 @@ TEST(McCli, BadOptionsAndInputsFailCleanly)
         {"mc " + bunny + " -o " + quoted(output) + " --cell 1e-9", "cells along an axis"},
     };
     // Surfels whose normals are all zero.
-    std::string zero_normals = "ply\nformat ascii 1.0\nelement vertex 40\nproperty float x\n"
-                               "property float y\nproperty float z\nproperty float nx\n"
-                               "property float ny\nproperty float nz\nend_header\n";
+    std::string zero_normals =
+        "ply\nformat ascii 1.0\nelement vertex 40\nproperty float x\n"
+        "property float y\nproperty float z\nproperty float nx\n"
+        "property float ny\nproperty float nz\nend_header\n";
     for (int i = 0; i < 40; ++i)
     {
         zero_normals += std::to_string(std::cos(i)) + " " + std::to_string(std::sin(i)) + " " +
@@ -116,7 +117,8 @@ TEST(McCli, BadOptionsAndInputsFailCleanly)
                      "zero or non-finite normal"});
     // A mesh whose face points past its vertices.
     test::write_file(dir / "bad_index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
-    cases.push_back({"mc " + quoted(dir / "bad_index.off") + " -o " + quoted(output), "bad_index.off"});
+    cases.push_back(
+        {"mc " + quoted(dir / "bad_index.off") + " -o " + quoted(output), "bad_index.off"});
     cases.push_back({"mc " + bunny + " -o " + quoted(output) + " --resolution 0", "--resolution"});
     // Far more cells than memory: refused before anything is allocated.
     cases.push_back({"mc " + bunny + " -o " + quoted(output) + " --resolution 200000", "GiB"});

@@ -86,8 +86,8 @@ TEST(PointField, MatchesTheTrueSignedDistanceNearTheSurface)
         double worst = 0.0;
         for (int i = 0; i < 2000; ++i)
         {
-            const Vec3d p = Vec3d(gauss(rng), gauss(rng), gauss(rng)).normalized() *
-                            (1.0 + offset(rng));
+            const Vec3d p =
+                Vec3d(gauss(rng), gauss(rng), gauss(rng)).normalized() * (1.0 + offset(rng));
             const FieldSample f = field.evaluate(p);
             ASSERT_TRUE(f.defined);
             worst = std::max(worst, std::abs(f.value - (p.norm() - 1.0)));

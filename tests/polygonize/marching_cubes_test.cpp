@@ -9,8 +9,8 @@
 #include "pointform/geometry/shapes.h"
 #include "pointform/hermite/radius.h"
 #include "pointform/hermite/surfels.h"
-#include "pointform/spatial/kd_tree.h"
 #include "pointform/implicit/point_field.h"
+#include "pointform/spatial/kd_tree.h"
 
 #include <gtest/gtest.h>
 
