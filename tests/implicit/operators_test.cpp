@@ -11,6 +11,8 @@
 #include "pointform/implicit/transform.h"
 #include "pointform/polygonize/marching_cubes.h"
 
+#include "field_test_util.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -19,6 +21,9 @@
 
 namespace pointform {
 namespace {
+
+using test::numeric_gradient;
+using test::random_points;
 
 using FieldPtr = std::shared_ptr<const Field>;
 
@@ -35,30 +40,6 @@ FieldPtr sampled_sphere(const Vec3d& center, double radius, float influence,
     cloud.origin += center;
     cloud.radii.assign(cloud.size(), influence);
     return std::make_shared<const PointField>(std::move(cloud));
-}
-
-std::vector<Vec3d> random_points(const Aabb& box, int count, std::uint64_t seed)
-{
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    std::vector<Vec3d> points;
-    for (int i = 0; i < count; ++i)
-    {
-        const Vec3d t(u(rng), u(rng), u(rng));
-        points.emplace_back(box.min + t.cwiseProduct(box.max - box.min));
-    }
-    return points;
-}
-
-Vec3d numeric_gradient(const Field& f, const Vec3d& p, double h = 1e-6)
-{
-    Vec3d g;
-    for (int i = 0; i < 3; ++i)
-    {
-        const Vec3d e = h * Vec3d::Unit(i);
-        g[i] = (f.evaluate(p + e).value - f.evaluate(p - e).value) / (2.0 * h);
-    }
-    return g;
 }
 
 void expect_gradient_matches(const Field& f, const Aabb& box, int count, std::uint64_t seed)
