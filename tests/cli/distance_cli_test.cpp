@@ -7,6 +7,7 @@
 #include "pointform/io/io.h"
 
 #include "cli_run.h"
+#include "support/test_meshes.h"
 #include "support/test_support.h"
 
 #include <gtest/gtest.h>
@@ -25,18 +26,7 @@ using test::quoted;
 using test::run;
 using test::RunResult;
 
-/// Axis-aligned box [lo, hi] as 12 triangles.
-TriMesh box_mesh(const Vec3d& lo, const Vec3d& hi)
-{
-    TriMesh mesh;
-    for (int i = 0; i < 8; ++i)
-        mesh.vertices.positions.emplace_back(static_cast<float>((i & 1) != 0 ? hi.x() : lo.x()),
-                                             static_cast<float>((i & 2) != 0 ? hi.y() : lo.y()),
-                                             static_cast<float>((i & 4) != 0 ? hi.z() : lo.z()));
-    mesh.triangles = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
-                      {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
-    return mesh;
-}
+using test::box_mesh;
 
 const std::string bunny = quoted(test::data_path("meshes/bunny_uniform.off"));
 

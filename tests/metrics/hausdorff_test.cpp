@@ -12,7 +12,7 @@
 #include "pointform/metrics/surface_sampling.h"
 
 #include "support/test_support.h"
-#include "test_meshes.h"
+#include "support/test_meshes.h"
 
 #include <gtest/gtest.h>
 

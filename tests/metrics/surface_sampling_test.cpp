@@ -10,7 +10,7 @@
 #include "pointform/core/parallel.h"
 #include "pointform/spatial/triangle_bvh.h"
 
-#include "test_meshes.h"
+#include "support/test_meshes.h"
 
 #include <gtest/gtest.h>
 

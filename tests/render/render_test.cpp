@@ -10,66 +10,18 @@
 #include "pointform/core/parallel.h"
 #include "pointform/geometry/shapes.h"
 
+#include "support/test_meshes.h"
 #include "support/test_support.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <numbers>
 #include <utility>
 
 namespace pointform {
 namespace {
-
-/// An icosphere: the icosahedron, split 1-to-4 `levels` times, vertices pushed onto the sphere.
-/// Faces counter-clockwise seen from outside.
-TriMesh icosphere(int levels, double radius, const Vec3d& center = Vec3d::Zero())
-{
-    const double phi = (1.0 + std::sqrt(5.0)) / 2.0;
-    std::vector<Vec3d> v = {{-1, phi, 0}, {1, phi, 0}, {-1, -phi, 0}, {1, -phi, 0},
-                            {0, -1, phi}, {0, 1, phi}, {0, -1, -phi}, {0, 1, -phi},
-                            {phi, 0, -1}, {phi, 0, 1}, {-phi, 0, -1}, {-phi, 0, 1}};
-    std::vector<Triangle> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                               {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                               {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                               {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-    for (Vec3d& p : v)
-        p.normalize();
-    for (int level = 0; level < levels; ++level)
-    {
-        std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> midpoints;
-        const auto midpoint = [&](std::uint32_t a, std::uint32_t b) {
-            const auto key = std::minmax(a, b);
-            const auto found = midpoints.find(key);
-            if (found != midpoints.end())
-                return found->second;
-            v.push_back((v[a] + v[b]).normalized());
-            const auto index = static_cast<std::uint32_t>(v.size() - 1);
-            midpoints.emplace(key, index);
-            return index;
-        };
-        std::vector<Triangle> finer;
-        for (const Triangle& t : f)
-        {
-            const std::uint32_t ab = midpoint(t[0], t[1]);
-            const std::uint32_t bc = midpoint(t[1], t[2]);
-            const std::uint32_t ca = midpoint(t[2], t[0]);
-            finer.push_back({t[0], ab, ca});
-            finer.push_back({t[1], bc, ab});
-            finer.push_back({t[2], ca, bc});
-            finer.push_back({ab, bc, ca});
-        }
-        f = std::move(finer);
-    }
-    TriMesh mesh;
-    mesh.vertices.origin = center;
-    for (const Vec3d& p : v)
-        mesh.vertices.positions.push_back((radius * p).cast<float>());
-    mesh.triangles = std::move(f);
-    return mesh;
-}
 
 bool is_background(const Image& image, int x, int y, const RenderOptions& options)
 {
@@ -132,7 +84,7 @@ TEST(RenderMesh, SphereSilhouetteIsTheProjectedDisc)
 {
     const double r = 2.5;
     const Vec3d center(100.0, -40.0, 7.0); // off the origin: framing must follow the object
-    const TriMesh mesh = icosphere(4, r, center);
+    const TriMesh mesh = test::icosphere(4, center, r);
     RenderOptions options = front_orthographic();
     options.supersampling = 1; // count pixel centres inside the silhouette
     const Image image = render_mesh(mesh, options);
@@ -164,7 +116,7 @@ TEST(RenderMesh, SphereSilhouetteIsTheProjectedDisc)
 
 TEST(RenderMesh, HeadlightBrightnessIsCosineOfTheViewAngle)
 {
-    const TriMesh mesh = icosphere(4, 1.0);
+    const TriMesh mesh = test::icosphere(4, Vec3d::Zero(), 1.0);
     RenderOptions options = front_orthographic();
     options.ambient = 0.0;
     options.key_light = 0.0;
@@ -205,7 +157,7 @@ TEST(RenderMesh, HeadlightBrightnessIsCosineOfTheViewAngle)
 TEST(RenderMesh, BackFacesHaveTheirOwnColour)
 {
     // Inside out: every visible face is a back face.
-    TriMesh mesh = icosphere(3, 1.0);
+    TriMesh mesh = test::icosphere(3, Vec3d::Zero(), 1.0);
     for (Triangle& t : mesh.triangles)
         std::swap(t[1], t[2]);
     RenderOptions options = front_orthographic();
@@ -218,7 +170,7 @@ TEST(RenderMesh, BackFacesHaveTheirOwnColour)
 
     // A sphere with the cap facing the camera cut away: through the hole, the inside of the far
     // half shows back faces; the remaining rim of the near half shows front faces.
-    TriMesh open = icosphere(3, 1.0);
+    TriMesh open = test::icosphere(3, Vec3d::Zero(), 1.0);
     std::erase_if(open.triangles, [&](const Triangle& t) {
         double z = 0;
         for (const std::uint32_t v : t)
@@ -234,7 +186,7 @@ TEST(RenderMesh, BackFacesHaveTheirOwnColour)
 
 TEST(RenderMesh, WireframeDrawsTheEdgesOfVisibleFaces)
 {
-    const TriMesh mesh = icosphere(1, 1.0); // 80 faces: large triangles
+    const TriMesh mesh = test::icosphere(1, Vec3d::Zero(), 1.0); // 80 faces: large triangles
     RenderOptions options = front_orthographic();
     options.width = options.height = 400;
     const Image plain = render_mesh(mesh, options);
@@ -281,7 +233,7 @@ TEST(RenderMesh, WireframeLineWidthIsInPixels)
     // Darkened pixels grow with the total projected edge length, not with triangle size: the
     // same sphere at two resolutions darkens about 2× as many pixels per unit of edge length
     // when lines are 2× as wide.
-    const TriMesh mesh = icosphere(3, 1.0);
+    const TriMesh mesh = test::icosphere(3, Vec3d::Zero(), 1.0);
     RenderOptions options = front_orthographic();
     options.width = options.height = 300;
     const Image plain = render_mesh(mesh, options);
@@ -304,7 +256,7 @@ TEST(RenderMesh, WireframeLineWidthIsInPixels)
 TEST(RenderMesh, PerspectiveFramesTheObject)
 {
     // Any view: the object lies within the image, centred, touching the margin on one axis.
-    const TriMesh mesh = icosphere(3, 3.0, Vec3d(5, 5, 5));
+    const TriMesh mesh = test::icosphere(3, Vec3d(5, 5, 5), 3.0);
     for (const auto& [azimuth, elevation] :
          {std::pair{30.0, 20.0}, std::pair{-120.0, 60.0}, std::pair{0.0, 90.0}})
     {
@@ -333,7 +285,7 @@ TEST(RenderMesh, PerspectiveFramesTheObject)
 
 TEST(RenderMesh, SameImageWhateverTheThreadCount)
 {
-    const TriMesh mesh = icosphere(4, 1.0);
+    const TriMesh mesh = test::icosphere(4, Vec3d::Zero(), 1.0);
     RenderOptions options{.width = 200, .height = 150, .wireframe = true};
     set_thread_count(1);
     const Image one = render_mesh(mesh, options);
@@ -345,7 +297,7 @@ TEST(RenderMesh, SameImageWhateverTheThreadCount)
 
 TEST(RenderMesh, RejectsBadInput)
 {
-    TriMesh mesh = icosphere(1, 1.0);
+    TriMesh mesh = test::icosphere(1, Vec3d::Zero(), 1.0);
     TriMesh no_faces = mesh;
     no_faces.triangles.clear();
     EXPECT_THROW((void)render_mesh(no_faces), InvalidInput);

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Copyright (c) 2026 the pointform authors
 
-// Small analytic meshes for the metrics tests.
+// Small analytic meshes for tests: an icosphere, a box, a square grid.
 
 #pragma once
 
