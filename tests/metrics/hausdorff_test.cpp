@@ -11,8 +11,8 @@
 #include "pointform/io/io.h"
 #include "pointform/metrics/surface_sampling.h"
 
-#include "support/test_support.h"
 #include "support/test_meshes.h"
+#include "support/test_support.h"
 
 #include <gtest/gtest.h>
 
