@@ -40,13 +40,13 @@ const PointCloud& surfels()
     return cloud;
 }
 
-/// Queries within ±2% of the radius around the sphere, in Morton order when `coherent` (as
+/// Queries within ±`half_width` of the unit sphere, in Morton order when `coherent` (as
 /// polygonization asks: cell by cell along the surface) or in random order.
-std::vector<Vec3d> near_surface_queries(std::size_t n, bool coherent)
+std::vector<Vec3d> near_surface_queries(std::size_t n, bool coherent, double half_width)
 {
     std::mt19937_64 rng(3);
     std::normal_distribution<double> gauss;
-    std::uniform_real_distribution<double> shell(0.98, 1.02);
+    std::uniform_real_distribution<double> shell(1.0 - half_width, 1.0 + half_width);
     std::vector<Vec3d> points(n);
     for (Vec3d& p : points)
     {
@@ -74,8 +74,13 @@ void BM_FieldEvaluate(benchmark::State& state)
 {
     const auto fit = static_cast<PlaneFit>(state.range(0));
     const bool coherent = state.range(1) != 0;
+    const bool one_cell = state.range(2) != 0;
     const PointField field(surfels(), {.fit = fit});
-    const std::vector<Vec3d> points = near_surface_queries(1 << 20, coherent);
+    // Either within one default marching-cubes cell of the surface (where polygonization and
+    // projection evaluate), or within ±2% of the radius (about 6 sample spacings, mostly
+    // beyond the influence radii).
+    const double half_width = one_cell ? default_cell_size(field) : 0.02;
+    const std::vector<Vec3d> points = near_surface_queries(1 << 20, coherent, half_width);
     std::vector<FieldSample> out(points.size());
     for (auto _ : state)
     {
@@ -83,13 +88,14 @@ void BM_FieldEvaluate(benchmark::State& state)
         benchmark::DoNotOptimize(out.data());
     }
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * points.size()));
-    state.SetLabel(std::string(to_string(fit)) +
+    state.SetLabel(std::string(to_string(fit)) + (one_cell ? ", ±1 cell" : ", ±2%") +
                    (coherent ? ", Morton order, " : ", random order, ") +
                    std::to_string(thread_count()) + " thread(s)");
 }
 BENCHMARK(BM_FieldEvaluate)
     ->ArgsProduct({{static_cast<int>(PlaneFit::Raw), static_cast<int>(PlaneFit::Centroid),
                     static_cast<int>(PlaneFit::Blend)},
+                   {1, 0},
                    {1, 0}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#pragma once
+
+#include "pointform/core/types.h"
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace pointform {
+
+class KdTree;
+
+/// \brief A sparse uniform grid over float points for exact k-nearest queries near the points.
+///
+/// The points are stored cell by cell (cells in Morton order) and the occupied cells are found
+/// through a hash table, so a query reads a few short runs of contiguous memory instead of
+/// walking a tree. A query first scans the 2 × 2 × 2 cells around it, then 3 × 3 × 3, then
+/// 5 × 5 × 5, and stops as soon as the k-th nearest point found is closer than every point it
+/// has not scanned; a query farther from the points than that goes to the kd-tree. With a cell
+/// about twice the k-th neighbour distance of the points, queries near the surface they sample
+/// (as fields and polygonization ask) stop after the first 8 cells.
+///
+/// The results are exact and ties are broken in a fixed order (by grid slot), so they do not
+/// depend on the order of queries or on threads.
+class PointGrid
+{
+public:
+    /// \param points  the points (kept by copy, in grid order)
+    /// \param cell    the cell size, > 0 (grown if the points span more than 2^20 cells)
+    /// \param fallback a kd-tree over the same points, for queries far from them; must outlive
+    ///                 the grid
+    PointGrid(std::span<const Vec3f> points, float cell, const KdTree& fallback);
+
+    /// \brief The k nearest points to `query`, nearest first, as slots (positions in grid
+    /// order; original_index() maps them back).
+    /// \param slots, squared_distances  caller buffers of size >= k
+    /// \return how many were found: min(k, point count)
+    std::size_t knn(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
+                    std::span<float> squared_distances) const;
+
+    [[nodiscard]] std::uint32_t original_index(std::uint32_t slot) const { return order_[slot]; }
+    /// \brief Slots in all, padding included: callers that keep attributes in grid order size
+    /// them by this and fill the slots whose original_index() is not padding_slot.
+    [[nodiscard]] std::size_t slot_count() const { return order_.size(); }
+    /// \brief original_index() of a padding slot (cells are padded to whole vectors).
+    static constexpr std::uint32_t padding_slot = ~std::uint32_t{0};
+    [[nodiscard]] float cell_size() const { return cell_; }
+    [[nodiscard]] std::size_t size() const { return count_; }
+
+private:
+    struct Range
+    {
+        std::uint32_t begin = 0;
+        std::uint32_t end = 0;
+    };
+    struct Entry
+    {
+        std::uint64_t key = ~std::uint64_t{0};
+        Range range;
+    };
+    class Within;
+    struct OctantCache;
+
+    [[nodiscard]] Range cell_range(std::int64_t x, std::int64_t y, std::int64_t z) const;
+
+    const KdTree* fallback_;
+    std::uint64_t id_; ///< unique per grid ever built, so thread caches never mix grids
+    float cell_ = 0.0F;
+    float inv_cell_ = 0.0F;
+    Vec3f min_ = Vec3f::Zero();
+    std::size_t count_ = 0;
+    std::int64_t dims_ = 0; ///< cells per axis are < dims_ (a power-of-two bound for the keys)
+    std::vector<float> xs_, ys_, zs_;
+    std::vector<std::uint32_t> order_;
+    std::vector<std::uint32_t> slot_of_;
+    std::vector<Entry> table_;
+    std::uint64_t table_mask_ = 0;
+    int table_shift_ = 0;
+};
+
+} // namespace pointform

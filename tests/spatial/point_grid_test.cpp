@@ -1,0 +1,147 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/spatial/point_grid.h"
+
+#include "pointform/core/error.h"
+#include "pointform/geometry/shapes.h"
+#include "pointform/spatial/kd_tree.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <random>
+#include <vector>
+
+namespace pointform {
+namespace {
+
+/// Every squared distance, sorted with ties by index.
+std::vector<std::pair<float, std::uint32_t>> brute_sorted(std::span<const Vec3f> points,
+                                                          const Vec3f& q)
+{
+    std::vector<std::pair<float, std::uint32_t>> all;
+    for (std::uint32_t i = 0; i < points.size(); ++i)
+    {
+        all.emplace_back((points[i] - q).squaredNorm(), i);
+    }
+    std::sort(all.begin(), all.end());
+    return all;
+}
+
+void expect_exact(const PointGrid& grid, std::span<const Vec3f> points, const Vec3f& q,
+                  std::size_t k)
+{
+    std::vector<std::uint32_t> slots(k);
+    std::vector<float> d2(k);
+    const std::size_t found = grid.knn(q, k, slots, d2);
+    const auto truth = brute_sorted(points, q);
+    ASSERT_EQ(found, std::min(k, points.size()));
+    std::vector<std::uint32_t> seen;
+    for (std::size_t j = 0; j < found; ++j)
+    {
+        // The same distances as brute force (to float rounding: the grid sums in another
+        // order), each belonging to the point reported; ties may pick either tied point.
+        const std::uint32_t index = grid.original_index(slots[j]);
+        ASSERT_LT(index, points.size());
+        EXPECT_FLOAT_EQ(d2[j], truth[j].first) << "query " << q.transpose() << " rank " << j;
+        EXPECT_FLOAT_EQ(d2[j], (points[index] - q).squaredNorm()) << "rank " << j;
+        seen.push_back(index);
+    }
+    std::sort(seen.begin(), seen.end());
+    EXPECT_EQ(std::adjacent_find(seen.begin(), seen.end()), seen.end()) << "a point twice";
+}
+
+TEST(PointGrid, KnnOnASurfaceMatchesBruteForceNearAndFar)
+{
+    // A sphere sampled like a scan; queries on it, off it by up to a few cells, and far away
+    // (which the grid hands to the kd-tree).
+    const PointCloud cloud = sample_shape(Shape::Sphere, {.count = 3000, .seed = 5});
+    const KdTree tree(cloud.positions);
+    for (const float cell : {0.02F, 0.1F, 0.5F})
+    {
+        const PointGrid grid(cloud.positions, cell, tree);
+        std::mt19937_64 rng(11);
+        std::normal_distribution<float> gauss;
+        std::uniform_real_distribution<float> radius(0.0F, 3.0F);
+        for (int q = 0; q < 300; ++q)
+        {
+            const Vec3f dir = Vec3f(gauss(rng), gauss(rng), gauss(rng)).normalized();
+            const float r = q < 200 ? 1.0F + 0.05F * gauss(rng) : radius(rng);
+            for (const std::size_t k : {1U, 9U, 17U})
+            {
+                expect_exact(grid, cloud.positions, dir * r, k);
+            }
+        }
+    }
+}
+
+TEST(PointGrid, TiesAreExactAndRepeatable)
+{
+    // A lattice queried at cell corners and centres: many neighbours at equal distances.
+    std::vector<Vec3f> points;
+    for (int z = 0; z < 6; ++z)
+    {
+        for (int y = 0; y < 6; ++y)
+        {
+            for (int x = 0; x < 6; ++x)
+            {
+                points.emplace_back(static_cast<float>(x), static_cast<float>(y),
+                                    static_cast<float>(z));
+            }
+        }
+    }
+    std::reverse(points.begin(), points.end());
+    const KdTree tree(points);
+    const PointGrid grid(points, 1.5F, tree);
+    for (const Vec3f& q : {Vec3f(2.5F, 2.5F, 2.5F), Vec3f(2.0F, 3.0F, 1.0F),
+                           Vec3f(0.5F, 0.0F, 0.0F), Vec3f(5.0F, 5.0F, 2.5F)})
+    {
+        expect_exact(grid, points, q, 8);
+        // Asked again after other queries (the thread's cache of cells changed), the same
+        // answer.
+        std::array<std::uint32_t, 8> first{};
+        std::array<std::uint32_t, 8> again{};
+        std::array<float, 8> d2{};
+        grid.knn(q, 8, first, d2);
+        grid.knn(Vec3f(0, 0, 0), 8, again, d2);
+        grid.knn(q, 8, again, d2);
+        EXPECT_EQ(first, again);
+    }
+}
+
+TEST(PointGrid, FewPointsDuplicatesAndNonFiniteQueries)
+{
+    const std::vector<Vec3f> points = {Vec3f(1, 1, 1), Vec3f(1, 1, 1), Vec3f(2, 0, 0)};
+    const KdTree tree(points);
+    const PointGrid grid(points, 0.1F, tree);
+    expect_exact(grid, points, Vec3f(1, 1, 1.01F), 5); // k beyond the count
+    expect_exact(grid, points, Vec3f(1e6F, -1e6F, 0), 2);
+
+    const std::vector<Vec3f> none;
+    const KdTree empty_tree(none);
+    const PointGrid empty(none, 1.0F, empty_tree);
+    std::vector<std::uint32_t> slots(3);
+    std::vector<float> d2(3);
+    EXPECT_EQ(empty.knn(Vec3f::Zero(), 3, slots, d2), 0U);
+
+    EXPECT_THROW(PointGrid(points, 0.0F, tree), InvalidInput);
+    EXPECT_THROW(PointGrid(points, -1.0F, tree), InvalidInput);
+}
+
+TEST(PointGrid, FarOutlierGrowsTheCellsButStaysExact)
+{
+    PointCloud cloud = sample_shape(Shape::Sphere, {.count = 500, .seed = 2});
+    cloud.positions.emplace_back(3e6F, 0.0F, 0.0F);
+    const KdTree tree(cloud.positions);
+    const PointGrid grid(cloud.positions, 0.01F, tree);
+    EXPECT_GT(grid.cell_size(), 0.01F);
+    for (const Vec3f& q : {Vec3f(1, 0, 0), Vec3f(0, 0.7F, 0.7F), Vec3f(2.9e6F, 0, 0)})
+    {
+        expect_exact(grid, cloud.positions, q, 4);
+    }
+}
+
+} // namespace
+} // namespace pointform
