@@ -26,7 +26,7 @@ struct McCommandOptions
     std::string output;
     int resolution = 0;
     double cell = 0.0;
-    std::string fit = "blend";
+    std::string fit = "quadric";
     SurfelInputOptions surfels;
     bool ascii = false;
     bool json = false;
@@ -106,7 +106,7 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
     std::printf("%s -> %s\n", options.input.c_str(), options.output.c_str());
     print_row("samples", std::to_string(input.surfels.size()) +
                              (input.estimated_normals ? " (normals estimated)" : " (surfels)"));
-    print_row("cell", format_number(cell) + " (" + options.fit + " planes)");
+    print_row("cell", format_number(cell) + " (" + options.fit + " field)");
     print_row("vertices", std::to_string(result.mesh.vertex_count()));
     print_row("faces", std::to_string(result.mesh.face_count()));
     print_row("components", std::to_string(topo.components));
@@ -147,10 +147,11 @@ void register_mc(CLI::App& app, const GlobalOptions& global)
         ->check(CLI::PositiveNumber)
         ->excludes(resolution);
     cmd->add_option("--fit", options->fit,
-                    "Tangent planes of the field: blend (smooth blend of nearby centroid planes, "
-                    "most accurate on noisy scans), centroid (Hoppe) or raw (the paper's)")
+                    "Local surfaces of the field: quadric (smooth blend of nearby local quadric "
+                    "fits, the most accurate on exact and on noisy samples), blend (of centroid "
+                    "planes), centroid (Hoppe's plane) or raw (the paper's plane)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"blend", "centroid", "raw"}));
+        ->check(CLI::IsMember({"quadric", "blend", "centroid", "raw"}));
     add_surfel_input_options(*cmd, options->surfels);
     cmd->add_flag("--ascii", options->ascii, "Write ascii PLY instead of binary");
     cmd->add_flag("--json", options->json, "Print the report as JSON");

@@ -81,10 +81,11 @@ void add_scene_command_options(CLI::App& cmd, SceneCommandOptions& options)
     cmd.add_option("--bounds", options.bounds,
                    "Box to polygonize, xmin,ymin,zmin,xmax,ymax,zmax (default: the scene's "
                    "bounds; required when the scene is unbounded, e.g. a half_space in a union)");
-    cmd.add_option("--fit", options.fit,
-                   "Tangent planes of the scans' fields: blend, centroid or raw (see `mc`)")
+    cmd.add_option(
+           "--fit", options.fit,
+           "Local surfaces of the scans' fields: quadric, blend, centroid or raw (see `mc`)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"blend", "centroid", "raw"}));
+        ->check(CLI::IsMember({"quadric", "blend", "centroid", "raw"}));
     add_surfel_input_options(cmd, options.surfels);
     cmd.add_flag("--ascii", options.ascii, "Write ascii PLY instead of binary");
     cmd.add_flag("--json", options.json, "Print the report as JSON");

@@ -26,7 +26,7 @@ struct SceneCommandOptions
     int resolution = 0;
     double cell = 0.0;
     std::string bounds;
-    std::string fit = "blend";
+    std::string fit = "quadric";
     SurfelInputOptions surfels;
     bool ascii = false;
     bool json = false;

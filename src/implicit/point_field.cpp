@@ -4,8 +4,11 @@
 #include "pointform/implicit/point_field.h"
 
 #include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/point_grid.h"
+
+#include <Eigen/Cholesky>
 
 #include <algorithm>
 #include <array>
@@ -24,6 +27,12 @@ constexpr std::size_t max_blend_k = 32;
 /// of the surface (bench/implicit). Smaller cells send more queries to the 3 × 3 × 3 block,
 /// larger ones scan more points.
 constexpr float grid_cell_scale = 2.5F;
+
+/// Whether the field blends the surfaces of several samples (or takes the nearest one's).
+bool blends(PlaneFit fit)
+{
+    return fit == PlaneFit::Blend || fit == PlaneFit::Quadric;
+}
 
 void check_surfels(const PointCloud& cloud)
 {
@@ -68,8 +77,12 @@ PlaneFit parse_plane_fit(std::string_view text)
     {
         return PlaneFit::Blend;
     }
+    if (text == "quadric")
+    {
+        return PlaneFit::Quadric;
+    }
     throw InvalidInput("unknown plane fit '" + std::string(text) +
-                       "' (expected raw, centroid or blend)");
+                       "' (expected raw, centroid, blend or quadric)");
 }
 
 std::string_view to_string(PlaneFit fit)
@@ -82,27 +95,138 @@ std::string_view to_string(PlaneFit fit)
             return "centroid";
         case PlaneFit::Blend:
             return "blend";
+        case PlaneFit::Quadric:
+            return "quadric";
     }
     return "?";
 }
 
 /// What the field reads of one sample, packed in the grid's order so that the samples a query
 /// meets are next to each other in memory.
+///
+/// Each sample carries a local surface: in the frame (t1, t2, n) at the sample, the height
+/// h(u, v) = a + b u + c v + d u² + e uv + f v² over its tangent plane. The paper's plane is
+/// h = 0 (Raw), Hoppe's centroid plane h = a (Centroid, Blend), and the local quadric fit all
+/// six (Quadric).
 struct PackedSurfel
 {
     Vec3f position;
-    /// n·(c − s): the offset of the centroid plane along the normal (zero for Raw).
-    float offset;
-    Vec3f normal;
     float radius;
+    Vec3f normal;
+    float a; ///< height of the surface over the sample along the normal
+    Vec3f tangent;
+    float b;
+    float c, d, e, f;
 
-    /// Signed distance of `p` (relative to the cloud origin) to the sample's plane.
-    [[nodiscard]] double plane_distance(const Vec3d& p) const
+    /// Signed distance of `p` (relative to the cloud origin) to the sample's surface, measured
+    /// along the normal, and its gradient.
+    [[nodiscard]] double distance(const Vec3d& p, Vec3d* gradient) const
     {
-        return (p - position.cast<double>()).dot(normal.cast<double>()) -
-               static_cast<double>(offset);
+        const Vec3d x = p - position.cast<double>();
+        const Vec3d n = normal.cast<double>();
+        const Vec3d t1 = tangent.cast<double>();
+        const Vec3d t2 = n.cross(t1);
+        const double u = x.dot(t1);
+        const double v = x.dot(t2);
+        const auto coef = [](float value) {
+            return static_cast<double>(value);
+        };
+        const double height = coef(a) + coef(b) * u + coef(c) * v + coef(d) * u * u +
+                              coef(e) * u * v + coef(f) * v * v;
+        if (gradient != nullptr)
+        {
+            *gradient = n - (coef(b) + 2.0 * coef(d) * u + coef(e) * v) * t1 -
+                        (coef(c) + coef(e) * u + 2.0 * coef(f) * v) * t2;
+        }
+        return x.dot(n) - height;
     }
 };
+
+/// A unit vector perpendicular to the unit vector n, the same for the same n.
+Vec3f tangent_of(const Vec3f& n)
+{
+    const Vec3f axis = std::abs(n.x()) < 0.9F ? Vec3f::UnitX() : Vec3f::UnitY();
+    return n.cross(axis).normalized();
+}
+
+/// The local surface of sample i (see PackedSurfel) from its neighbours (the sample first).
+void fit_local_surface(const PointCloud& cloud, std::span<const std::uint32_t> neighbors,
+                       std::size_t i, PlaneFit fit, PackedSurfel& out)
+{
+    const Vec3d s = cloud.positions[i].cast<double>();
+    const Vec3d n = out.normal.cast<double>();
+    const Vec3d t1 = out.tangent.cast<double>();
+    const Vec3d t2 = n.cross(t1);
+    out.a = out.b = out.c = out.d = out.e = out.f = 0.0F;
+    if (fit == PlaneFit::Raw)
+    {
+        return;
+    }
+    double mean_height = 0.0;
+    for (const std::uint32_t j : neighbors)
+    {
+        mean_height += (cloud.positions[j].cast<double>() - s).dot(n);
+    }
+    mean_height /= static_cast<double>(neighbors.size());
+    out.a = static_cast<float>(mean_height);
+    if (fit != PlaneFit::Quadric)
+    {
+        return;
+    }
+    // The quadric's neighbourhood is wide enough to reach across a thin wall: samples facing
+    // more than 60° away belong to another sheet and are left out.
+    double scale2 = 0.0;
+    std::size_t used = 0;
+    for (const std::uint32_t j : neighbors)
+    {
+        if (cloud.normals[j].dot(out.normal) > 0.5F)
+        {
+            scale2 = std::max(scale2, (cloud.positions[j].cast<double>() - s).squaredNorm());
+            ++used;
+        }
+    }
+    if (used < 10 || !(scale2 > 0.0))
+    {
+        return; // too few to fit six coefficients: keep the centroid plane
+    }
+    // Least squares in coordinates scaled to the neighbourhood, for a well-conditioned system.
+    const double inv_scale = 1.0 / std::sqrt(scale2);
+    Eigen::Matrix<double, 6, 6> normal_matrix = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
+    for (const std::uint32_t j : neighbors)
+    {
+        if (!(cloud.normals[j].dot(out.normal) > 0.5F))
+        {
+            continue;
+        }
+        const Vec3d x = (cloud.positions[j].cast<double>() - s) * inv_scale;
+        const double u = x.dot(t1);
+        const double v = x.dot(t2);
+        Eigen::Matrix<double, 6, 1> row;
+        row << 1.0, u, v, u * u, u * v, v * v;
+        normal_matrix.selfadjointView<Eigen::Lower>().rankUpdate(row);
+        rhs += row * x.dot(n);
+    }
+    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(
+        normal_matrix.selfadjointView<Eigen::Lower>());
+    const auto pivots = solver.vectorD();
+    if (solver.info() != Eigen::Success || !(pivots.minCoeff() > 1e-6 * pivots.maxCoeff()))
+    {
+        return; // neighbours on a line, or too few spread: keep the centroid plane
+    }
+    const Eigen::Matrix<double, 6, 1> coef = solver.solve(rhs);
+    if (!coef.allFinite())
+    {
+        return;
+    }
+    const double scale = std::sqrt(scale2);
+    out.a = static_cast<float>(coef[0] * scale);
+    out.b = static_cast<float>(coef[1]);
+    out.c = static_cast<float>(coef[2]);
+    out.d = static_cast<float>(coef[3] * inv_scale);
+    out.e = static_cast<float>(coef[4] * inv_scale);
+    out.f = static_cast<float>(coef[5] * inv_scale);
+}
 
 struct PointField::Impl
 {
@@ -123,7 +247,7 @@ struct PointField::Impl
 PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
 {
     check_surfels(surfels);
-    if (options.fit == PlaneFit::Blend && (options.blend_k < 2 || options.blend_k > max_blend_k))
+    if (blends(options.fit) && (options.blend_k < 2 || options.blend_k > max_blend_k))
     {
         throw InvalidInput("point field: blend_k must be between 2 and " +
                            std::to_string(max_blend_k));
@@ -131,6 +255,10 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
     if (options.fit != PlaneFit::Raw && options.centroid_k < 2)
     {
         throw InvalidInput("point field: centroid_k must be at least 2");
+    }
+    if (options.fit == PlaneFit::Quadric && options.quadric_k < 2)
+    {
+        throw InvalidInput("point field: quadric_k must be at least 2");
     }
     impl_ = std::make_unique<Impl>(std::move(surfels), options);
     Impl& m = *impl_;
@@ -140,8 +268,9 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
         m.surfels.normals[i].normalize();
     }
 
-    std::vector<float> plane_offset(n, 0.0F);
-    const std::size_t k = std::min(std::max<std::size_t>(options.centroid_k, 2) + 1, n);
+    const std::size_t fit_k =
+        options.fit == PlaneFit::Quadric ? options.quadric_k : options.centroid_k;
+    const std::size_t k = std::min(std::max<std::size_t>(fit_k, 2) + 1, n);
     const KnnTable knn = knn_batch(m.tree, m.surfels.positions, k);
     double area = 0.0;
     for (std::size_t i = 0; i < n; ++i)
@@ -149,24 +278,12 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
         // The ball to the last neighbour holds k samples: π d² / k of surface per sample.
         area += std::numbers::pi * static_cast<double>(knn.distances2(i)[k - 1]) /
                 static_cast<double>(k);
-        if (options.fit == PlaneFit::Raw)
-        {
-            continue;
-        }
-        Vec3d centroid = Vec3d::Zero();
-        for (const std::uint32_t j : knn.neighbors(i))
-        {
-            centroid += m.surfels.positions[j].cast<double>();
-        }
-        centroid /= static_cast<double>(k);
-        plane_offset[i] = static_cast<float>((centroid - m.surfels.positions[i].cast<double>())
-                                                 .dot(m.surfels.normals[i].cast<double>()));
     }
     m.area = area;
 
     // Grid cells of about twice a query's farthest neighbour, so that queries near the surface
     // find their neighbours in the 8 cells around them (PointGrid).
-    const std::size_t query_k = options.fit == PlaneFit::Blend ? options.blend_k + 1 : 9;
+    const std::size_t query_k = blends(options.fit) ? options.blend_k + 1 : 9;
     std::vector<float> reach(n);
     for (std::size_t i = 0; i < n; ++i)
     {
@@ -176,16 +293,23 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
     std::nth_element(reach.begin(), reach_middle, reach.end());
     const float cell = grid_cell_scale * std::sqrt(*reach_middle);
     m.grid = std::make_unique<PointGrid>(m.surfels.positions, cell > 0.0F ? cell : 1.0F, m.tree);
-    m.packed.resize(m.grid->slot_count());
-    for (std::size_t slot = 0; slot < m.packed.size(); ++slot)
-    {
-        const std::uint32_t i = m.grid->original_index(static_cast<std::uint32_t>(slot));
-        if (i != PointGrid::padding_slot)
+    m.packed.assign(m.grid->slot_count(), PackedSurfel{});
+    parallel_blocks(m.packed.size(), 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t slot = begin; slot < end; ++slot)
         {
-            m.packed[slot] = PackedSurfel{m.surfels.positions[i], plane_offset[i],
-                                          m.surfels.normals[i], m.surfels.radii[i]};
+            const std::uint32_t i = m.grid->original_index(static_cast<std::uint32_t>(slot));
+            if (i == PointGrid::padding_slot)
+            {
+                continue;
+            }
+            PackedSurfel& packed = m.packed[slot];
+            packed.position = m.surfels.positions[i];
+            packed.radius = m.surfels.radii[i];
+            packed.normal = m.surfels.normals[i];
+            packed.tangent = tangent_of(packed.normal);
+            fit_local_surface(m.surfels, knn.neighbors(i), i, options.fit, packed);
         }
-    }
+    });
 
     float max_radius = 0.0F;
     for (const float r : m.surfels.radii)
@@ -213,25 +337,22 @@ FieldSample PointField::evaluate(const Vec3d& world_point) const
 
     std::array<std::uint32_t, max_blend_k + 1> slot{};
     std::array<float, max_blend_k + 1> dist2{};
-    if (m.options.fit != PlaneFit::Blend)
+    if (!blends(m.options.fit))
     {
         m.grid->knn(query, 1, slot, dist2);
         const PackedSurfel& nearest = m.packed[slot[0]];
         const double distance = (p - nearest.position.cast<double>()).norm();
-        const double plane = nearest.plane_distance(p);
+        const double plane = nearest.distance(p, &out.gradient);
         out.defined = distance <= static_cast<double>(nearest.radius);
         out.value = out.defined ? plane : std::copysign(distance, plane);
-        out.gradient = nearest.normal.cast<double>();
         return out;
     }
 
-    // Blend: the blend_k nearest planes, weights vanishing at the (blend_k + 1)-th distance.
+    // Blend: the blend_k nearest surfaces, weights vanishing at the (blend_k + 1)-th distance.
     const std::size_t want = std::min(m.options.blend_k + 1, m.surfels.size());
     const std::size_t found =
         m.grid->knn(query, want, std::span(slot.data(), want), std::span(dist2.data(), want));
     const PackedSurfel& nearest = m.packed[slot[0]];
-    const double nearest_distance = (p - nearest.position.cast<double>()).norm();
-    const double nearest_plane = nearest.plane_distance(p);
     // Defined inside the union of the blended samples' influence balls, so that a gap next to
     // a sample with a small radius is covered by its neighbours' balls.
     out.defined = false;
@@ -242,7 +363,8 @@ FieldSample PointField::evaluate(const Vec3d& world_point) const
     }
     if (!out.defined)
     {
-        out.value = std::copysign(nearest_distance, nearest_plane);
+        const double nearest_distance = (p - nearest.position.cast<double>()).norm();
+        out.value = std::copysign(nearest_distance, nearest.distance(p, nullptr));
         out.gradient = nearest.normal.cast<double>();
         return out;
     }
@@ -256,12 +378,11 @@ FieldSample PointField::evaluate(const Vec3d& world_point) const
     }
     if (!(bandwidth > 0.0))
     {
-        out.value = nearest_plane;
-        out.gradient = nearest.normal.cast<double>();
+        out.value = nearest.distance(p, &out.gradient);
         return out;
     }
-    // One pass: with w_i the weights, d_i the plane distances and g_i = ∇w_i,
-    // f = Σ w_i d_i / Σ w_i and ∇f = (Σ w_i n_i + Σ g_i d_i − f Σ g_i) / Σ w_i.
+    // One pass: with w_i the weights, d_i the distances to the samples' surfaces and
+    // g_i = ∇w_i, f = Σ w_i d_i / Σ w_i and ∇f = (Σ w_i ∇d_i + Σ g_i d_i − f Σ g_i) / Σ w_i.
     const double inv_h = 1.0 / bandwidth;
     double weight_sum = 0.0;
     double value_sum = 0.0;
@@ -278,8 +399,8 @@ FieldSample PointField::evaluate(const Vec3d& world_point) const
         const double weight = u3 * u * (4.0 * t + 1.0); // Wendland's C² kernel (1 − t)⁴(4t + 1)
         // d/dp of (1 − t)⁴(4t + 1) with t = ‖p − s_i‖/h: −20 (1 − t)³ (p − s_i)/h².
         const Vec3d weight_gradient = (-20.0 * u3 * inv_h * inv_h) * offset;
-        const Vec3d normal = sample.normal.cast<double>();
-        const double plane = offset.dot(normal) - static_cast<double>(sample.offset);
+        Vec3d normal;
+        const double plane = sample.distance(p, &normal);
         weight_sum += weight;
         value_sum += weight * plane;
         normal_sum += weight * normal;
@@ -288,8 +409,7 @@ FieldSample PointField::evaluate(const Vec3d& world_point) const
     }
     if (!(weight_sum > 1e-12))
     {
-        out.value = nearest_plane;
-        out.gradient = nearest.normal.cast<double>();
+        out.value = nearest.distance(p, &out.gradient);
         return out;
     }
     out.value = value_sum / weight_sum;

@@ -234,14 +234,33 @@ TEST(PointField, SmoothPlanesAreMoreAccurateOnNoisyScans)
     const double raw = rms_on_true_sphere(PointField(surfels, {.fit = PlaneFit::Raw}));
     const double centroid = rms_on_true_sphere(PointField(surfels, {.fit = PlaneFit::Centroid}));
     const double blend = rms_on_true_sphere(PointField(surfels, {.fit = PlaneFit::Blend}));
+    const double quadric = rms_on_true_sphere(PointField(surfels, {.fit = PlaneFit::Quadric}));
     RecordProperty("rms_raw", std::to_string(raw));
     RecordProperty("rms_centroid", std::to_string(centroid));
     RecordProperty("rms_blend", std::to_string(blend));
+    RecordProperty("rms_quadric", std::to_string(quadric));
     // The raw planes carry the noise; averaging over a neighbourhood removes most of it.
     EXPECT_GT(raw, 0.7 * sigma);
     EXPECT_LT(centroid, 0.6 * raw);
     EXPECT_LT(blend, 0.6 * raw);
     EXPECT_LE(blend, centroid * 1.05);
+    // The quadrics' wider neighbourhood averages more noise than the centroid planes.
+    EXPECT_LE(quadric, blend);
+}
+
+TEST(PointField, QuadricsFollowCurvatureThatPlanesCutThrough)
+{
+    // Exact samples of the unit sphere: the centroid planes sit inside the curved surface by
+    // about ρ²/4R (ρ the neighbourhood's radius), the local quadrics follow it.
+    const PointCloud exact = sample_shape(Shape::Sphere, {.count = 30000, .seed = 4});
+    const PointCloud surfels = compute_surfels(exact).surfels;
+    const double spacing = std::sqrt(4.0 * std::numbers::pi / 30000.0);
+    const double blend = rms_on_true_sphere(PointField(surfels, {.fit = PlaneFit::Blend}));
+    const double quadric = rms_on_true_sphere(PointField(surfels, {.fit = PlaneFit::Quadric}));
+    RecordProperty("rms_blend", std::to_string(blend));
+    RecordProperty("rms_quadric", std::to_string(quadric));
+    EXPECT_GT(blend, 0.02 * spacing);
+    EXPECT_LT(quadric, 1e-3 * spacing);
 }
 
 TEST(PointField, RejectsSurfelsItCannotUse)

@@ -1,0 +1,170 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#pragma once
+
+#include "pointform/core/progress.h"
+#include "pointform/geometry/multires_mesh.h"
+#include "pointform/geometry/point_cloud.h"
+#include "pointform/implicit/field.h"
+
+#include <cstddef>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+namespace pointform {
+
+/// \brief Where a refinement first puts a new edge vertex, before projecting it (§5.2).
+enum class Predictor
+{
+    /// The midpoint of the parent edge.
+    Midpoint,
+    /// The modified butterfly subdivision rule (Zorin, Schröder and Sweldens 1996): the 8-point
+    /// stencil where the edge's interior ends are regular (valence 6; one end may lie on the
+    /// boundary if the stencil's wings exist), the extraordinary-vertex stencil of an irregular
+    /// interior end (averaged when both are irregular), the 4-point rule along boundary edges,
+    /// and the midpoint for an interior edge whose two ends lie on the boundary (a simplification
+    /// of Zorin's boundary rules). Projecting the prediction gives the paper's "displaced
+    /// butterfly" refinement.
+    Butterfly,
+};
+
+/// \brief Parses "midpoint" or "butterfly". \throw InvalidInput otherwise
+[[nodiscard]] Predictor parse_predictor(std::string_view text);
+[[nodiscard]] std::string_view to_string(Predictor predictor);
+
+/// \brief Options of refine_once() and refine().
+struct RefineOptions
+{
+    Predictor predictor = Predictor::Midpoint;
+    /// The search for the zero crossing along ±(edge normal) from the prediction reaches at most
+    /// this multiple of the parent edge's length (§5.2.2: "bounded by the local edge length").
+    double search_scale = 1.0;
+    /// Rounds of relaxation (§5.2.3): each moves every projected new vertex by the tangential
+    /// part of the move to the average of its 1-ring (umbrella), then projects it again; a move
+    /// that folds a face or finds no crossing is undone. 0 = none.
+    int relax_iterations = 1;
+    /// A child face is folded when the cosine between its normal and its parent face's normal is
+    /// at most this (0: the child faces away from its parent, or is degenerate).
+    double fold_cosine = 0.0;
+    /// refine(): the finest level J to reach at most (the level cap, `--levels J`).
+    std::size_t max_level = 6;
+    /// refine(): stop once the one-sided Hausdorff distance from the samples to M^J is below
+    /// this, in world units (§5.2.4). 0 = estimate_sampling_density(samples).
+    double sampling_density = 0.0;
+    /// refine(): also stop when a level lowers the Hausdorff distance by less than this
+    /// fraction of the previous level's: the samples that stay far are where no refinement
+    /// reaches (outliers, noise, samples beyond a hole's rim), and each further level would
+    /// quadruple the faces for nothing. 0 disables (refine to max_level unless the density is
+    /// reached).
+    double min_improvement = 0.05;
+    /// Optional progress report and cancellation, per stage of each level.
+    ProgressCallback progress;
+};
+
+/// \brief What one refinement M^i → M^(i+1) did.
+struct RefineLevelStats
+{
+    std::size_t level = 0;        ///< the level made, i + 1
+    std::size_t faces = 0;        ///< faces of the new level
+    std::size_t vertices = 0;     ///< vertices of the new level (all levels' vertices)
+    std::size_t new_vertices = 0; ///< vertices the split added
+    /// New vertices of a folded child face after projection along AW_FEN (§5.2.2) ...
+    std::size_t fold_vertices = 0;
+    /// ... of which projection along the vertex-based edge normal VEN removed the fold ...
+    std::size_t folds_fixed_by_ven = 0;
+    /// ... and of which neither did: VEN found no crossing, or the face stayed folded. These,
+    /// and neighbours whose faces fold in turn, went back to the prediction, or to the edge
+    /// midpoint if the prediction folds too; they are off the surface and also counted in
+    /// `unprojected`.
+    std::size_t folds_unresolved = 0;
+    /// New vertices that stayed off the surface, at the prediction: no crossing within reach
+    /// (the field is undefined there: a hole) or an unresolved fold.
+    std::size_t unprojected = 0;
+    /// Relaxation moves kept (summed over the rounds).
+    std::size_t relaxed = 0;
+    /// Relaxation moves undone because they folded a face or found no crossing.
+    std::size_t relax_undone = 0;
+    /// Child faces still folded at the end (cosine to the parent's normal ≤ fold_cosine);
+    /// 0 unless a prediction itself folds.
+    std::size_t folded_faces = 0;
+    /// One-sided Hausdorff distance max_s d(s, M^(i+1)) from the samples, world units; set
+    /// when samples were given.
+    std::optional<double> hausdorff;
+    /// Mean distance from the samples to M^(i+1); set when samples were given.
+    std::optional<double> mean_distance;
+    /// Wall-clock seconds of this refinement, the distance measurement included.
+    double seconds = 0.0;
+};
+
+/// \brief Why refine() stopped.
+enum class RefineStop
+{
+    BelowSamplingDensity, ///< the Hausdorff distance fell below the sampling density (§5.2.4)
+    LevelCap,             ///< options.max_level was reached first
+    Stalled, ///< a level improved the Hausdorff distance by less than options.min_improvement
+};
+
+[[nodiscard]] std::string_view to_string(RefineStop stop);
+
+/// \brief The outcome of refine().
+struct RefineReport
+{
+    /// One entry per level made, coarse to fine.
+    std::vector<RefineLevelStats> levels;
+    /// Hausdorff distance and mean distance from the samples to the finest level that refine()
+    /// started from.
+    double initial_hausdorff = 0.0;
+    double initial_mean_distance = 0.0;
+    /// The threshold used: options.sampling_density, or the estimate.
+    double sampling_density = 0.0;
+    RefineStop stop = RefineStop::LevelCap;
+};
+
+/// \brief The sampling density of a point set, the threshold of the stopping criterion
+/// (§5.2.4): the median, over the samples, of the distance to the nearest other sample (world
+/// units); coincident duplicates are skipped (the distance to the nearest distinct sample).
+/// \throw InvalidInput if the cloud has fewer than 2 distinct points
+[[nodiscard]] double estimate_sampling_density(const PointCloud& samples);
+
+/// \brief One refinement M^J → M^(J+1) of the finest level (§5.2).
+///
+/// 1. Split: every face 1-to-4 (MultiresMesh::split); the new vertex of edge e starts at the
+///    prediction (options.predictor).
+/// 2. Project: along ±AW_FEN(e), the area-weighted normal of e's one or two faces, to the
+///    nearest zero crossing where AW_FEN·∇f > 0 (project_to_zero), the search bounded by
+///    search_scale × |e|.
+/// 3. Folds: a child face whose normal is against its parent face's normal (cosine ≤
+///    fold_cosine) marks its new vertices; they are projected again from the prediction along
+///    VEN(e), the normalised sum of the area-weighted vertex normals of e's ends (§5.2.2). A
+///    vertex still in a folded face goes back to the prediction (then to the midpoint).
+/// 4. Relax (§5.2.3): relax_iterations rounds of the tangential umbrella move of every projected
+///    new vertex towards the average of its 1-ring in M^(J+1) (on the boundary: of its two
+///    boundary neighbours; tangent plane: the vertex's area-weighted normal), each followed by
+///    re-projection along that normal; moves that fold a face or lose the surface are undone.
+/// Old vertices never move. Where no crossing is found (the field undefined: a hole), the new
+/// vertex keeps its prediction and is counted in `unprojected`. Every per-vertex step runs in
+/// parallel into its own slot (Jacobi style), so the result does not depend on the thread
+/// count.
+/// \param samples  optional; when given, the stats carry the one-sided Hausdorff distance from
+///                 them to M^(J+1)
+/// \throw InvalidInput if the hierarchy is empty, an option is out of range (search_scale not
+///        positive and finite, fold_cosine outside [-1, 1), relax_iterations < 0,
+///        sampling_density negative or not finite, min_improvement outside [0, 1)) or the new
+///        level would overflow 32-bit indices
+/// \throw Cancelled if the progress callback asks to stop (the new level is then removed)
+RefineLevelStats refine_once(MultiresMesh& mesh, const Field& field,
+                             const RefineOptions& options = {},
+                             const PointCloud* samples = nullptr);
+
+/// \brief Refines the finest level until the one-sided Hausdorff distance from `samples` to it
+/// is below the sampling density (§5.2.4), up to options.max_level, or until a level no longer
+/// improves it by options.min_improvement. Checks the criterion on the starting level first, so
+/// a hierarchy that already fits is left as it is.
+/// \throw InvalidInput as refine_once(), or if `samples` is empty
+/// \throw Cancelled if the progress callback asks to stop
+RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& samples,
+                    const RefineOptions& options = {});
+
+} // namespace pointform

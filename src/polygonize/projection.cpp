@@ -1,0 +1,163 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/polygonize/projection.h"
+
+#include "pointform/core/error.h"
+
+#include <cmath>
+#include <limits>
+
+namespace pointform {
+
+namespace {
+
+/// One sample of the field restricted to the line: g(t) = f(p + t·d).
+struct LineSample
+{
+    double t = 0.0;
+    double value = 0.0;
+    bool defined = false;
+};
+
+class Line
+{
+public:
+    Line(const Field& field, const Vec3d& p, const Vec3d& d) : field_(field), p_(p), d_(d) {}
+
+    [[nodiscard]] LineSample at(double t) const
+    {
+        const FieldSample s = field_.evaluate(point(t));
+        if (!std::isfinite(s.value))
+            return {t, std::numeric_limits<double>::quiet_NaN(), false};
+        return {t, s.value, s.defined};
+    }
+    [[nodiscard]] Vec3d point(double t) const { return p_ + t * d_; }
+
+private:
+    const Field& field_;
+    Vec3d p_;
+    Vec3d d_;
+};
+
+/// Refines a bracket lo.t < hi.t, lo.value < 0 <= hi.value, by Illinois regula falsi. Returns
+/// the parameter of the crossing, or nullopt if the located point is not a defined sample.
+std::optional<double> refine_bracket(const Line& line, LineSample lo, LineSample hi,
+                                     double tolerance, int max_iterations)
+{
+    if (hi.value == 0.0 && hi.defined)
+        return hi.t;
+    double flo = lo.value;
+    double fhi = hi.value;
+    int side = 0; // which end was replaced last time: -1 lo, +1 hi
+    for (int it = 0; it < max_iterations && hi.t - lo.t > tolerance; ++it)
+    {
+        double t = (lo.t * fhi - hi.t * flo) / (fhi - flo);
+        // Rounding can put the secant point on an end: bisect instead.
+        if (!(t > lo.t && t < hi.t))
+            t = 0.5 * (lo.t + hi.t);
+        const LineSample s = line.at(t);
+        if (std::isnan(s.value))
+            return std::nullopt;
+        // Undefined samples still carry the sign (field.h), which keeps the bracket valid; the
+        // final point must be defined. Values are distance-like, so |f| below the tolerance is
+        // as good as a small interval.
+        if (std::abs(s.value) <= tolerance)
+        {
+            if (s.defined)
+                return t;
+        }
+        if (s.value < 0.0)
+        {
+            lo = s;
+            flo = s.value;
+            if (side == -1)
+                fhi *= 0.5;
+            side = -1;
+        }
+        else
+        {
+            hi = s;
+            fhi = s.value;
+            if (side == +1)
+                flo *= 0.5;
+            side = +1;
+        }
+    }
+    // The interval is small: report its end nearer to zero. Where one end is undefined the
+    // crossing is real only if the defined end is itself (almost) on the zero set; otherwise the
+    // sign change is the rim of a hole (the surface ends there), not a crossing.
+    const LineSample& a = std::abs(lo.value) <= std::abs(hi.value) ? lo : hi;
+    const LineSample& b = (&a == &lo) ? hi : lo;
+    if (a.defined && (b.defined || std::abs(a.value) <= 16.0 * tolerance))
+        return a.t;
+    if (b.defined && std::abs(b.value) <= 16.0 * tolerance)
+        return b.t;
+    return std::nullopt;
+}
+
+} // namespace
+
+std::optional<Vec3d> project_to_zero(const Field& field, const Vec3d& p, const Vec3d& direction,
+                                     double max_distance)
+{
+    return project_to_zero(field, p, direction, max_distance, ProjectionOptions{});
+}
+
+std::optional<Vec3d> project_to_zero(const Field& field, const Vec3d& p, const Vec3d& direction,
+                                     double max_distance, const ProjectionOptions& options)
+{
+    if (options.steps < 1 || options.max_iterations < 1 ||
+        !(options.relative_tolerance > 0.0 && std::isfinite(options.relative_tolerance)))
+        throw InvalidInput(
+            "project_to_zero: steps and max_iterations must be >= 1 and the "
+            "tolerance positive and finite");
+    const double length = direction.norm();
+    if (!(length > 0.0) || !std::isfinite(length) || !(max_distance > 0.0) ||
+        !std::isfinite(max_distance) || !p.allFinite())
+        return std::nullopt;
+
+    const Line line(field, p, direction / length);
+    const double h = max_distance / options.steps;
+    const double tolerance = options.relative_tolerance * max_distance;
+
+    const LineSample centre = line.at(0.0);
+    if (centre.defined && centre.value == 0.0)
+    {
+        // Exactly on the surface: accept if the field grows along the direction.
+        const FieldSample s = field.evaluate(p);
+        if (s.gradient.dot(direction) > 0.0)
+            return p;
+    }
+
+    LineSample pos_prev = centre; // innermost sample of the positive side
+    LineSample neg_prev = centre; // innermost sample of the negative side
+    for (int k = 1; k <= options.steps; ++k)
+    {
+        const double r = k == options.steps ? max_distance : k * h;
+        const LineSample pos = line.at(r);
+        const LineSample neg = line.at(-r);
+
+        std::optional<double> best;
+        // Positive side: interval [pos_prev.t, pos.t], crossing when pos_prev < 0 <= pos.
+        // Undefined samples still carry the sign (field.h), so a band of definition thinner than
+        // a step is not jumped over; the located point must be defined.
+        if (pos_prev.value < 0.0 && pos.value >= 0.0)
+            best = refine_bracket(line, pos_prev, pos, tolerance, options.max_iterations);
+        // Negative side: interval [neg.t, neg_prev.t], crossing when neg < 0 <= neg_prev.
+        if (neg.value < 0.0 && neg_prev.value >= 0.0)
+        {
+            const std::optional<double> t =
+                refine_bracket(line, neg, neg_prev, tolerance, options.max_iterations);
+            if (t && (!best || std::abs(*t) < std::abs(*best)))
+                best = t;
+        }
+        if (best)
+            return line.point(*best);
+        pos_prev = pos;
+        neg_prev = neg;
+    }
+    return std::nullopt;
+}
+
+} // namespace pointform

@@ -1,0 +1,743 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/polygonize/refine.h"
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+#include "pointform/polygonize/projection.h"
+#include "pointform/spatial/kd_tree.h"
+#include "pointform/spatial/triangle_bvh.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <utility>
+
+namespace pointform {
+
+namespace {
+
+constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
+constexpr std::size_t vertex_block = 512;
+
+/// Halfedge h = 3f + k of a level goes from corner k to corner k + 1 of face f.
+constexpr std::uint32_t next_of(std::uint32_t h)
+{
+    return h - h % 3 + (h % 3 + 1) % 3;
+}
+constexpr std::uint32_t prev_of(std::uint32_t h)
+{
+    return h - h % 3 + (h % 3 + 2) % 3;
+}
+
+/// The connectivity of level i and how level i + 1 splits it.
+struct Level
+{
+    std::vector<Triangle> faces;            ///< level i
+    std::vector<std::uint32_t> edge_vertex; ///< halfedge → vertex of level i + 1 on its edge
+    std::vector<std::uint32_t> twin;        ///< halfedge → opposite halfedge, or none
+    std::vector<std::array<std::uint32_t, 2>> halfedges; ///< new vertex j → its 1 or 2 halfedges
+    std::vector<std::uint32_t> outgoing; ///< vertex → an outgoing halfedge (a boundary one
+                                         ///< on the boundary), or none if unused
+    std::uint32_t first_new = 0;         ///< index of the first vertex of level i + 1
+
+    [[nodiscard]] std::uint32_t from(std::uint32_t h) const { return faces[h / 3][h % 3]; }
+    [[nodiscard]] std::uint32_t to(std::uint32_t h) const { return from(next_of(h)); }
+    /// The vertex of a face opposite halfedge h.
+    [[nodiscard]] std::uint32_t opposite(std::uint32_t h) const { return from(prev_of(h)); }
+
+    /// The 1-ring of v in counter-clockwise order, starting with the end of its outgoing
+    /// halfedge `start`; `closed` says whether v is interior. For a boundary vertex `start` must
+    /// be its boundary halfedge.
+    void ring(std::uint32_t start, std::vector<std::uint32_t>& out, bool& closed) const
+    {
+        out.clear();
+        std::uint32_t h = start;
+        closed = true;
+        for (std::size_t guard = 0; guard <= faces.size(); ++guard)
+        {
+            out.push_back(to(h));
+            const std::uint32_t p = prev_of(h);
+            if (twin[p] == none)
+            {
+                out.push_back(from(p));
+                closed = false;
+                return;
+            }
+            h = twin[p];
+            if (h == start)
+                return;
+        }
+    }
+};
+
+Level build_level(const MultiresMesh& mesh, MultiresMesh::SplitResult split)
+{
+    const std::size_t i = split.level - 1;
+    Level level;
+    level.faces = std::move(split.faces);
+    level.edge_vertex = std::move(split.edge_vertices);
+    level.first_new = static_cast<std::uint32_t>(mesh.level_offsets()[i + 1]);
+    const std::size_t added = mesh.vertex_count(i + 1) - level.first_new;
+    const auto halfedge_count = static_cast<std::uint32_t>(level.edge_vertex.size());
+    level.halfedges.assign(added, {none, none});
+    for (std::uint32_t h = 0; h < halfedge_count; ++h)
+    {
+        auto& slot = level.halfedges[level.edge_vertex[h] - level.first_new];
+        (slot[0] == none ? slot[0] : slot[1]) = h;
+    }
+    level.twin.assign(halfedge_count, none);
+    for (const auto& [h1, h2] : level.halfedges)
+        if (h2 != none)
+        {
+            level.twin[h1] = h2;
+            level.twin[h2] = h1;
+        }
+    level.outgoing.assign(mesh.vertex_count(i), none);
+    for (std::uint32_t h = 0; h < halfedge_count; ++h)
+    {
+        std::uint32_t& out = level.outgoing[level.from(h)];
+        if (out == none || level.twin[h] == none)
+            out = h;
+    }
+    return level;
+}
+
+/// u × v of a triangle: twice its area times its unit normal.
+Vec3d area_normal(const Vec3d& a, const Vec3d& b, const Vec3d& c)
+{
+    return (b - a).cross(c - b);
+}
+
+/// Weights of the modified butterfly's extraordinary-vertex stencil for valence n (Zorin et al.
+/// 1996): the centre gets 3/4, ring vertex j (j = 0 the other end of the edge) gets s[j].
+std::vector<double> extraordinary_weights(std::size_t n)
+{
+    std::vector<double> s(n, 0.0);
+    if (n == 3)
+        s = {5.0 / 12.0, -1.0 / 12.0, -1.0 / 12.0};
+    else if (n == 4)
+        s = {3.0 / 8.0, 0.0, -1.0 / 8.0, 0.0};
+    else
+        for (std::size_t j = 0; j < n; ++j)
+        {
+            const double t =
+                2.0 * std::numbers::pi * static_cast<double>(j) / static_cast<double>(n);
+            s[j] = (0.25 + std::cos(t) + 0.5 * std::cos(2.0 * t)) / static_cast<double>(n);
+        }
+    return s;
+}
+
+/// The butterfly prediction of the edge of halfedge h1 (h2 its twin or none).
+Vec3d butterfly(const Level& level, std::span<const Vec3d> x, std::uint32_t h1, std::uint32_t h2,
+                std::vector<std::uint32_t>& ring)
+{
+    const std::uint32_t a = level.from(h1);
+    const std::uint32_t b = level.to(h1);
+    const Vec3d midpoint = 0.5 * (x[a] + x[b]);
+    if (h2 == none)
+    {
+        // Boundary edge: the 4-point rule along the boundary.
+        // Previous boundary vertex before a: rotate clockwise around a to its incoming boundary
+        // halfedge; next after b: b's outgoing boundary halfedge.
+        const std::uint32_t out_b = level.outgoing[b];
+        if (out_b == none || level.twin[out_b] != none)
+            return midpoint;
+        const std::uint32_t next_vertex = level.to(out_b);
+        std::uint32_t h = prev_of(h1); // into a
+        for (std::size_t guard = 0; level.twin[h] != none && guard <= level.faces.size(); ++guard)
+            h = prev_of(level.twin[h]);
+        if (level.twin[h] != none)
+            return midpoint;
+        const std::uint32_t prev_vertex = level.from(h);
+        return (9.0 / 16.0) * (x[a] + x[b]) - (1.0 / 16.0) * (x[prev_vertex] + x[next_vertex]);
+    }
+
+    // Interior edge: the stencil of each interior end, starting its ring at the other end.
+    bool closed = false;
+    const auto stencil = [&](std::uint32_t centre, std::uint32_t other,
+                             std::size_t& valence) -> std::optional<Vec3d> {
+        const std::uint32_t start = level.outgoing[centre];
+        level.ring(start, ring, closed);
+        if (!closed)
+            return std::nullopt;
+        valence = ring.size();
+        const auto it = std::find(ring.begin(), ring.end(), other);
+        if (it == ring.end())
+            return std::nullopt;
+        std::rotate(ring.begin(), it, ring.end());
+        const std::vector<double> s = extraordinary_weights(ring.size());
+        Vec3d p = 0.75 * x[centre];
+        for (std::size_t j = 0; j < ring.size(); ++j)
+            p += s[j] * x[ring[j]];
+        return p;
+    };
+    std::size_t valence_a = 0;
+    std::size_t valence_b = 0;
+    const std::optional<Vec3d> from_a = stencil(a, b, valence_a);
+    const std::optional<Vec3d> from_b = stencil(b, a, valence_b);
+    const bool regular_a = from_a && valence_a == 6;
+    const bool regular_b = from_b && valence_b == 6;
+    if ((regular_a && regular_b) || (regular_a && !from_b) || (regular_b && !from_a))
+    {
+        // Regular ends (one may lie on the boundary): the 8-point butterfly, if its wings exist.
+        const std::uint32_t c = level.opposite(h1);
+        const std::uint32_t d = level.opposite(h2);
+        const std::array<std::uint32_t, 4> sides = {next_of(h1), prev_of(h1), next_of(h2),
+                                                    prev_of(h2)};
+        if (std::all_of(sides.begin(), sides.end(),
+                        [&](std::uint32_t h) { return level.twin[h] != none; }))
+        {
+            Vec3d wings = Vec3d::Zero();
+            for (const std::uint32_t h : sides)
+                wings += x[level.opposite(level.twin[h])];
+            return 0.5 * (x[a] + x[b]) + 0.125 * (x[c] + x[d]) - 0.0625 * wings;
+        }
+        return regular_a && regular_b ? 0.5 * (*from_a + *from_b) : midpoint;
+    }
+    // An irregular interior end: its stencil (both irregular: the average).
+    if (from_a && from_b && !regular_a && !regular_b)
+        return 0.5 * (*from_a + *from_b);
+    if (from_a && !regular_a)
+        return *from_a;
+    if (from_b && !regular_b)
+        return *from_b;
+    return midpoint;
+}
+
+enum class State : std::uint8_t
+{
+    Projected,   ///< on the surface (AW_FEN, VEN or after relaxation)
+    Unprojected, ///< kept at the prediction: no crossing along AW_FEN
+    Reverted,    ///< kept at the prediction (or midpoint): a fold VEN did not remove
+};
+
+/// What a relaxation round did to one new vertex.
+enum class Move : std::uint8_t
+{
+    None,       ///< not relaxed (not on the surface)
+    Made,       ///< moved and re-projected
+    NoCrossing, ///< the re-projection found no crossing: not moved
+    Undone,     ///< moved, then put back because it folded a face
+};
+
+/// Marks, per child face of level i + 1 (4f + c), whether it is folded against its parent.
+void find_folds(const Level& level, std::span<const Vec3d> x, std::span<const Vec3d> parent_normal,
+                double fold_cosine, std::vector<char>& folded)
+{
+    folded.assign(4 * level.faces.size(), 0);
+    parallel_blocks(level.faces.size(), 1024, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t f = begin; f < end; ++f)
+        {
+            const Vec3d& n = parent_normal[f];
+            const double n_norm = n.norm();
+            if (!(n_norm > 0.0))
+                continue; // a degenerate parent gives no reference
+            const auto [a, b, c] = level.faces[f];
+            const std::uint32_t ab = level.edge_vertex[3 * f];
+            const std::uint32_t bc = level.edge_vertex[3 * f + 1];
+            const std::uint32_t ca = level.edge_vertex[3 * f + 2];
+            const std::array<Triangle, 4> children = {Triangle{a, ab, ca}, Triangle{ab, b, bc},
+                                                      Triangle{ca, bc, c}, Triangle{ab, bc, ca}};
+            for (std::size_t k = 0; k < 4; ++k)
+            {
+                const Triangle& t = children[k];
+                const Vec3d m = area_normal(x[t[0]], x[t[1]], x[t[2]]);
+                const double m_norm = m.norm();
+                const bool bad = !(m_norm > 0.0) || m.dot(n) <= fold_cosine * m_norm * n_norm;
+                folded[4 * f + k] = bad ? 1 : 0;
+            }
+        }
+    });
+}
+
+/// The new vertices (local indices) of the folded child faces, ascending, without repeats.
+std::vector<std::uint32_t> vertices_of_folds(const Level& level, const std::vector<char>& folded)
+{
+    std::vector<std::uint32_t> out;
+    for (std::size_t c = 0; c < folded.size(); ++c)
+    {
+        if (folded[c] == 0)
+            continue;
+        const std::size_t f = c / 4;
+        const std::uint32_t ab = level.edge_vertex[3 * f] - level.first_new;
+        const std::uint32_t bc = level.edge_vertex[3 * f + 1] - level.first_new;
+        const std::uint32_t ca = level.edge_vertex[3 * f + 2] - level.first_new;
+        switch (c % 4)
+        {
+            case 0:
+                out.insert(out.end(), {ab, ca});
+                break;
+            case 1:
+                out.insert(out.end(), {ab, bc});
+                break;
+            case 2:
+                out.insert(out.end(), {ca, bc});
+                break;
+            default:
+                out.insert(out.end(), {ab, bc, ca});
+                break;
+        }
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+}
+
+std::size_t count_folds(const std::vector<char>& folded)
+{
+    return static_cast<std::size_t>(std::count(folded.begin(), folded.end(), char{1}));
+}
+
+void check_options(const RefineOptions& options)
+{
+    if (!(options.search_scale > 0.0) || !std::isfinite(options.search_scale))
+        throw InvalidInput("refine: search_scale must be positive and finite");
+    if (!std::isfinite(options.fold_cosine) || options.fold_cosine >= 1.0 ||
+        options.fold_cosine < -1.0)
+        throw InvalidInput("refine: fold_cosine must lie in [-1, 1)");
+    if (options.relax_iterations < 0)
+        throw InvalidInput("refine: relax_iterations must not be negative");
+    if (!(options.sampling_density >= 0.0) || !std::isfinite(options.sampling_density))
+        throw InvalidInput("refine: sampling_density must be 0 (estimate) or positive");
+    if (!(options.min_improvement >= 0.0 && options.min_improvement < 1.0))
+        throw InvalidInput("refine: min_improvement must lie in [0, 1)");
+}
+
+struct Distances
+{
+    double hausdorff = 0.0;
+    double mean = 0.0;
+};
+
+Distances distances_from(const PointCloud& samples, const MultiresMesh& mesh,
+                         std::span<const Triangle> faces, std::size_t level,
+                         const ProgressCallback& progress)
+{
+    TriMesh surface;
+    surface.vertices.origin = mesh.origin();
+    const std::size_t n = mesh.vertex_count(level);
+    surface.vertices.positions.resize(n);
+    for (std::size_t v = 0; v < n; ++v)
+        surface.vertices.positions[v] = mesh.positions()[v].cast<float>();
+    surface.triangles.assign(faces.begin(), faces.end());
+    const TriangleBvh bvh(surface);
+    const std::vector<double> d = distances_to_mesh(bvh, samples, {.progress = progress});
+    Distances out;
+    double sum = 0.0;
+    for (const double value : d)
+    {
+        out.hausdorff = std::max(out.hausdorff, value);
+        sum += value;
+    }
+    out.mean = d.empty() ? 0.0 : sum / static_cast<double>(d.size());
+    return out;
+}
+
+/// Faces of level i + 1 (the children, in order).
+std::vector<Triangle> child_faces(const Level& level)
+{
+    std::vector<Triangle> out(4 * level.faces.size());
+    for (std::size_t f = 0; f < level.faces.size(); ++f)
+    {
+        const auto [a, b, c] = level.faces[f];
+        const std::uint32_t ab = level.edge_vertex[3 * f];
+        const std::uint32_t bc = level.edge_vertex[3 * f + 1];
+        const std::uint32_t ca = level.edge_vertex[3 * f + 2];
+        out[4 * f] = {a, ab, ca};
+        out[4 * f + 1] = {ab, b, bc};
+        out[4 * f + 2] = {ca, bc, c};
+        out[4 * f + 3] = {ab, bc, ca};
+    }
+    return out;
+}
+
+/// The refinement proper, on a hierarchy whose finest level was just split; returns the faces
+/// of the new level.
+std::vector<Triangle> refine_split_level(MultiresMesh& mesh, MultiresMesh::SplitResult split,
+                                         const Field& field, const RefineOptions& options,
+                                         RefineLevelStats& stats)
+{
+    const Level level = build_level(mesh, std::move(split));
+    const std::span<Vec3d> new_positions = mesh.finest_new_positions();
+    const std::span<const Vec3d> x = mesh.positions(); // all vertices; new ones change below
+    const std::size_t added = new_positions.size();
+    const Vec3d& origin = mesh.origin();
+    const std::size_t old_count = level.first_new;
+
+    // Normals of level i: per face (area-weighted), per vertex (sum over its faces, serial so
+    // the sums do not depend on the thread count).
+    std::vector<Vec3d> face_normal(level.faces.size());
+    parallel_blocks(level.faces.size(), 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t f = begin; f < end; ++f)
+        {
+            const auto [a, b, c] = level.faces[f];
+            face_normal[f] = area_normal(x[a], x[b], x[c]);
+        }
+    });
+    std::vector<Vec3d> vertex_normal(old_count, Vec3d::Zero());
+    for (std::size_t f = 0; f < level.faces.size(); ++f)
+        for (const std::uint32_t v : level.faces[f])
+            vertex_normal[v] += face_normal[f];
+
+    // Per new vertex: prediction, AW_FEN, VEN and search reach.
+    std::vector<Vec3d> prediction(added);
+    std::vector<Vec3d> aw_fen(added);
+    std::vector<Vec3d> ven(added);
+    std::vector<double> reach(added);
+    {
+        ProgressReporter reporter(options.progress, "refine: predict");
+        parallel_blocks(
+            added, vertex_block,
+            [&](std::size_t begin, std::size_t end) {
+                std::vector<std::uint32_t> ring;
+                for (std::size_t j = begin; j < end; ++j)
+                {
+                    const auto [h1, h2] = level.halfedges[j];
+                    const std::uint32_t a = level.from(h1);
+                    const std::uint32_t b = level.to(h1);
+                    prediction[j] = options.predictor == Predictor::Butterfly
+                                        ? butterfly(level, x, h1, h2, ring)
+                                        : Vec3d(0.5 * (x[a] + x[b]));
+                    Vec3d n = face_normal[h1 / 3];
+                    if (h2 != none)
+                        n += face_normal[h2 / 3];
+                    aw_fen[j] = n;
+                    const Vec3d na = vertex_normal[a].normalized();
+                    const Vec3d nb = vertex_normal[b].normalized();
+                    ven[j] = na + nb;
+                    reach[j] = options.search_scale * (x[a] - x[b]).norm();
+                }
+            },
+            &reporter);
+        reporter.finish();
+    }
+
+    // Project along AW_FEN.
+    std::vector<State> state(added, State::Unprojected);
+    {
+        ProgressReporter reporter(options.progress, "refine: project");
+        parallel_blocks(
+            added, vertex_block,
+            [&](std::size_t begin, std::size_t end) {
+                for (std::size_t j = begin; j < end; ++j)
+                {
+                    const std::optional<Vec3d> hit =
+                        project_to_zero(field, origin + prediction[j], aw_fen[j], reach[j]);
+                    new_positions[j] = hit ? Vec3d(*hit - origin) : prediction[j];
+                    state[j] = hit ? State::Projected : State::Unprojected;
+                }
+            },
+            &reporter);
+        reporter.finish();
+    }
+
+    // Folds: VEN for the vertices of folded child faces, then fall back to the prediction, then
+    // to the midpoint.
+    std::vector<char> folded;
+    find_folds(level, x, face_normal, options.fold_cosine, folded);
+    const std::vector<std::uint32_t> marked = vertices_of_folds(level, folded);
+    stats.fold_vertices = marked.size();
+    std::vector<char> used_ven(added, 0);
+    if (!marked.empty())
+    {
+        parallel_blocks(marked.size(), 64, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t m = begin; m < end; ++m)
+            {
+                const std::uint32_t j = marked[m];
+                const std::optional<Vec3d> hit =
+                    project_to_zero(field, origin + prediction[j], ven[j], reach[j]);
+                new_positions[j] = hit ? Vec3d(*hit - origin) : prediction[j];
+                state[j] = hit ? State::Projected : State::Reverted;
+                used_ven[j] = hit ? 1 : 0;
+            }
+        });
+        for (int fallback = 0; fallback < 2; ++fallback)
+        {
+            find_folds(level, x, face_normal, options.fold_cosine, folded);
+            std::vector<std::uint32_t> still = vertices_of_folds(level, folded);
+            // Repeat: putting one vertex back can fold a neighbour's face.
+            while (!still.empty())
+            {
+                bool changed = false;
+                for (const std::uint32_t j : still)
+                {
+                    const auto [h1, h2] = level.halfedges[j];
+                    const Vec3d midpoint = 0.5 * (x[level.from(h1)] + x[level.to(h1)]);
+                    const Vec3d target = fallback == 0 ? prediction[j] : midpoint;
+                    if (new_positions[j] != target)
+                    {
+                        new_positions[j] = target;
+                        state[j] = State::Reverted;
+                        used_ven[j] = 0;
+                        changed = true;
+                    }
+                }
+                if (!changed)
+                    break;
+                find_folds(level, x, face_normal, options.fold_cosine, folded);
+                still = vertices_of_folds(level, folded);
+            }
+        }
+        for (const std::uint32_t j : marked)
+            if (used_ven[j] != 0 && state[j] == State::Projected)
+                ++stats.folds_fixed_by_ven;
+    }
+
+    // Relaxation (§5.2.3): tangential umbrella moves of the projected new vertices, re-projected;
+    // Jacobi style (every move computed from the same positions).
+    std::vector<Vec3d> moved(added);
+    std::vector<Move> move(added, Move::None);
+    for (int round = 0; round < options.relax_iterations; ++round)
+    {
+        ProgressReporter reporter(options.progress, "refine: relax");
+        parallel_blocks(
+            added, vertex_block,
+            [&](std::size_t begin, std::size_t end) {
+                for (std::size_t j = begin; j < end; ++j)
+                {
+                    move[j] = Move::None;
+                    if (state[j] != State::Projected)
+                        continue;
+                    const auto [h1, h2] = level.halfedges[j];
+                    const Vec3d& p = new_positions[j];
+                    Vec3d sum = x[level.from(h1)] + x[level.to(h1)];
+                    std::size_t count = 2;
+                    Vec3d normal = Vec3d::Zero();
+                    for (const std::uint32_t h : {h1, h2})
+                    {
+                        if (h == none)
+                            continue;
+                        const std::uint32_t f = h / 3;
+                        const std::uint32_t k = h % 3;
+                        const Vec3d& q1 = x[level.edge_vertex[3 * f + (k + 1) % 3]];
+                        const Vec3d& q2 = x[level.edge_vertex[3 * f + (k + 2) % 3]];
+                        sum += q1 + q2;
+                        count += 2;
+                        // The three children of f around the vertex: (from, p, q2),
+                        // (p, to, q1) and (p, q1, q2).
+                        const Vec3d& s = x[level.from(h)];
+                        const Vec3d& t = x[level.to(h)];
+                        normal +=
+                            area_normal(s, p, q2) + area_normal(p, t, q1) + area_normal(p, q1, q2);
+                    }
+                    const Vec3d direction = aw_fen[j].normalized();
+                    Vec3d n = normal.normalized();
+                    if (!(normal.norm() > 0.0) || !(n.dot(direction) > 0.0))
+                        n = direction;
+                    // On the boundary the umbrella of the two boundary neighbours only, so the
+                    // border is evened out along itself instead of pulled inwards.
+                    const Vec3d target = h2 == none
+                                             ? Vec3d(0.5 * (x[level.from(h1)] + x[level.to(h1)]))
+                                             : Vec3d(sum / static_cast<double>(count));
+                    const Vec3d umbrella = target - p;
+                    const Vec3d tangential = umbrella - n * n.dot(umbrella);
+                    const std::optional<Vec3d> hit =
+                        project_to_zero(field, origin + p + tangential, n, reach[j]);
+                    if (hit)
+                    {
+                        moved[j] = *hit - origin;
+                        move[j] = Move::Made;
+                    }
+                    else
+                    {
+                        move[j] = Move::NoCrossing;
+                    }
+                }
+            },
+            &reporter);
+        reporter.finish();
+        std::vector<Vec3d> before(added);
+        for (std::size_t j = 0; j < added; ++j)
+        {
+            if (move[j] == Move::NoCrossing)
+                ++stats.relax_undone;
+            if (move[j] == Move::Made)
+            {
+                before[j] = new_positions[j];
+                new_positions[j] = moved[j];
+            }
+        }
+        // Undo the moves of vertices in folded faces until no folded face has a moved vertex.
+        for (;;)
+        {
+            find_folds(level, x, face_normal, options.fold_cosine, folded);
+            bool changed = false;
+            for (const std::uint32_t j : vertices_of_folds(level, folded))
+                if (move[j] == Move::Made)
+                {
+                    new_positions[j] = before[j];
+                    move[j] = Move::Undone;
+                    ++stats.relax_undone;
+                    changed = true;
+                }
+            if (!changed)
+                break;
+        }
+        for (std::size_t j = 0; j < added; ++j)
+            if (move[j] == Move::Made)
+                ++stats.relaxed;
+    }
+
+    find_folds(level, x, face_normal, options.fold_cosine, folded);
+    stats.folded_faces = count_folds(folded);
+    for (std::size_t j = 0; j < added; ++j)
+    {
+        if (state[j] != State::Projected)
+            ++stats.unprojected;
+        if (state[j] == State::Reverted)
+            ++stats.folds_unresolved;
+    }
+    return child_faces(level);
+}
+
+} // namespace
+
+Predictor parse_predictor(std::string_view text)
+{
+    if (text == "midpoint")
+        return Predictor::Midpoint;
+    if (text == "butterfly")
+        return Predictor::Butterfly;
+    throw InvalidInput("unknown predictor '" + std::string(text) +
+                       "' (expected midpoint or butterfly)");
+}
+
+std::string_view to_string(Predictor predictor)
+{
+    return predictor == Predictor::Butterfly ? "butterfly" : "midpoint";
+}
+
+std::string_view to_string(RefineStop stop)
+{
+    switch (stop)
+    {
+        case RefineStop::BelowSamplingDensity:
+            return "below sampling density";
+        case RefineStop::LevelCap:
+            return "level cap";
+        case RefineStop::Stalled:
+            return "stalled";
+    }
+    return "unknown";
+}
+
+double estimate_sampling_density(const PointCloud& samples)
+{
+    if (samples.size() < 2)
+        throw InvalidInput("sampling density: need at least 2 samples, got " +
+                           std::to_string(samples.size()));
+    const KdTree tree(samples.positions);
+    // At most about 100k queries, evenly spread over the samples (deterministic stride).
+    const std::size_t stride = std::max<std::size_t>(1, samples.size() / 100000);
+    const std::size_t queries = (samples.size() + stride - 1) / stride;
+    const std::size_t k = std::min<std::size_t>(8, samples.size());
+    std::vector<double> nearest(queries, -1.0);
+    parallel_blocks(queries, 1024, [&](std::size_t begin, std::size_t end) {
+        std::vector<std::uint32_t> indices(k);
+        std::vector<float> d2(k);
+        for (std::size_t q = begin; q < end; ++q)
+        {
+            const std::size_t found = tree.knn(samples.positions[q * stride], k, indices, d2);
+            for (std::size_t i = 0; i < found; ++i)
+                if (d2[i] > 0.0F)
+                {
+                    nearest[q] = std::sqrt(static_cast<double>(d2[i]));
+                    break;
+                }
+        }
+    });
+    nearest.erase(std::remove(nearest.begin(), nearest.end(), -1.0), nearest.end());
+    if (nearest.empty())
+        throw InvalidInput("sampling density: the samples are all coincident");
+    const auto middle = nearest.begin() + static_cast<std::ptrdiff_t>(nearest.size() / 2);
+    std::nth_element(nearest.begin(), middle, nearest.end());
+    return *middle;
+}
+
+RefineLevelStats refine_once(MultiresMesh& mesh, const Field& field, const RefineOptions& options,
+                             const PointCloud* samples)
+{
+    check_options(options);
+    if (mesh.level_count() == 0)
+        throw InvalidInput("refine: the hierarchy is empty");
+    const auto start = std::chrono::steady_clock::now();
+    const std::size_t previous = mesh.finest_level();
+    RefineLevelStats stats;
+    MultiresMesh::SplitResult split = mesh.split();
+    stats.level = split.level;
+    try
+    {
+        const std::vector<Triangle> faces =
+            refine_split_level(mesh, std::move(split), field, options, stats);
+        if (samples != nullptr && !samples->empty())
+        {
+            const Distances d = distances_from(
+                *samples, mesh, faces, stats.level, [&](std::string_view, double fraction) {
+                    return !options.progress || options.progress("refine: distance", fraction);
+                });
+            stats.hausdorff = d.hausdorff;
+            stats.mean_distance = d.mean;
+        }
+    }
+    catch (...)
+    {
+        mesh.truncate(previous);
+        throw;
+    }
+    stats.faces = mesh.face_count(stats.level);
+    stats.vertices = mesh.vertex_count(stats.level);
+    stats.new_vertices = stats.vertices - mesh.vertex_count(previous);
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return stats;
+}
+
+RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& samples,
+                    const RefineOptions& options)
+{
+    check_options(options);
+    if (mesh.level_count() == 0)
+        throw InvalidInput("refine: the hierarchy is empty");
+    if (samples.empty())
+        throw InvalidInput("refine: no samples to measure the Hausdorff distance from");
+    RefineReport report;
+    report.sampling_density = options.sampling_density > 0.0 ? options.sampling_density
+                                                             : estimate_sampling_density(samples);
+    const Distances initial = distances_from(
+        samples, mesh, mesh.faces(mesh.finest_level()), mesh.finest_level(),
+        [&](std::string_view, double fraction) {
+            return !options.progress || options.progress("refine: distance", fraction);
+        });
+    report.initial_hausdorff = initial.hausdorff;
+    report.initial_mean_distance = initial.mean;
+    double hausdorff = initial.hausdorff;
+    while (true)
+    {
+        if (hausdorff < report.sampling_density)
+        {
+            report.stop = RefineStop::BelowSamplingDensity;
+            break;
+        }
+        if (mesh.finest_level() >= options.max_level)
+        {
+            report.stop = RefineStop::LevelCap;
+            break;
+        }
+        report.levels.push_back(refine_once(mesh, field, options, &samples));
+        const double previous = hausdorff;
+        hausdorff = *report.levels.back().hausdorff;
+        if (hausdorff >= report.sampling_density &&
+            hausdorff > (1.0 - options.min_improvement) * previous)
+        {
+            report.stop = RefineStop::Stalled;
+            break;
+        }
+    }
+    return report;
+}
+
+} // namespace pointform

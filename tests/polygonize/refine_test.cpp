@@ -1,0 +1,456 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/polygonize/refine.h"
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+#include "pointform/geometry/mesh_topology.h"
+#include "pointform/geometry/shapes.h"
+#include "pointform/hermite/radius.h"
+#include "pointform/implicit/point_field.h"
+#include "pointform/implicit/primitives.h"
+#include "pointform/polygonize/projection.h"
+#include "pointform/spatial/kd_tree.h"
+
+#include "support/test_meshes.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <set>
+#include <utility>
+
+namespace pointform {
+namespace {
+
+/// The octahedron inscribed in the unit sphere, outward faces.
+TriMesh octahedron()
+{
+    TriMesh mesh;
+    mesh.vertices.positions = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    mesh.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                      {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+    return mesh;
+}
+
+constexpr double torus_major = 1.0;
+constexpr double torus_minor = 0.35;
+
+/// A coarse torus about z: an nu × nv grid of quads on the surface, each split in two,
+/// counter-clockwise seen from outside.
+TriMesh torus_grid(std::uint32_t nu, std::uint32_t nv)
+{
+    TriMesh mesh;
+    for (std::uint32_t j = 0; j < nv; ++j)
+        for (std::uint32_t i = 0; i < nu; ++i)
+        {
+            const double u = 2.0 * std::numbers::pi * i / nu;
+            const double v = 2.0 * std::numbers::pi * j / nv;
+            const double rho = torus_major + torus_minor * std::cos(v);
+            mesh.vertices.positions.emplace_back(static_cast<float>(rho * std::cos(u)),
+                                                 static_cast<float>(rho * std::sin(u)),
+                                                 static_cast<float>(torus_minor * std::sin(v)));
+        }
+    const auto at = [&](std::uint32_t i, std::uint32_t j) {
+        return (j % nv) * nu + (i % nu);
+    };
+    for (std::uint32_t j = 0; j < nv; ++j)
+        for (std::uint32_t i = 0; i < nu; ++i)
+        {
+            mesh.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+            mesh.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+        }
+    return mesh;
+}
+
+double torus_distance(const Vec3d& p)
+{
+    return std::hypot(std::hypot(p.x(), p.y()) - torus_major, p.z()) - torus_minor;
+}
+
+/// A unit sphere sampled with exact normals, radii 1.5 × the 16th neighbour's distance,
+/// without the samples within angle `cap` of `cap_axis` (no cap if cap = 0).
+PointCloud sampled_sphere(std::size_t count, const Vec3d& cap_axis = Vec3d::UnitZ(),
+                          double cap = 0.0)
+{
+    const PointCloud all = sample_shape(Shape::Sphere, {.count = count, .seed = 5});
+    PointCloud cloud;
+    const Vec3d axis = cap_axis.normalized();
+    for (std::size_t i = 0; i < all.size(); ++i)
+    {
+        const Vec3d p = all.world(i);
+        if (cap > 0.0 && p.normalized().dot(axis) > std::cos(cap))
+            continue;
+        cloud.positions.push_back(all.positions[i]);
+        cloud.normals.push_back(all.positions[i].normalized());
+    }
+    const KdTree tree(cloud.positions);
+    cloud.radii = influence_radii(knn_batch(tree, cloud.positions, 17), 1.5);
+    return cloud;
+}
+
+/// Level meshes and checks common to every refinement on a closed surface.
+struct LevelChecks
+{
+    std::size_t folded = 0;        ///< child faces against their parent
+    std::size_t irregular_new = 0; ///< added vertices without valence 6
+    bool nested = true;            ///< coarser prefixes identical bit for bit
+    std::vector<MeshTopology> topology;
+};
+
+LevelChecks check_levels(const MultiresMesh& mesh)
+{
+    LevelChecks out;
+    const TriMesh finest = mesh.level_mesh(mesh.finest_level());
+    for (std::size_t level = 0; level < mesh.level_count(); ++level)
+    {
+        const TriMesh m = mesh.level_mesh(level);
+        out.topology.push_back(analyze_topology(m));
+        out.nested =
+            out.nested && std::equal(m.vertices.positions.begin(), m.vertices.positions.end(),
+                                     finest.vertices.positions.begin());
+        if (level == 0)
+            continue;
+        std::vector<std::set<std::uint32_t>> ring(m.vertex_count());
+        for (const Triangle& t : m.triangles)
+            for (std::size_t k = 0; k < 3; ++k)
+            {
+                ring[t[k]].insert(t[(k + 1) % 3]);
+                ring[t[(k + 1) % 3]].insert(t[k]);
+            }
+        for (std::size_t v = mesh.vertex_count(level - 1); v < m.vertex_count(); ++v)
+            out.irregular_new += ring[v].size() == 6 ? 0 : 1;
+        const std::vector<Triangle> parents = mesh.faces(level - 1);
+        const auto normal = [&](const Triangle& t) {
+            const Vec3d a = mesh.positions()[t[0]];
+            return Vec3d((mesh.positions()[t[1]] - a).cross(mesh.positions()[t[2]] - a));
+        };
+        for (std::size_t c = 0; c < m.face_count(); ++c)
+            out.folded += normal(m.triangles[c]).dot(normal(parents[c / 4])) > 0.0 ? 0 : 1;
+    }
+    return out;
+}
+
+/// The smallest angle of any triangle of level `level`, in degrees.
+double min_angle_degrees(const MultiresMesh& mesh, std::size_t level)
+{
+    double smallest = 180.0;
+    for (const Triangle& t : mesh.faces(level))
+        for (std::size_t k = 0; k < 3; ++k)
+        {
+            const Vec3d& p = mesh.positions()[t[k]];
+            const Vec3d u = (mesh.positions()[t[(k + 1) % 3]] - p).normalized();
+            const Vec3d w = (mesh.positions()[t[(k + 2) % 3]] - p).normalized();
+            smallest = std::min(
+                smallest, std::acos(std::clamp(u.dot(w), -1.0, 1.0)) * 180.0 / std::numbers::pi);
+        }
+    return smallest;
+}
+
+TEST(Projection, FindsTheNearestOutwardCrossing)
+{
+    const auto sphere = make_sphere(Vec3d::Zero(), 1.0);
+    // From inside at x = 0.5 along +x: the crossing at x = 1 (the one at x = -1 goes from
+    // outside to inside along +x, and is farther).
+    const auto hit = project_to_zero(*sphere, Vec3d(0.5, 0, 0), Vec3d(2, 0, 0), 1.0);
+    ASSERT_TRUE(hit);
+    EXPECT_NEAR(hit->x(), 1.0, 1e-6);
+    // From outside, the search goes backwards along the direction.
+    const auto back = project_to_zero(*sphere, Vec3d(0, 1.3, 0), Vec3d(0, 1, 0), 0.5);
+    ASSERT_TRUE(back);
+    EXPECT_NEAR(back->y(), 1.0, 1e-6);
+    // Direction against the gradient: the crossing at y = 1 goes outside-to-inside along −y,
+    // so the only valid one is the far side y = −1, out of reach here.
+    EXPECT_FALSE(project_to_zero(*sphere, Vec3d(0, 1.3, 0), Vec3d(0, -1, 0), 0.5));
+    EXPECT_FALSE(project_to_zero(*sphere, Vec3d(0, 3, 0), Vec3d(0, 1, 0), 0.5)); // out of reach
+    EXPECT_FALSE(project_to_zero(*sphere, Vec3d(0, 1, 0), Vec3d::Zero(), 0.5));
+    EXPECT_THROW((void)project_to_zero(*sphere, Vec3d::Zero(), Vec3d::UnitX(), 1.0, {.steps = 0}),
+                 InvalidInput);
+}
+
+TEST(Refine, OctahedronOnAnalyticSphere)
+{
+    const auto sphere = make_sphere(Vec3d::Zero(), 1.0);
+    MultiresMesh mesh(octahedron());
+    std::vector<double> min_angles;
+    for (std::size_t level = 1; level <= 4; ++level)
+    {
+        const RefineLevelStats stats = refine_once(mesh, *sphere);
+        EXPECT_EQ(stats.level, level);
+        EXPECT_EQ(stats.faces, 8U << (2 * level));
+        EXPECT_EQ(stats.vertices, mesh.vertex_count());
+        EXPECT_EQ(stats.unprojected, 0U);
+        EXPECT_EQ(stats.folded_faces, 0U);
+        EXPECT_FALSE(stats.hausdorff); // no samples given
+        min_angles.push_back(min_angle_degrees(mesh, level));
+    }
+    // Every vertex on the sphere (the root finder's tolerance is 1e-7 of the edge length).
+    for (const Vec3d& p : mesh.positions())
+        ASSERT_NEAR(p.norm(), 1.0, 1e-6);
+    const LevelChecks checks = check_levels(mesh);
+    EXPECT_TRUE(checks.nested);
+    EXPECT_EQ(checks.folded, 0U);
+    EXPECT_EQ(checks.irregular_new, 0U);
+    for (const MeshTopology& t : checks.topology)
+    {
+        EXPECT_TRUE(t.is_oriented_manifold());
+        EXPECT_TRUE(t.is_closed());
+        EXPECT_EQ(t.euler_characteristic, 2);
+    }
+    // Relaxation keeps triangles well shaped: the octahedron's 45° right angles-split triangles
+    // do not degenerate with depth.
+    EXPECT_GT(*std::min_element(min_angles.begin(), min_angles.end()), 30.0);
+}
+
+TEST(Refine, TorusKeepsGenusOne)
+{
+    const auto torus = make_torus(Vec3d::Zero(), Vec3d::UnitZ(), torus_major, torus_minor);
+    for (const Predictor predictor : {Predictor::Midpoint, Predictor::Butterfly})
+    {
+        MultiresMesh mesh(torus_grid(8, 4));
+        std::size_t unprojected = 0;
+        for (int level = 0; level < 3; ++level)
+            unprojected += refine_once(mesh, *torus, {.predictor = predictor}).unprojected;
+        EXPECT_EQ(unprojected, 0U);
+        // Base vertices are float-rounded; new ones are exact up to the root finder.
+        for (const Vec3d& p : mesh.positions())
+            ASSERT_NEAR(torus_distance(p), 0.0, 1e-6);
+        const LevelChecks checks = check_levels(mesh);
+        EXPECT_TRUE(checks.nested);
+        EXPECT_EQ(checks.folded, 0U);
+        EXPECT_EQ(checks.irregular_new, 0U);
+        for (const MeshTopology& t : checks.topology)
+        {
+            EXPECT_TRUE(t.is_oriented_manifold());
+            EXPECT_TRUE(t.is_closed());
+            EXPECT_EQ(t.euler_characteristic, 0);
+            EXPECT_EQ(t.components, 1U);
+        }
+    }
+}
+
+TEST(Refine, SampledSphereStopsBelowTheSamplingDensity)
+{
+    const PointCloud samples = sampled_sphere(8000);
+    const PointField field(samples);
+    MultiresMesh mesh(test::icosphere(0));
+    const RefineReport report = refine(mesh, field, samples, {.max_level = 6});
+    const double density = report.sampling_density;
+    // 8000 area-uniform samples on the unit sphere are about sqrt(4π/8000) ≈ 0.04 apart; the
+    // median nearest-neighbour distance is a fraction of that.
+    EXPECT_GT(density, 0.005);
+    EXPECT_LT(density, 0.04);
+    ASSERT_EQ(report.stop, RefineStop::BelowSamplingDensity);
+    ASSERT_FALSE(report.levels.empty());
+    EXPECT_LT(*report.levels.back().hausdorff, density);
+    EXPECT_LT(mesh.finest_level(), 6U);
+    // Hausdorff from the samples non-increasing with level.
+    double previous = report.initial_hausdorff;
+    for (const RefineLevelStats& s : report.levels)
+    {
+        EXPECT_LE(*s.hausdorff, previous) << "level " << s.level;
+        EXPECT_LE(*s.mean_distance, *s.hausdorff);
+        EXPECT_EQ(s.unprojected, 0U);
+        previous = *s.hausdorff;
+    }
+    // Every vertex within the sampling density of the true sphere.
+    for (const Vec3d& p : mesh.positions())
+        ASSERT_NEAR(p.norm(), 1.0, density);
+    const LevelChecks checks = check_levels(mesh);
+    EXPECT_TRUE(checks.nested);
+    EXPECT_EQ(checks.folded, 0U);
+    EXPECT_EQ(checks.irregular_new, 0U);
+    for (const MeshTopology& t : checks.topology)
+    {
+        EXPECT_TRUE(t.is_closed());
+        EXPECT_EQ(t.euler_characteristic, 2);
+    }
+}
+
+TEST(Refine, HoleLeavesVerticesAtThePrediction)
+{
+    // The cap of angular radius 25° around the centre of the octahedron's first face has no
+    // samples; the octahedron's vertices and its edges' midpoints (35° away) are outside it.
+    const Vec3d axis = Vec3d(1, 1, 1).normalized();
+    const double cap = 25.0 * std::numbers::pi / 180.0;
+    const PointCloud samples = sampled_sphere(6000, axis, cap);
+    const PointField field(samples);
+    MultiresMesh mesh(octahedron());
+    std::size_t unprojected = 0;
+    for (int level = 0; level < 3; ++level)
+    {
+        const RefineLevelStats stats = refine_once(mesh, field, {}, &samples);
+        EXPECT_EQ(stats.folds_unresolved, 0U);
+        // Vertices left at their prediction (the midpoint) are exactly the unprojected ones.
+        std::size_t at_midpoint = 0;
+        for (std::size_t v = mesh.vertex_count(stats.level - 1); v < mesh.vertex_count(); ++v)
+        {
+            const ParentEdge e = mesh.parent_edge(static_cast<std::uint32_t>(v));
+            const Vec3d& p = mesh.positions()[v];
+            const double angle = std::acos(std::clamp(p.normalized().dot(axis), -1.0, 1.0));
+            if (p == Vec3d(0.5 * (mesh.positions()[e.a] + mesh.positions()[e.b])))
+            {
+                ++at_midpoint;
+                EXPECT_LT(angle, cap + 0.1)
+                    << "vertex " << v; // only in (or at the rim of) the hole
+            }
+            else
+            {
+                EXPECT_NEAR(p.norm(), 1.0, 0.02) << "vertex " << v; // on the sampled surface
+            }
+        }
+        EXPECT_EQ(at_midpoint, stats.unprojected);
+        unprojected += stats.unprojected;
+    }
+    EXPECT_GT(unprojected, 0U);
+    const LevelChecks checks = check_levels(mesh);
+    EXPECT_TRUE(checks.nested);
+    EXPECT_EQ(checks.folded, 0U);
+}
+
+/// A field defined nowhere: every new vertex stays at its prediction.
+class NowhereField final : public Field
+{
+public:
+    [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override
+    {
+        return {p.norm() - 1.0, p.normalized(), false};
+    }
+    using Field::evaluate;
+    [[nodiscard]] Aabb bounds() const override { return {Vec3d::Constant(-1), Vec3d::Constant(1)}; }
+};
+
+TEST(Refine, ButterflyPredictsBetterThanTheMidpoint)
+{
+    const NowhereField nowhere;
+    double worst[2] = {0.0, 0.0};
+    for (const Predictor predictor : {Predictor::Midpoint, Predictor::Butterfly})
+    {
+        // Icosphere level 1: valence-5 and valence-6 vertices, so both stencils are used.
+        MultiresMesh mesh(test::icosphere(1));
+        const RefineLevelStats stats = refine_once(mesh, nowhere, {.predictor = predictor});
+        EXPECT_EQ(stats.unprojected, stats.new_vertices);
+        for (std::size_t v = mesh.vertex_count(0); v < mesh.vertex_count(); ++v)
+            worst[static_cast<int>(predictor)] = std::max(
+                worst[static_cast<int>(predictor)], std::abs(mesh.positions()[v].norm() - 1.0));
+    }
+    EXPECT_LT(worst[1], 0.25 * worst[0]);
+
+    // Affine invariance: on a flat grid (boundary and interior) predictions stay in the plane,
+    // and away from the square's corners (where the 4-point rule rounds the border) inside it.
+    MultiresMesh flat(test::square_grid(4));
+    refine_once(flat, nowhere, {.predictor = Predictor::Butterfly});
+    const auto is_corner = [&](std::uint32_t v) {
+        return flat.positions()[v].head<2>().cwiseAbs() == Eigen::Vector2d(1.0, 1.0);
+    };
+    for (std::size_t v = flat.vertex_count(0); v < flat.vertex_count(); ++v)
+    {
+        const Vec3d& p = flat.positions()[v];
+        EXPECT_EQ(p.z(), 0.0);
+        const ParentEdge e = flat.parent_edge(static_cast<std::uint32_t>(v));
+        if (!is_corner(e.a) && !is_corner(e.b))
+        {
+            EXPECT_LE(p.cwiseAbs().maxCoeff(), 1.0 + 1e-12);
+        }
+    }
+}
+
+TEST(Refine, ButterflyOnSampledSphere)
+{
+    const PointCloud samples = sampled_sphere(6000);
+    const PointField field(samples);
+    MultiresMesh mesh(octahedron());
+    const RefineReport report =
+        refine(mesh, field, samples, {.predictor = Predictor::Butterfly, .max_level = 4});
+    for (const RefineLevelStats& s : report.levels)
+        EXPECT_EQ(s.unprojected, 0U);
+    for (const Vec3d& p : mesh.positions())
+        ASSERT_NEAR(p.norm(), 1.0, report.sampling_density);
+    const LevelChecks checks = check_levels(mesh);
+    EXPECT_EQ(checks.folded, 0U);
+    EXPECT_EQ(checks.topology.back().euler_characteristic, 2);
+}
+
+TEST(Refine, FoldsAreFixedByTheVertexBasedEdgeNormal)
+{
+    // A thin triangle F1 = (a, b, c) facing +z, hinged along ab to a large triangle F2 tilted by
+    // 45°, and flanked by two wide triangles facing +z. AW_FEN of ab is dominated by F2, so
+    // projecting ab's midpoint along it onto a plane below slides it sideways across F1's
+    // children (a fold); VEN, dominated by the wide faces at a and b, does not.
+    TriMesh base;
+    base.vertices.positions = {{-1, 0, 0},  {1, 0, 0},    {0, 0.1F, 0},
+                               {0, -1, -1}, {-10, 10, 0}, {10, 10, 0}};
+    base.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 2, 4}, {2, 1, 5}};
+    const Vec3d aw_fen = Vec3d(0.0, -2.0, 2.2).normalized(); // F1 + F2 area normals
+    const auto plane = make_half_space(-0.2 * aw_fen, aw_fen);
+    for (const int relax : {0, 1})
+    {
+        MultiresMesh mesh(base);
+        const RefineLevelStats stats = refine_once(mesh, *plane, {.relax_iterations = relax});
+        EXPECT_GE(stats.fold_vertices, 1U);
+        EXPECT_GE(stats.folds_fixed_by_ven, 1U);
+        EXPECT_EQ(stats.folds_unresolved, 0U);
+        EXPECT_EQ(stats.unprojected, 0U);
+        EXPECT_EQ(stats.folded_faces, 0U);
+        EXPECT_EQ(check_levels(mesh).folded, 0U);
+        for (std::size_t v = mesh.vertex_count(0); v < mesh.vertex_count(); ++v)
+            EXPECT_NEAR(plane->evaluate(mesh.world(static_cast<std::uint32_t>(v))).value, 0.0,
+                        1e-6);
+    }
+    // The vertex of ab is where VEN put it, off the AW_FEN line through ab's midpoint (0).
+    MultiresMesh mesh(base);
+    refine_once(mesh, *plane, {.relax_iterations = 0});
+    const Vec3d on_ab = mesh.positions()[mesh.edge_vertices(0)[0]];
+    EXPECT_GT(on_ab.cross(aw_fen).norm(), 1e-3); // off the AW_FEN line through the midpoint 0
+}
+
+TEST(Refine, SameResultWhateverTheThreadCount)
+{
+    const PointCloud samples = sampled_sphere(4000);
+    const PointField field(samples);
+    std::vector<std::vector<Vec3d>> results;
+    for (const int threads : {1, 3})
+    {
+        set_thread_count(threads);
+        MultiresMesh mesh(octahedron());
+        for (int level = 0; level < 3; ++level)
+            refine_once(mesh, field, {.predictor = Predictor::Butterfly, .relax_iterations = 2});
+        results.emplace_back(mesh.positions().begin(), mesh.positions().end());
+    }
+    set_thread_count(0);
+    EXPECT_TRUE(results[0] == results[1]);
+}
+
+TEST(Refine, RejectsBadInput)
+{
+    const auto sphere = make_sphere(Vec3d::Zero(), 1.0);
+    MultiresMesh empty;
+    EXPECT_THROW(refine_once(empty, *sphere), InvalidInput);
+    MultiresMesh mesh(octahedron());
+    EXPECT_THROW(refine_once(mesh, *sphere, {.search_scale = 0.0}), InvalidInput);
+    EXPECT_THROW(refine_once(mesh, *sphere, {.relax_iterations = -1}), InvalidInput);
+    EXPECT_THROW(refine(mesh, *sphere, PointCloud{}), InvalidInput);
+    EXPECT_EQ(mesh.level_count(), 1U); // nothing was added
+    EXPECT_THROW((void)estimate_sampling_density(PointCloud{}), InvalidInput);
+    EXPECT_THROW((void)parse_predictor("loop"), InvalidInput);
+    EXPECT_EQ(parse_predictor("butterfly"), Predictor::Butterfly);
+}
+
+TEST(Refine, CancelRemovesTheNewLevel)
+{
+    const auto sphere = make_sphere(Vec3d::Zero(), 1.0);
+    MultiresMesh mesh(octahedron());
+    refine_once(mesh, *sphere);
+    const auto cancel = [](std::string_view, double) {
+        return false;
+    };
+    EXPECT_THROW(refine_once(mesh, *sphere, {.progress = cancel}), Cancelled);
+    EXPECT_EQ(mesh.level_count(), 2U);
+    EXPECT_NO_THROW(mesh.validate());
+}
+
+} // namespace
+} // namespace pointform
