@@ -9,7 +9,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libnanoflann-dev libcli11-dev nlohmann-json3-dev
-  libembree-dev libstb-dev
+  libembree-dev libstb-dev libopenmesh-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format
 )

@@ -8,7 +8,9 @@
 #include "pointform/core/parallel.h"
 #include "pointform/geometry/shapes.h"
 #include "pointform/hermite/radius.h"
+#include "pointform/implicit/operators.h"
 #include "pointform/implicit/point_field.h"
+#include "pointform/implicit/primitives.h"
 #include "pointform/polygonize/marching_cubes.h"
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/spatial_sort.h"
@@ -114,6 +116,57 @@ void BM_MarchingCubes512(benchmark::State& state)
     state.counters["faces"] = static_cast<double>(faces);
 }
 BENCHMARK(BM_MarchingCubes512)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+
+/// A sampled shape with exact normals and automatic radii, as an oriented scan would come in.
+PointCloud scan_of(Shape shape, std::size_t count, const Vec3d& offset)
+{
+    PointCloud cloud = sample_shape(shape, {.count = count, .seed = 7});
+    cloud.origin = offset;
+    cloud.normals.resize(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+    {
+        const Vec3f p = cloud.positions[i];
+        // Sphere: radial; torus: away from the core circle.
+        const Vec3f core =
+            shape == Shape::Torus ? Vec3f(p.x(), p.y(), 0.0F).normalized() : Vec3f::Zero();
+        cloud.normals[i] = (p - core).normalized();
+    }
+    const KdTree tree(cloud.positions);
+    cloud.radii = influence_radii(knn_batch(tree, cloud.positions, 17), 1.5);
+    return cloud;
+}
+
+/// Issue 4's scene: two 100k-sample scans (a sphere and a torus through it) and three
+/// primitives, polygonized at 256 cells along the longest side. `with_fields` times the two
+/// point fields' construction too (as `pointform model` runs it on scans that carry normals).
+void BM_Scene256(benchmark::State& state)
+{
+    const bool with_fields = state.range(0) != 0;
+    static const PointCloud sphere = scan_of(Shape::Sphere, 100000, Vec3d(0.0, 0.0, 0.0));
+    static const PointCloud torus = scan_of(Shape::Torus, 100000, Vec3d(0.9, 0.0, 0.0));
+    std::size_t faces = 0;
+    auto scene = [&] {
+        auto a = std::make_shared<const PointField>(sphere);
+        auto b = std::make_shared<const PointField>(torus);
+        return make_difference(
+            make_union({make_smooth_union(a, b, 0.1), make_sphere(Vec3d(0.0, 0.0, 1.0), 0.3)}),
+            make_union({make_box(Vec3d(-0.2, -1.5, 0.3), Vec3d(0.2, 1.5, 1.5)),
+                        make_cylinder(Vec3d(-2.0, 0.0, 0.0), Vec3d(2.0, 0.0, 0.0), 0.15)}));
+    };
+    std::shared_ptr<const Field> prebuilt = with_fields ? nullptr : scene();
+    for (auto _ : state)
+    {
+        const std::shared_ptr<const Field> field = with_fields ? scene() : prebuilt;
+        const Aabb box = field->bounds();
+        const auto result = marching_cubes(*field, grid_over(box, cell_for_resolution(box, 256)));
+        faces = result.mesh.face_count();
+        benchmark::DoNotOptimize(faces);
+    }
+    state.counters["faces"] = static_cast<double>(faces);
+    state.SetLabel(std::string(with_fields ? "fields + " : "") + "marching cubes, " +
+                   std::to_string(thread_count()) + " thread(s)");
+}
+BENCHMARK(BM_Scene256)->Arg(0)->Arg(1)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
 } // namespace
 } // namespace pointform

@@ -28,6 +28,10 @@ constexpr std::size_t max_blend_k = 32;
 /// larger ones scan more points.
 constexpr float grid_cell_scale = 2.5F;
 
+/// Beyond every influence radius the field's magnitude is the distance to a sample at most this
+/// factor farther than the nearest (PointField).
+constexpr float far_distance_factor = 1.01F;
+
 /// Whether the field blends the surfaces of several samples (or takes the nearest one's).
 bool blends(PlaneFit fit)
 {
@@ -237,6 +241,7 @@ struct PointField::Impl
     std::vector<PackedSurfel> packed; ///< indexed by grid slot
     Aabb box;
     double median_radius = 0.0;
+    double max_radius = 0.0;
     double area = 0.0;
 
     Impl(PointCloud cloud, const PointFieldOptions& opts)
@@ -316,6 +321,7 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
     {
         max_radius = std::max(max_radius, r);
     }
+    m.max_radius = max_radius;
     m.box = m.surfels.bounds();
     m.box.min -= Vec3d::Constant(max_radius);
     m.box.max += Vec3d::Constant(max_radius);
@@ -350,8 +356,30 @@ FieldSample PointField::evaluate(const Vec3d& world_point) const
 
     // Blend: the blend_k nearest surfaces, weights vanishing at the (blend_k + 1)-th distance.
     const std::size_t want = std::min(m.options.blend_k + 1, m.surfels.size());
-    const std::size_t found =
-        m.grid->knn(query, want, std::span(slot.data(), want), std::span(dist2.data(), want));
+    std::size_t found = m.grid->knn_nearby(query, want, std::span(slot.data(), want),
+                                           std::span(dist2.data(), want));
+    if (found == 0)
+    {
+        // Far from the samples (as a scene evaluates one scan along another's surface): a
+        // nearly nearest sample tells whether any influence ball can reach, which mostly ends
+        // it. Its distance is within far_distance_factor of the nearest's: deep inside a
+        // closed scan the samples are all about equally far, and an exact search visits most.
+        float nearest_d2 = 0.0F;
+        const std::uint32_t index =
+            m.tree.nearest_within_factor(query, far_distance_factor, &nearest_d2).value;
+        const PackedSurfel& nearest = m.packed[m.grid->slot_of(index)];
+        const double reach = m.max_radius * static_cast<double>(far_distance_factor);
+        if (static_cast<double>(nearest_d2) > reach * reach)
+        {
+            const double nearest_distance = (p - nearest.position.cast<double>()).norm();
+            out.defined = false;
+            out.value = std::copysign(nearest_distance, nearest.distance(p, nullptr));
+            out.gradient = nearest.normal.cast<double>();
+            return out;
+        }
+        found =
+            m.grid->knn(query, want, std::span(slot.data(), want), std::span(dist2.data(), want));
+    }
     const PackedSurfel& nearest = m.packed[slot[0]];
     // Defined inside the union of the blended samples' influence balls, so that a gap next to
     // a sample with a small radius is covered by its neighbours' balls.

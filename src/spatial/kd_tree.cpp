@@ -92,6 +92,24 @@ std::size_t KdTree::knn(const Vec3f& query, std::size_t k, std::span<std::uint32
     return result.size();
 }
 
+PointId KdTree::nearest_within_factor(const Vec3f& query, float factor,
+                                      float* squared_distance) const
+{
+    PF_ASSERT(factor >= 1.0F);
+    if (size() == 0)
+        return {};
+    std::uint32_t index = 0;
+    float d2 = 0.0F;
+    nanoflann::KNNResultSet<float, std::uint32_t, std::size_t> result(1);
+    result.init(&index, &d2);
+    nanoflann::SearchParams params;
+    params.eps = factor - 1.0F;
+    impl_->tree.findNeighbors(result, query.data(), params);
+    if (squared_distance != nullptr)
+        *squared_distance = d2;
+    return PointId{index};
+}
+
 PointId KdTree::nearest(const Vec3f& query, float* squared_distance) const
 {
     std::uint32_t index = 0;

@@ -304,6 +304,13 @@ PointGrid::Range PointGrid::cell_range(std::int64_t x, std::int64_t y, std::int6
 std::size_t PointGrid::knn(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
                            std::span<float> squared_distances) const
 {
+    const std::size_t found = knn_nearby(query, k, slots, squared_distances);
+    return found > 0 || k == 0 || count_ == 0 ? found : knn_far(query, k, slots, squared_distances);
+}
+
+std::size_t PointGrid::knn_nearby(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
+                                  std::span<float> squared_distances) const
+{
     k = std::min(k, count_);
     PF_ASSERT(slots.size() >= k && squared_distances.size() >= k);
     if (k == 0)
@@ -387,6 +394,13 @@ std::size_t PointGrid::knn(const Vec3f& query, std::size_t k, std::span<std::uin
         }
     }
 
+    return 0;
+}
+
+std::size_t PointGrid::knn_far(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
+                               std::span<float> squared_distances) const
+{
+    k = std::min(k, count_);
     // Far from the points: the kd-tree, its indices mapped to slots.
     std::array<std::uint32_t, max_k> index_buffer{};
     std::array<float, max_k> d2_buffer{};

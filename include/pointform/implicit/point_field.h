@@ -58,11 +58,18 @@ struct PointFieldOptions
 /// \brief The signed field of oriented surfels (§4).
 ///
 /// s_k = the sample nearest to p. Where ‖p − s_k‖ ≤ r_k the field is defined: f(p) is the signed
-/// distance to the plane chosen by PlaneFit, ∇f its gradient (n_k for Raw and Centroid). Beyond
-/// r_k the field is the paper's f = ∞: `defined` is false, the value is ±‖p − s_k‖ with the sign
-/// of the nearest sample's plane, so inside and outside stay told apart (see FieldSample).
-/// Blend widens "defined" to the union of the influence balls of the blended samples: with
-/// irregular sampling the nearest sample's ball alone leaves pinholes between clusters.
+/// distance to the local surface chosen by PlaneFit, ∇f its gradient. Beyond r_k the field is
+/// the paper's f = ∞: `defined` is false, the value is ±‖p − s_k‖ with the sign of the nearest
+/// sample's surface, so inside and outside stay told apart (see FieldSample). Blend and Quadric
+/// widen "defined" to the union of the influence balls of the blended samples: with irregular
+/// sampling the nearest sample's ball alone leaves pinholes between clusters.
+///
+/// Farther from every sample than the largest influence radius, s_k may be a sample up to 1%
+/// farther than the nearest: there every sample is about as far as the nearest (think of the
+/// middle of a closed scan) and an exact search would visit most of them.
+///
+/// Queries are answered by a PointGrid over the samples (a kd-tree far from them), and run
+/// fastest in spatially coherent order (as marching cubes and refinement ask).
 class PointField final : public Field
 {
 public:

@@ -58,6 +58,11 @@ public:
     /// \brief The single nearest point; returns its index, or invalid if the tree is empty.
     [[nodiscard]] PointId nearest(const Vec3f& query, float* squared_distance = nullptr) const;
 
+    /// \brief A point at most `factor` (≥ 1) times as far as the nearest: far from a surface
+    /// every point is nearly as far as the nearest, and an exact search visits most of them.
+    [[nodiscard]] PointId nearest_within_factor(const Vec3f& query, float factor,
+                                                float* squared_distance = nullptr) const;
+
     /// \brief Appends to the buffers every point within `radius` of `query`, nearest first.
     /// \return the number appended
     std::size_t radius_search(const Vec3f& query, float radius, std::vector<std::uint32_t>& indices,

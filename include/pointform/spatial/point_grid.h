@@ -41,6 +41,14 @@ public:
     std::size_t knn(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
                     std::span<float> squared_distances) const;
 
+    /// \brief knn() where the grid alone answers it: returns 0 (and fills nothing) when the
+    /// query is too far from the points for the cells around it, so that a caller who needs
+    /// less there (say, the nearest point only) can ask the kd-tree for just that.
+    std::size_t knn_nearby(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
+                           std::span<float> squared_distances) const;
+
+    /// \brief The slot of an original point index.
+    [[nodiscard]] std::uint32_t slot_of(std::uint32_t index) const { return slot_of_[index]; }
     [[nodiscard]] std::uint32_t original_index(std::uint32_t slot) const { return order_[slot]; }
     /// \brief Slots in all, padding included: callers that keep attributes in grid order size
     /// them by this and fill the slots whose original_index() is not padding_slot.
@@ -64,6 +72,8 @@ private:
     class Within;
     struct OctantCache;
 
+    std::size_t knn_far(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
+                        std::span<float> squared_distances) const;
     [[nodiscard]] Range cell_range(std::int64_t x, std::int64_t y, std::int64_t z) const;
 
     const KdTree* fallback_;

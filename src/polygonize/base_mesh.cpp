@@ -1,0 +1,1118 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+// OpenMesh's PropertyT::push_back appends a default-constructed VectorT, which is uninitialised
+// by design; GCC flags it inside the inlined std::vector code in sanitizer builds. The pragma
+// must come before the first standard header to cover those locations.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+
+#include "pointform/polygonize/base_mesh.h"
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+#include "pointform/io/io.h"
+#include "pointform/polygonize/projection.h"
+#include "pointform/spatial/kd_tree.h"
+
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <OpenMesh/Tools/Decimater/DecimaterT.hh>
+#include <OpenMesh/Tools/Decimater/ModNormalFlippingT.hh>
+#include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
+#include <OpenMesh/Tools/Decimater/Observer.hh>
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <numeric>
+#include <optional>
+#include <string_view>
+#include <utility>
+
+namespace pointform {
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// OpenMesh adapter: a halfedge mesh in double precision, used only inside this file.
+
+struct OmTraits : public OpenMesh::DefaultTraits
+{
+    using Point = OpenMesh::Vec3d;
+    using Normal = OpenMesh::Vec3d;
+    VertexAttributes(OpenMesh::Attributes::Status);
+    EdgeAttributes(OpenMesh::Attributes::Status);
+    HalfedgeAttributes(OpenMesh::Attributes::PrevHalfedge);
+    FaceAttributes(OpenMesh::Attributes::Status | OpenMesh::Attributes::Normal);
+};
+using OmBase = OpenMesh::TriMesh_ArrayKernelT<OmTraits>;
+
+/// The halfedge mesh. It hides TriConnectivity::is_collapse_ok, which the Decimater calls for
+/// every candidate collapse, with the same test minus that function's per-call allocations
+/// (which made it 70% of the decimation time).
+class OmMesh : public OmBase
+{
+public:
+    /// \brief The link condition: may v0v1 be collapsed (v0 into v1) without changing the
+    /// topology? The conditions of OpenMesh's TriConnectivity::is_collapse_ok: the edge and its
+    /// vertices exist; neither triangle has its other two edges on the boundary; the opposite
+    /// vertices vl and vr differ; the one-rings of v0 and v1 share only vl and vr; an edge between
+    /// two boundary vertices is a boundary edge.
+    bool is_collapse_ok(HalfedgeHandle v0v1)
+    {
+        if (status(edge_handle(v0v1)).deleted())
+        {
+            return false;
+        }
+        const HalfedgeHandle v1v0 = opposite_halfedge_handle(v0v1);
+        const VertexHandle v0 = to_vertex_handle(v1v0);
+        const VertexHandle v1 = to_vertex_handle(v0v1);
+        if (status(v0).deleted() || status(v1).deleted())
+        {
+            return false;
+        }
+        const auto ear = [this](HalfedgeHandle h) {
+            const HalfedgeHandle h1 = next_halfedge_handle(h);
+            const HalfedgeHandle h2 = next_halfedge_handle(h1);
+            return is_boundary(opposite_halfedge_handle(h1)) &&
+                   is_boundary(opposite_halfedge_handle(h2));
+        };
+        VertexHandle vl;
+        VertexHandle vr;
+        if (!is_boundary(v0v1))
+        {
+            vl = to_vertex_handle(next_halfedge_handle(v0v1));
+            if (ear(v0v1))
+            {
+                return false;
+            }
+        }
+        if (!is_boundary(v1v0))
+        {
+            vr = to_vertex_handle(next_halfedge_handle(v1v0));
+            if (ear(v1v0))
+            {
+                return false;
+            }
+        }
+        if (vl == vr)
+        {
+            return false;
+        }
+        ring_.clear();
+        for (const VertexHandle w : vv_range(v1))
+        {
+            ring_.push_back(w);
+        }
+        for (const VertexHandle w : vv_range(v0))
+        {
+            if (w != vl && w != vr && std::find(ring_.begin(), ring_.end(), w) != ring_.end())
+            {
+                return false;
+            }
+        }
+        return !(is_boundary(v0) && is_boundary(v1) && !is_boundary(v0v1) && !is_boundary(v1v0));
+    }
+
+private:
+    std::vector<VertexHandle> ring_;
+};
+
+Vec3d to_eigen(const OpenMesh::Vec3d& p)
+{
+    return {p[0], p[1], p[2]};
+}
+
+OpenMesh::Vec3d to_om(const Vec3d& p)
+{
+    return {p.x(), p.y(), p.z()};
+}
+
+constexpr double degrees = std::numbers::pi / 180.0;
+
+/// Smallest interior angle of triangle abc, radians; 0 for a degenerate one.
+double min_angle(const Vec3d& a, const Vec3d& b, const Vec3d& c)
+{
+    const auto angle = [](const Vec3d& u, const Vec3d& v) {
+        return std::atan2(u.cross(v).norm(), u.dot(v));
+    };
+    const Vec3d ab = b - a;
+    const Vec3d bc = c - b;
+    const Vec3d ca = a - c;
+    if (ab.squaredNorm() == 0.0 || bc.squaredNorm() == 0.0 || ca.squaredNorm() == 0.0)
+    {
+        return 0.0;
+    }
+    return std::min({angle(ab, Vec3d(-ca)), angle(bc, Vec3d(-ab)), angle(ca, Vec3d(-bc))});
+}
+
+std::array<Vec3d, 3> face_points(const OmMesh& mesh, OmMesh::FaceHandle f)
+{
+    std::array<Vec3d, 3> p;
+    int i = 0;
+    for (const auto v : mesh.fv_range(f))
+    {
+        p[static_cast<std::size_t>(i++)] = to_eigen(mesh.point(v));
+    }
+    return p;
+}
+
+/// Twice the area times the unit normal of triangle abc.
+Vec3d area_normal(const std::array<Vec3d, 3>& p)
+{
+    return (p[1] - p[0]).cross(p[2] - p[0]);
+}
+
+/// Forwards the decimater's progress to a ProgressReporter; a cancellation is remembered and
+/// rethrown after OpenMesh has returned.
+class DecimateObserver final : public OpenMesh::Decimater::Observer
+{
+public:
+    DecimateObserver(ProgressReporter& reporter, std::size_t collapses)
+        : Observer(std::max<std::size_t>(collapses / 100, 1)),
+          reporter_(reporter),
+          collapses_(static_cast<double>(std::max<std::size_t>(collapses, 1)))
+    {}
+    void notify(std::size_t step) override
+    {
+        try
+        {
+            reporter_.update(static_cast<double>(step), collapses_);
+        }
+        catch (const Cancelled&)
+        {
+            cancelled_ = true;
+        }
+    }
+    [[nodiscard]] bool abort() const override { return cancelled_; }
+    [[nodiscard]] bool cancelled() const { return cancelled_; }
+
+private:
+    ProgressReporter& reporter_;
+    double collapses_;
+    bool cancelled_ = false;
+};
+
+void check_options(const BaseMeshOptions& options)
+{
+    const auto in_range = [](double value, double low, double high, const std::string& what) {
+        if (!(value >= low && value < high))
+        {
+            throw InvalidInput("base mesh: " + what + " must be in [" + std::to_string(low) + ", " +
+                               std::to_string(high) + ") degrees, got " + std::to_string(value));
+        }
+    };
+    in_range(options.min_angle_degrees, 0.0, 60.0, "the minimum-angle target");
+    in_range(options.max_normal_deviation_degrees, 1.0, 180.0, "the maximum normal deviation");
+    in_range(options.max_flip_dihedral_degrees, 0.0, 90.0, "the maximum flip dihedral angle");
+    if (options.max_smoothing_rounds < 0)
+    {
+        throw InvalidInput("base mesh: smoothing rounds must be >= 0, got " +
+                           std::to_string(options.max_smoothing_rounds));
+    }
+}
+
+OmMesh to_openmesh(const TriMesh& mesh)
+{
+    OmMesh om;
+    om.reserve(mesh.vertex_count(), mesh.face_count() * 3 / 2, mesh.face_count());
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+    {
+        om.add_vertex(to_om(mesh.vertices.positions[v].cast<double>()));
+    }
+    for (const Triangle& t : mesh.triangles)
+    {
+        const auto f = om.add_face(OmMesh::VertexHandle(static_cast<int>(t[0])),
+                                   OmMesh::VertexHandle(static_cast<int>(t[1])),
+                                   OmMesh::VertexHandle(static_cast<int>(t[2])));
+        if (!f.is_valid())
+        {
+            throw InvalidInput(
+                "base mesh: the intermediate mesh is not a 2-manifold (a face could "
+                "not be added to the halfedge mesh)");
+        }
+    }
+    om.delete_isolated_vertices(); // vertices no triangle uses do not belong to the base mesh
+    om.garbage_collection();
+    return om;
+}
+
+/// Edge flips that raise the smaller minimum angle of an edge's two triangles, where the two
+/// triangles' normals differ by at most `max_dihedral` (radians; so a flip does not cut across a
+/// crease) and neither new triangle turns further than that from their mean normal.
+std::size_t improve_by_flips(OmMesh& mesh, double max_dihedral)
+{
+    const double flat_cos = std::cos(max_dihedral);
+    constexpr int max_passes = 10;
+    std::size_t flips = 0;
+    for (int pass = 0; pass < max_passes; ++pass)
+    {
+        std::size_t flips_this_pass = 0;
+        for (const auto e : mesh.edges())
+        {
+            if (mesh.is_boundary(e) || !mesh.is_flip_ok(e))
+            {
+                continue;
+            }
+            const auto h = mesh.halfedge_handle(e, 0);
+            const auto o = mesh.opposite_halfedge_handle(h);
+            const auto a = mesh.from_vertex_handle(h);
+            const auto b = mesh.to_vertex_handle(h);
+            const auto c = mesh.to_vertex_handle(mesh.next_halfedge_handle(h));
+            const auto d = mesh.to_vertex_handle(mesh.next_halfedge_handle(o));
+            // a and b each lose an edge: an interior vertex keeps three, a boundary one two.
+            const auto lowest = [&mesh](OmMesh::VertexHandle v) {
+                return mesh.is_boundary(v) ? 2U : 3U;
+            };
+            if (mesh.valence(a) <= lowest(a) || mesh.valence(b) <= lowest(b))
+            {
+                continue;
+            }
+            const Vec3d pa = to_eigen(mesh.point(a));
+            const Vec3d pb = to_eigen(mesh.point(b));
+            const Vec3d pc = to_eigen(mesh.point(c));
+            const Vec3d pd = to_eigen(mesh.point(d));
+            const Vec3d n1 = (pb - pa).cross(pc - pa);
+            const Vec3d n2 = (pa - pb).cross(pd - pb);
+            const Vec3d m1 = (pd - pa).cross(pc - pa);
+            const Vec3d m2 = (pb - pd).cross(pc - pd);
+            const double l1 = n1.norm();
+            const double l2 = n2.norm();
+            const double k1 = m1.norm();
+            const double k2 = m2.norm();
+            if (l1 == 0.0 || l2 == 0.0 || k1 == 0.0 || k2 == 0.0 || n1.dot(n2) < flat_cos * l1 * l2)
+            {
+                continue;
+            }
+            const Vec3d n = (n1 / l1 + n2 / l2).normalized();
+            if (m1.dot(n) < flat_cos * k1 || m2.dot(n) < flat_cos * k2)
+            {
+                continue;
+            }
+            const double before = std::min(min_angle(pa, pb, pc), min_angle(pb, pa, pd));
+            const double after = std::min(min_angle(pa, pd, pc), min_angle(pd, pb, pc));
+            if (after > before + 1e-9)
+            {
+                mesh.flip(e);
+                ++flips_this_pass;
+            }
+        }
+        flips += flips_this_pass;
+        if (flips_this_pass == 0)
+        {
+            break;
+        }
+    }
+    return flips;
+}
+
+/// Per-vertex state of the shape-improvement and projection stage.
+struct VertexState
+{
+    std::vector<Vec3d> position;
+    std::vector<char> on_surface; ///< the current position was projected onto f = 0
+};
+
+Vec3d vertex_normal(const OmMesh& mesh, OmMesh::VertexHandle v, const std::vector<Vec3d>& pos)
+{
+    Vec3d n = Vec3d::Zero();
+    for (const auto f : mesh.vf_range(v))
+    {
+        std::array<Vec3d, 3> p;
+        int i = 0;
+        for (const auto w : mesh.fv_range(f))
+        {
+            p[static_cast<std::size_t>(i++)] = pos[static_cast<std::size_t>(w.idx())];
+        }
+        n += area_normal(p);
+    }
+    const double length = n.norm();
+    return length > 0.0 ? Vec3d(n / length) : Vec3d::Zero();
+}
+
+double mean_edge_length(const OmMesh& mesh, OmMesh::VertexHandle v, const std::vector<Vec3d>& pos)
+{
+    double sum = 0.0;
+    int count = 0;
+    const Vec3d& p = pos[static_cast<std::size_t>(v.idx())];
+    for (const auto w : mesh.vv_range(v))
+    {
+        sum += (pos[static_cast<std::size_t>(w.idx())] - p).norm();
+        ++count;
+    }
+    return count > 0 ? sum / count : 0.0;
+}
+
+/// p moved onto f = 0 along the normalised gradient at p, or along `normal` where the gradient
+/// is undefined, within `reach`.
+std::optional<Vec3d> project_vertex(const Field& field, const Vec3d& p, const Vec3d& normal,
+                                    double reach)
+{
+    const FieldSample s = field.evaluate(p);
+    Vec3d direction = normal;
+    if (s.defined && s.gradient.allFinite() && s.gradient.squaredNorm() > 0.0)
+    {
+        direction = s.gradient.normalized();
+    }
+    if (direction.squaredNorm() == 0.0 || !(reach > 0.0))
+    {
+        return std::nullopt;
+    }
+    return project_to_zero(field, p, direction, reach);
+}
+
+/// One round: every interior vertex moved tangentially to the average of its neighbours (when
+/// `relax`), then every vertex projected onto f = 0; a vertex whose relaxed position cannot be
+/// projected tries its old one, and keeps it if that fails too. Moves that fold a face (its
+/// normal turned by 90° or more, or its area gone) are undone.
+void relax_and_project(const OmMesh& mesh, const Field& field, bool relax, VertexState& state)
+{
+    const std::size_t n = mesh.n_vertices();
+    const std::vector<Vec3d>& old = state.position;
+    std::vector<Vec3d> next(n);
+    std::vector<char> next_on(n, 0);
+    parallel_blocks(n, 256, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            const auto v = OmMesh::VertexHandle(static_cast<int>(i));
+            const Vec3d normal = vertex_normal(mesh, v, old);
+            const double reach = mean_edge_length(mesh, v, old);
+            Vec3d candidate = old[i];
+            if (relax && !mesh.is_boundary(v))
+            {
+                Vec3d centre = Vec3d::Zero();
+                int count = 0;
+                for (const auto w : mesh.vv_range(v))
+                {
+                    centre += old[static_cast<std::size_t>(w.idx())];
+                    ++count;
+                }
+                if (count > 0)
+                {
+                    Vec3d d = centre / count - old[i];
+                    d -= d.dot(normal) * normal;
+                    candidate += d;
+                }
+            }
+            std::optional<Vec3d> projected = project_vertex(field, candidate, normal, reach);
+            if (!projected && candidate != old[i])
+            {
+                projected = project_vertex(field, old[i], normal, reach);
+            }
+            if (projected)
+            {
+                next[i] = *projected;
+                next_on[i] = 1;
+            }
+            else
+            {
+                next[i] = old[i];
+                next_on[i] = state.on_surface[i];
+            }
+        }
+    });
+
+    // Undo moves that fold a face, until none is left (at worst every vertex of a folding face
+    // goes back to its old position, which did not fold).
+    for (bool changed = true; changed;)
+    {
+        changed = false;
+        for (const auto f : mesh.faces())
+        {
+            std::array<std::size_t, 3> ids{};
+            int i = 0;
+            for (const auto w : mesh.fv_range(f))
+            {
+                ids[static_cast<std::size_t>(i++)] = static_cast<std::size_t>(w.idx());
+            }
+            const Vec3d before = area_normal({old[ids[0]], old[ids[1]], old[ids[2]]});
+            const Vec3d after = area_normal({next[ids[0]], next[ids[1]], next[ids[2]]});
+            if (after.dot(before) > 0.0 && after.norm() > 1e-3 * before.norm())
+            {
+                continue;
+            }
+            for (const std::size_t id : ids)
+            {
+                if (next[id] != old[id])
+                {
+                    next[id] = old[id];
+                    next_on[id] = state.on_surface[id];
+                    changed = true;
+                }
+            }
+        }
+    }
+    state.position = std::move(next);
+    state.on_surface = std::move(next_on);
+}
+
+std::size_t default_base_faces(std::size_t faces, std::size_t components)
+{
+    const std::size_t lower = std::max<std::size_t>(200, 8 * components);
+    return std::min(std::clamp<std::size_t>(faces / 64, lower, 20000), faces);
+}
+
+std::string describe_topology_change(const MeshTopology& before, const MeshTopology& after)
+{
+    std::string out;
+    const auto add = [&out](const std::string& what, auto a, auto b) {
+        if (a != b)
+        {
+            out += (out.empty() ? "" : ", ") + what + " " + std::to_string(a) + " -> " +
+                   std::to_string(b);
+        }
+    };
+    add("Euler characteristic", before.euler_characteristic, after.euler_characteristic);
+    add("boundary loops", before.boundary_loops, after.boundary_loops);
+    add("components", before.components, after.components);
+    if (!after.is_oriented_manifold())
+    {
+        out += std::string(out.empty() ? "" : ", ") + "the base mesh is not an oriented manifold";
+    }
+    return out;
+}
+
+} // namespace
+
+std::size_t default_base_faces(const TriMesh& intermediate)
+{
+    return default_base_faces(intermediate.face_count(), analyze_topology(intermediate).components);
+}
+
+BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
+                               const BaseMeshOptions& options)
+{
+    const auto start = std::chrono::steady_clock::now();
+    check_options(options);
+    if (intermediate.face_count() == 0)
+    {
+        throw InvalidInput("base mesh: the intermediate mesh has no faces");
+    }
+    BaseMeshResult result;
+    BaseMeshStats& stats = result.stats;
+    stats.input_faces = intermediate.face_count();
+    stats.topology_before = analyze_topology(intermediate);
+    const MeshTopology& before = stats.topology_before;
+    if (!before.is_oriented_manifold())
+    {
+        throw InvalidInput("base mesh: the intermediate mesh is not an oriented 2-manifold (" +
+                           std::to_string(before.non_manifold_edges) + " non-manifold edges, " +
+                           std::to_string(before.non_manifold_vertices) +
+                           " non-manifold vertices, " + std::to_string(before.misoriented_edges) +
+                           " misoriented edges, " + std::to_string(before.degenerate_faces) +
+                           " degenerate faces)");
+    }
+    stats.target_faces = options.target_faces
+                             ? *options.target_faces
+                             : default_base_faces(stats.input_faces, before.components);
+    if (stats.target_faces == 0)
+    {
+        throw InvalidInput("base mesh: the target face count must be at least 1, got 0");
+    }
+    if (stats.target_faces > stats.input_faces)
+    {
+        throw InvalidInput("base mesh: the target of " + std::to_string(stats.target_faces) +
+                           " faces is larger than the intermediate mesh's " +
+                           std::to_string(stats.input_faces) + " faces");
+    }
+
+    // 1. Simplify by edge collapses.
+    OmMesh mesh = to_openmesh(intermediate);
+    mesh.request_face_normals();
+    mesh.update_face_normals();
+    {
+        OpenMesh::Decimater::DecimaterT<OmMesh> decimater(mesh);
+        OpenMesh::Decimater::ModQuadricT<OmMesh>::Handle quadric;
+        OpenMesh::Decimater::ModNormalFlippingT<OmMesh>::Handle normal_flipping;
+        decimater.add(quadric);
+        decimater.add(normal_flipping);
+        decimater.module(quadric).unset_max_err();
+        decimater.module(normal_flipping)
+            .set_max_normal_deviation(options.max_normal_deviation_degrees);
+        decimater.initialize();
+        ProgressReporter reporter(options.progress, "base mesh: decimate");
+        DecimateObserver observer(reporter, (stats.input_faces - stats.target_faces) / 2);
+        decimater.set_observer(&observer);
+        decimater.decimate_to_faces(0, stats.target_faces);
+        decimater.set_observer(nullptr);
+        if (observer.cancelled())
+        {
+            throw Cancelled("base mesh: cancelled");
+        }
+        reporter.finish();
+    }
+    mesh.garbage_collection();
+
+    // 2. Shape: rounds of flips and tangential relaxation, each followed by the projection of
+    // every vertex onto f = 0 (or the projection alone).
+    VertexState state;
+    state.position.resize(mesh.n_vertices());
+    state.on_surface.assign(mesh.n_vertices(), 0);
+    for (const auto v : mesh.vertices())
+    {
+        state.position[static_cast<std::size_t>(v.idx())] = to_eigen(mesh.point(v));
+    }
+    const std::vector<Vec3d> decimated = state.position;
+    const double bound = options.min_angle_degrees * degrees;
+    const auto below_bound = [&mesh, bound]() {
+        std::size_t count = 0;
+        for (const auto f : mesh.faces())
+        {
+            bool on_boundary = false;
+            for (const auto v : mesh.fv_range(f))
+            {
+                on_boundary = on_boundary || mesh.is_boundary(v);
+            }
+            const std::array<Vec3d, 3> p = face_points(mesh, f);
+            count += !on_boundary && min_angle(p[0], p[1], p[2]) < bound ? 1 : 0;
+        }
+        return count;
+    };
+    {
+        ProgressReporter reporter(options.progress, "base mesh: shape and projection");
+        const bool shape = options.max_smoothing_rounds > 0;
+        std::size_t previous = std::numeric_limits<std::size_t>::max();
+        for (int round = 0; round < std::max(options.max_smoothing_rounds, 1); ++round)
+        {
+            if (shape)
+            {
+                const std::size_t bad = below_bound();
+                if (bad == 0 && round >= 2)
+                {
+                    break;
+                }
+                if (bad >= previous && round >= 2)
+                {
+                    break; // no longer improving
+                }
+                previous = bad;
+                stats.flips += improve_by_flips(mesh, options.max_flip_dihedral_degrees * degrees);
+                ++stats.smoothing_rounds;
+            }
+            if (options.project)
+            {
+                relax_and_project(mesh, field, shape, state);
+                for (const auto v : mesh.vertices())
+                {
+                    mesh.set_point(v, to_om(state.position[static_cast<std::size_t>(v.idx())]));
+                }
+            }
+            reporter.update(round + 1, std::max(options.max_smoothing_rounds, 1));
+        }
+        reporter.finish();
+    }
+
+    // 3. Back to an indexed mesh, with the report.
+    TriMesh& out = result.mesh;
+    out.vertices.origin = intermediate.vertices.origin;
+    out.vertices.positions.reserve(mesh.n_vertices());
+    for (const auto v : mesh.vertices())
+    {
+        const auto i = static_cast<std::size_t>(v.idx());
+        out.vertices.positions.push_back(state.position[i].cast<float>());
+        if (options.project)
+        {
+            stats.unprojected += state.on_surface[i] ? 0 : 1;
+        }
+        stats.max_vertex_move =
+            std::max(stats.max_vertex_move, (state.position[i] - decimated[i]).norm());
+    }
+    out.triangles.reserve(mesh.n_faces());
+    std::size_t below_20 = 0;
+    std::size_t off_boundary = 0;
+    std::size_t off_boundary_below_20 = 0;
+    double angle_sum = 0.0;
+    stats.min_angle_degrees = 180.0;
+    for (const auto f : mesh.faces())
+    {
+        Triangle t{};
+        bool on_boundary = false;
+        int i = 0;
+        for (const auto v : mesh.fv_range(f))
+        {
+            t[static_cast<std::size_t>(i++)] = static_cast<std::uint32_t>(v.idx());
+            on_boundary = on_boundary || mesh.is_boundary(v);
+        }
+        out.triangles.push_back(t);
+        const double angle = min_angle(out.vertices.positions[t[0]].cast<double>(),
+                                       out.vertices.positions[t[1]].cast<double>(),
+                                       out.vertices.positions[t[2]].cast<double>()) /
+                             degrees;
+        stats.min_angle_degrees = std::min(stats.min_angle_degrees, angle);
+        angle_sum += angle;
+        below_20 += angle < 20.0 ? 1 : 0;
+        off_boundary += on_boundary ? 0 : 1;
+        off_boundary_below_20 += !on_boundary && angle < 20.0 ? 1 : 0;
+    }
+    const auto share = [](std::size_t part, std::size_t whole) {
+        return whole == 0 ? 0.0 : static_cast<double>(part) / static_cast<double>(whole);
+    };
+    stats.faces = out.face_count();
+    stats.vertices = out.vertex_count();
+    stats.mean_min_angle_degrees = share(1, stats.faces) * angle_sum;
+    stats.share_below_20_degrees = share(below_20, stats.faces);
+    stats.share_below_20_degrees_off_boundary = share(off_boundary_below_20, off_boundary);
+    stats.topology_after = analyze_topology(out);
+    stats.topology_change = describe_topology_change(before, stats.topology_after);
+    stats.topology_kept = stats.topology_change.empty();
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Interactive base mesh.
+
+namespace {
+
+/// "line N" or "triangle N" (1-based) for a triangle of the input.
+std::string line_of(std::span<const std::size_t> lines, std::size_t face)
+{
+    return lines.empty() ? "triangle " + std::to_string(face + 1)
+                         : "line " + std::to_string(lines[face]);
+}
+
+/// "source:N: " or "source: triangle N: ", the prefix of a message about one triangle.
+std::string where(const std::string& source, std::span<const std::size_t> lines, std::size_t face)
+{
+    return lines.empty() ? source + ": triangle " + std::to_string(face + 1)
+                         : source + ":" + std::to_string(lines[face]);
+}
+
+class UnionFind
+{
+public:
+    explicit UnionFind(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
+    std::size_t find(std::size_t x)
+    {
+        while (parent_[x] != x)
+        {
+            parent_[x] = parent_[parent_[x]];
+            x = parent_[x];
+        }
+        return x;
+    }
+    void unite(std::size_t a, std::size_t b) { parent_[find(a)] = find(b); }
+
+private:
+    std::vector<std::size_t> parent_;
+};
+
+} // namespace
+
+PickedBaseMesh base_mesh_from_samples(std::span<const Triangle> triangles,
+                                      const PointCloud& samples, const Field& field,
+                                      const std::string& source, std::span<const std::size_t> lines)
+{
+    if (!lines.empty() && lines.size() != triangles.size())
+    {
+        throw InvalidInput("base mesh: " + std::to_string(lines.size()) + " line numbers for " +
+                           std::to_string(triangles.size()) + " triangles");
+    }
+    if (triangles.empty())
+    {
+        throw InvalidInput(source + ": no triangles");
+    }
+    const std::size_t nf = triangles.size();
+    const double diagonal = samples.bounds().diagonal();
+
+    // Per triangle: indices, repeats, zero area, duplicates.
+    std::map<std::array<std::uint32_t, 3>, std::size_t> seen;
+    for (std::size_t f = 0; f < nf; ++f)
+    {
+        const Triangle& t = triangles[f];
+        for (const std::uint32_t i : t)
+        {
+            if (i >= samples.size())
+            {
+                throw InvalidInput(where(source, lines, f) + ": sample index " + std::to_string(i) +
+                                   " does not exist (there are " + std::to_string(samples.size()) +
+                                   " samples)");
+            }
+        }
+        if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0])
+        {
+            throw InvalidInput(where(source, lines, f) + ": degenerate triangle (" +
+                               std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " +
+                               std::to_string(t[2]) + ") repeats a sample");
+        }
+        const Vec3d a = samples.world(t[0]);
+        const Vec3d cross = (samples.world(t[1]) - a).cross(samples.world(t[2]) - a);
+        if (!(cross.norm() > 1e-12 * diagonal * diagonal))
+        {
+            throw InvalidInput(where(source, lines, f) + ": triangle (" + std::to_string(t[0]) +
+                               ", " + std::to_string(t[1]) + ", " + std::to_string(t[2]) +
+                               ") has zero area (its samples are collinear or coincident)");
+        }
+        std::array<std::uint32_t, 3> key = t;
+        std::sort(key.begin(), key.end());
+        const auto [it, inserted] = seen.emplace(key, f);
+        if (!inserted)
+        {
+            throw InvalidInput(where(source, lines, f) + ": triangle (" + std::to_string(t[0]) +
+                               ", " + std::to_string(t[1]) + ", " + std::to_string(t[2]) +
+                               ") repeats the triangle on " + line_of(lines, it->second));
+        }
+    }
+
+    // Edges: at most two triangles each.
+    struct EdgeUse
+    {
+        std::size_t face;
+        bool forward; ///< the face runs lo → hi
+    };
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<EdgeUse>> edges;
+    for (std::size_t f = 0; f < nf; ++f)
+    {
+        for (int k = 0; k < 3; ++k)
+        {
+            const std::uint32_t a = triangles[f][static_cast<std::size_t>(k)];
+            const std::uint32_t b = triangles[f][static_cast<std::size_t>((k + 1) % 3)];
+            auto& uses = edges[{std::min(a, b), std::max(a, b)}];
+            uses.push_back({f, a < b});
+            if (uses.size() > 2)
+            {
+                throw InvalidInput(
+                    where(source, lines, f) + ": edge (" + std::to_string(a) + ", " +
+                    std::to_string(b) + ") is shared by more than two triangles (also on " +
+                    line_of(lines, uses[0].face) + " and " + line_of(lines, uses[1].face) + ")");
+            }
+        }
+    }
+
+    // Vertices: the triangles around a sample must form a single fan.
+    std::map<std::uint32_t, std::vector<std::size_t>> around;
+    for (std::size_t f = 0; f < nf; ++f)
+    {
+        for (const std::uint32_t v : triangles[f])
+        {
+            around[v].push_back(f);
+        }
+    }
+    for (const auto& [v, faces] : around)
+    {
+        UnionFind fans(faces.size());
+        for (std::size_t i = 0; i < faces.size(); ++i)
+        {
+            for (std::size_t j = i + 1; j < faces.size(); ++j)
+            {
+                int shared = 0;
+                for (const std::uint32_t a : triangles[faces[i]])
+                {
+                    for (const std::uint32_t b : triangles[faces[j]])
+                    {
+                        shared += (a == b && a != v) ? 1 : 0;
+                    }
+                }
+                if (shared > 0)
+                {
+                    fans.unite(i, j);
+                }
+            }
+        }
+        for (std::size_t i = 1; i < faces.size(); ++i)
+        {
+            if (fans.find(i) != fans.find(0))
+            {
+                throw InvalidInput(where(source, lines, faces[i]) + ": sample " +
+                                   std::to_string(v) +
+                                   " is a non-manifold vertex: its triangles form more than one "
+                                   "fan (those on " +
+                                   line_of(lines, faces[0]) + " and " + line_of(lines, faces[i]) +
+                                   " meet only at it)");
+            }
+        }
+    }
+
+    // Consistent orientation: breadth-first over edge-adjacent triangles.
+    std::vector<char> flip(nf, 0);
+    std::vector<char> visited(nf, 0);
+    std::vector<std::size_t> component(nf, 0);
+    std::vector<std::vector<std::size_t>> neighbours(nf);
+    for (const auto& [edge, uses] : edges)
+    {
+        if (uses.size() == 2)
+        {
+            neighbours[uses[0].face].push_back(uses[1].face);
+            neighbours[uses[1].face].push_back(uses[0].face);
+        }
+    }
+    const auto runs_forward = [&](std::size_t f, std::uint32_t a, std::uint32_t b) {
+        const Triangle& t = triangles[f];
+        for (int k = 0; k < 3; ++k)
+        {
+            if (t[static_cast<std::size_t>(k)] == a &&
+                t[static_cast<std::size_t>((k + 1) % 3)] == b)
+            {
+                return flip[f] == 0;
+            }
+        }
+        return flip[f] != 0; // the face runs b → a
+    };
+    std::size_t components = 0;
+    std::vector<std::size_t> queue;
+    for (std::size_t seed = 0; seed < nf; ++seed)
+    {
+        if (visited[seed])
+        {
+            continue;
+        }
+        visited[seed] = 1;
+        component[seed] = components;
+        queue.assign(1, seed);
+        for (std::size_t head = 0; head < queue.size(); ++head)
+        {
+            const std::size_t f = queue[head];
+            for (const std::size_t g : neighbours[f])
+            {
+                // The shared edge (a, b), as f runs it now.
+                std::uint32_t a = 0;
+                std::uint32_t b = 0;
+                for (int k = 0; k < 3; ++k)
+                {
+                    const std::uint32_t p = triangles[f][static_cast<std::size_t>(k)];
+                    const std::uint32_t q = triangles[f][static_cast<std::size_t>((k + 1) % 3)];
+                    const auto& tg = triangles[g];
+                    if (std::find(tg.begin(), tg.end(), p) != tg.end() &&
+                        std::find(tg.begin(), tg.end(), q) != tg.end())
+                    {
+                        a = flip[f] ? q : p;
+                        b = flip[f] ? p : q;
+                    }
+                }
+                if (!visited[g])
+                {
+                    visited[g] = 1;
+                    component[g] = components;
+                    // g must run b → a.
+                    if (runs_forward(g, a, b))
+                    {
+                        flip[g] = 1;
+                    }
+                    queue.push_back(g);
+                }
+                else if (runs_forward(g, a, b))
+                {
+                    throw InvalidInput(where(source, lines, g) +
+                                       ": the triangles cannot be oriented consistently (the "
+                                       "surface they form is not orientable)");
+                }
+            }
+        }
+        ++components;
+    }
+
+    // Outwards: per component, the area-weighted normals against ∇f at the vertices.
+    std::vector<double> vote(components, 0.0);
+    std::map<std::uint32_t, Vec3d> outward;
+    for (const auto& [v, faces] : around)
+    {
+        const Vec3d p = samples.world(v);
+        const FieldSample s = field.evaluate(p);
+        Vec3d g = Vec3d::Zero();
+        if (s.defined && s.gradient.allFinite())
+        {
+            g = s.gradient;
+        }
+        else if (samples.has_normals())
+        {
+            g = samples.normals[v].cast<double>();
+        }
+        outward[v] = g.squaredNorm() > 0.0 ? Vec3d(g.normalized()) : Vec3d::Zero();
+    }
+    for (std::size_t f = 0; f < nf; ++f)
+    {
+        const Triangle& t = triangles[f];
+        Vec3d n = (samples.world(t[1]) - samples.world(t[0]))
+                      .cross(samples.world(t[2]) - samples.world(t[0]));
+        if (flip[f])
+        {
+            n = -n;
+        }
+        for (const std::uint32_t v : t)
+        {
+            vote[component[f]] += n.dot(outward[v]);
+        }
+    }
+
+    PickedBaseMesh out;
+    out.mesh.vertices.origin = samples.origin;
+    std::map<std::uint32_t, std::uint32_t> vertex_of;
+    for (std::size_t f = 0; f < nf; ++f)
+    {
+        Triangle t = triangles[f];
+        const bool reverse = (flip[f] != 0) != (vote[component[f]] < 0.0);
+        if (reverse)
+        {
+            std::swap(t[1], t[2]);
+            ++out.reoriented_faces;
+        }
+        for (std::uint32_t& v : t)
+        {
+            const auto [it, inserted] =
+                vertex_of.emplace(v, static_cast<std::uint32_t>(out.samples.size()));
+            if (inserted)
+            {
+                out.samples.emplace_back(v);
+                out.mesh.vertices.positions.push_back(samples.positions[v]);
+            }
+            v = it->second;
+        }
+        out.mesh.triangles.push_back(t);
+    }
+    out.topology = analyze_topology(out.mesh);
+    PF_ASSERT(out.topology.is_oriented_manifold());
+    return out;
+}
+
+namespace {
+
+std::string_view trim(std::string_view s)
+{
+    const auto begin = s.find_first_not_of(" \t\r\f\v");
+    if (begin == std::string_view::npos)
+    {
+        return {};
+    }
+    const auto end = s.find_last_not_of(" \t\r\f\v");
+    return s.substr(begin, end - begin + 1);
+}
+
+/// Triangles of an index-triple file, with the line of each.
+std::pair<std::vector<Triangle>, std::vector<std::size_t>> read_index_triples(
+    const std::filesystem::path& path, std::size_t sample_count)
+{
+    std::ifstream in(path);
+    if (!in)
+    {
+        throw IoError(path, "cannot open the base-mesh file");
+    }
+    std::vector<Triangle> triangles;
+    std::vector<std::size_t> lines;
+    std::string line;
+    std::size_t number = 0;
+    const std::string name = path.string();
+    while (std::getline(in, line))
+    {
+        ++number;
+        std::string_view text = line;
+        text = trim(text.substr(0, text.find('#')));
+        if (text.empty())
+        {
+            continue;
+        }
+        Triangle t{};
+        std::size_t count = 0;
+        bool ok = true;
+        while (!text.empty())
+        {
+            const auto space = text.find_first_of(" \t,");
+            const std::string_view token = text.substr(0, space);
+            text =
+                space == std::string_view::npos ? std::string_view{} : trim(text.substr(space + 1));
+            std::uint64_t value = 0;
+            const auto [end, error] =
+                std::from_chars(token.data(), token.data() + token.size(), value);
+            if (error != std::errc{} || end != token.data() + token.size() || count == 3)
+            {
+                ok = false;
+                break;
+            }
+            if (value >= sample_count)
+            {
+                throw InvalidInput(name + ":" + std::to_string(number) + ": sample index " +
+                                   std::string(token) + " does not exist (there are " +
+                                   std::to_string(sample_count) + " samples)");
+            }
+            t[count++] = static_cast<std::uint32_t>(value);
+        }
+        if (!ok || count != 3)
+        {
+            throw InvalidInput(name + ":" + std::to_string(number) +
+                               ": expected three sample indices \"i j k\", got \"" +
+                               std::string(trim(line)) + "\"");
+        }
+        triangles.push_back(t);
+        lines.push_back(number);
+    }
+    if (in.bad())
+    {
+        throw IoError(path, "read error");
+    }
+    return {std::move(triangles), std::move(lines)};
+}
+
+} // namespace
+
+PickedBaseMesh read_picked_base_mesh(const std::filesystem::path& path, const PointCloud& samples,
+                                     const Field& field)
+{
+    if (samples.empty())
+    {
+        throw InvalidInput("base mesh: no samples to pick from");
+    }
+    std::error_code error;
+    if (!std::filesystem::is_regular_file(path, error))
+    {
+        throw IoError(path, "the base-mesh file does not exist or is not a regular file");
+    }
+    std::string extension = path.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const std::string name = path.string();
+    if (extension != ".obj")
+    {
+        auto [triangles, lines] = read_index_triples(path, samples.size());
+        return base_mesh_from_samples(triangles, samples, field, name, lines);
+    }
+
+    // OBJ: snap every used vertex to its nearest sample.
+    const ReadResult obj = read_geometry(path, {});
+    if (obj.triangles.empty())
+    {
+        throw InvalidInput(name + ": the OBJ file has no faces");
+    }
+    const KdTree tree(samples.positions);
+    std::vector<std::uint32_t> sample_of(obj.points.size(), PointId::invalid_value);
+    std::map<std::uint32_t, std::size_t> vertex_of_sample;
+    double max_snap = 0.0;
+    std::vector<Triangle> triangles;
+    triangles.reserve(obj.triangles.size());
+    for (const Triangle& t : obj.triangles)
+    {
+        Triangle s{};
+        for (std::size_t k = 0; k < 3; ++k)
+        {
+            const std::uint32_t v = t[k];
+            if (sample_of[v] == PointId::invalid_value)
+            {
+                const Vec3d world = obj.points.world(v);
+                float squared = 0.0F;
+                const PointId nearest =
+                    tree.nearest((world - samples.origin).cast<float>(), &squared);
+                const auto [it, inserted] = vertex_of_sample.emplace(nearest.value, v);
+                if (!inserted)
+                {
+                    throw InvalidInput(name + ": vertices " + std::to_string(it->second + 1) +
+                                       " and " + std::to_string(v + 1) +
+                                       " snap to the same sample " + std::to_string(nearest.value));
+                }
+                sample_of[v] = nearest.value;
+                max_snap = std::max(max_snap, (samples.world(nearest.value) - world).norm());
+            }
+            s[k] = sample_of[v];
+        }
+        triangles.push_back(s);
+    }
+    PickedBaseMesh out = base_mesh_from_samples(triangles, samples, field, name);
+    out.max_snap_distance = max_snap;
+    return out;
+}
+
+} // namespace pointform

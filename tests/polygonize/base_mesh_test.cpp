@@ -1,0 +1,525 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/polygonize/base_mesh.h"
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+#include "pointform/geometry/mesh_topology.h"
+#include "pointform/geometry/shapes.h"
+#include "pointform/hermite/radius.h"
+#include "pointform/hermite/surfels.h"
+#include "pointform/implicit/point_field.h"
+#include "pointform/implicit/primitives.h"
+#include "pointform/polygonize/marching_cubes.h"
+#include "pointform/spatial/kd_tree.h"
+
+#include "support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace pointform {
+namespace {
+
+/// Samples of a shape, their point field and its marching-cubes mesh.
+struct Scene
+{
+    std::unique_ptr<PointField> field;
+    TriMesh mc;
+    double spacing = 0.0; ///< mean sample spacing, √(area / count)
+};
+
+Scene sampled(Shape shape, std::size_t count, double area)
+{
+    const PointCloud samples = sample_shape(shape, {.count = count, .seed = 5});
+    Scene scene;
+    scene.field = std::make_unique<PointField>(
+        compute_surfels(samples, {.radius_scale = default_field_radius_scale}).surfels);
+    scene.mc = marching_cubes(*scene.field,
+                              grid_over(scene.field->bounds(), default_cell_size(*scene.field)))
+                   .mesh;
+    scene.spacing = std::sqrt(area / static_cast<double>(count));
+    return scene;
+}
+
+constexpr double sphere_area = 4.0 * std::numbers::pi;
+
+double min_angle_degrees(const TriMesh& mesh, const Triangle& t)
+{
+    const Vec3d p[3] = {mesh.vertices.world(t[0]), mesh.vertices.world(t[1]),
+                        mesh.vertices.world(t[2])};
+    double smallest = 180.0;
+    for (int k = 0; k < 3; ++k)
+    {
+        const Vec3d u = p[(k + 1) % 3] - p[k];
+        const Vec3d v = p[(k + 2) % 3] - p[k];
+        smallest =
+            std::min(smallest, std::atan2(u.cross(v).norm(), u.dot(v)) * 180.0 / std::numbers::pi);
+    }
+    return smallest;
+}
+
+Vec3d face_normal(const TriMesh& mesh, const Triangle& t)
+{
+    const Vec3d a = mesh.vertices.world(t[0]);
+    return (mesh.vertices.world(t[1]) - a).cross(mesh.vertices.world(t[2]) - a);
+}
+
+double share_below_20(const TriMesh& mesh)
+{
+    const auto bad =
+        std::count_if(mesh.triangles.begin(), mesh.triangles.end(),
+                      [&](const Triangle& t) { return min_angle_degrees(mesh, t) < 20.0; });
+    return static_cast<double>(bad) / static_cast<double>(mesh.face_count());
+}
+
+TEST(BaseMesh, SampledSphereReachesTheTargetOnTheSurface)
+{
+    const Scene scene = sampled(Shape::Sphere, 5000, sphere_area);
+    const std::size_t target = 300;
+    const BaseMeshResult result = build_base_mesh(scene.mc, *scene.field, {.target_faces = target});
+    const TriMesh& mesh = result.mesh;
+
+    EXPECT_NEAR(static_cast<double>(mesh.face_count()), static_cast<double>(target),
+                0.03 * static_cast<double>(target));
+    EXPECT_EQ(result.stats.faces, mesh.face_count());
+    EXPECT_EQ(result.stats.input_faces, scene.mc.face_count());
+    const MeshTopology topo = analyze_topology(mesh);
+    EXPECT_TRUE(topo.is_oriented_manifold());
+    EXPECT_TRUE(topo.is_closed());
+    EXPECT_EQ(topo.components, 1U);
+    EXPECT_EQ(topo.euler_characteristic, 2);
+    EXPECT_TRUE(result.stats.topology_kept) << result.stats.topology_change;
+    EXPECT_TRUE(result.stats.topology_change.empty());
+
+    // Every vertex on f = 0, which lies within a fraction of the spacing of the true sphere.
+    EXPECT_EQ(result.stats.unprojected, 0U);
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+    {
+        ASSERT_NEAR(mesh.vertices.world(v).norm(), 1.0, 0.25 * scene.spacing) << "vertex " << v;
+        ASSERT_NEAR(scene.field->evaluate(mesh.vertices.world(v)).value, 0.0, 0.01 * scene.spacing);
+    }
+    // Triangle shape, checked here and as reported.
+    EXPECT_LT(share_below_20(mesh), 0.02);
+    EXPECT_NEAR(result.stats.share_below_20_degrees, share_below_20(mesh), 1e-12);
+    // Outwards like the marching-cubes mesh, with no zero-area face.
+    for (const Triangle& t : mesh.triangles)
+    {
+        const Vec3d n = face_normal(mesh, t);
+        const Vec3d centre =
+            (mesh.vertices.world(t[0]) + mesh.vertices.world(t[1]) + mesh.vertices.world(t[2])) /
+            3.0;
+        ASSERT_GT(n.norm(), 1e-6);
+        ASSERT_GT(n.normalized().dot(centre.normalized()), 0.5);
+    }
+}
+
+TEST(BaseMesh, DefaultTargetFollowsTheIntermediateMesh)
+{
+    const Scene scene = sampled(Shape::Sphere, 3000, sphere_area);
+    const std::size_t expected = default_base_faces(scene.mc);
+    EXPECT_GE(expected, 200U);
+    EXPECT_LE(expected, scene.mc.face_count());
+    const BaseMeshResult result = build_base_mesh(scene.mc, *scene.field);
+    EXPECT_EQ(result.stats.target_faces, expected);
+    EXPECT_LE(result.stats.faces, expected);
+    EXPECT_GE(static_cast<double>(result.stats.faces), 0.97 * static_cast<double>(expected));
+}
+
+TEST(BaseMesh, TorusKeepsItsGenus)
+{
+    const Scene scene =
+        sampled(Shape::Torus, 6000, 4.0 * std::numbers::pi * std::numbers::pi * 0.35);
+    const BaseMeshResult result = build_base_mesh(scene.mc, *scene.field, {.target_faces = 240});
+    const MeshTopology topo = analyze_topology(result.mesh);
+    EXPECT_TRUE(topo.is_oriented_manifold());
+    EXPECT_TRUE(topo.is_closed());
+    EXPECT_EQ(topo.euler_characteristic, 0);
+    EXPECT_TRUE(result.stats.topology_kept) << result.stats.topology_change;
+    EXPECT_LT(share_below_20(result.mesh), 0.02);
+    // Every vertex within a fraction of the spacing of the true torus (R = 1, r = 0.35).
+    for (std::size_t v = 0; v < result.mesh.vertex_count(); ++v)
+    {
+        const Vec3d p = result.mesh.vertices.world(v);
+        const double ring = std::hypot(std::hypot(p.x(), p.y()) - 1.0, p.z());
+        ASSERT_NEAR(ring, 0.35, 0.25 * scene.spacing);
+    }
+}
+
+TEST(BaseMesh, SphereWithoutItsCapKeepsOneBoundaryLoop)
+{
+    // A unit sphere sampled with exact normals, without the cap above z = 0.8.
+    const PointCloud all = sample_shape(Shape::Sphere, {.count = 5000, .seed = 12});
+    PointCloud cloud;
+    for (std::size_t i = 0; i < all.size(); ++i)
+    {
+        if (all.positions[i].z() <= 0.8F)
+        {
+            cloud.positions.push_back(all.positions[i]);
+            cloud.normals.push_back(all.normals[i]);
+        }
+    }
+    const KdTree tree(cloud.positions);
+    cloud.radii = influence_radii(knn_batch(tree, cloud.positions, 17), 1.5);
+    const PointField field(cloud);
+    const TriMesh mc =
+        marching_cubes(field, grid_over(field.bounds(), default_cell_size(field))).mesh;
+    ASSERT_EQ(analyze_topology(mc).boundary_loops, 1U);
+
+    const BaseMeshResult result = build_base_mesh(mc, field, {.target_faces = 250});
+    const MeshTopology topo = analyze_topology(result.mesh);
+    EXPECT_TRUE(topo.is_oriented_manifold());
+    EXPECT_EQ(topo.boundary_loops, 1U);
+    EXPECT_EQ(topo.euler_characteristic, 1);
+    EXPECT_TRUE(result.stats.topology_kept) << result.stats.topology_change;
+    EXPECT_LE(result.stats.faces, 250U);
+    EXPECT_EQ(result.stats.unprojected, 0U);
+    EXPECT_LT(result.stats.share_below_20_degrees_off_boundary, 0.02);
+    // The rim stays where the samples end (within one influence radius).
+    const double reach =
+        0.8 + static_cast<double>(*std::max_element(cloud.radii.begin(), cloud.radii.end()));
+    for (std::size_t v = 0; v < result.mesh.vertex_count(); ++v)
+    {
+        ASSERT_LT(result.mesh.vertices.world(v).z(), reach);
+    }
+}
+
+TEST(BaseMesh, VerticesWhereTheFieldIsUndefinedStayAndAreCounted)
+{
+    // The marching-cubes mesh of a whole sphere (linear interpolation only, so its vertices are
+    // off f = 0), projected with a field that is undefined above z = 0.3: vertices up there find
+    // no crossing and keep their marching-cubes positions.
+    class LowerSphere final : public Field
+    {
+    public:
+        [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override
+        {
+            FieldSample s = sphere_->evaluate(p);
+            s.defined = p.z() < 0.3;
+            return s;
+        }
+        using Field::evaluate;
+        [[nodiscard]] Aabb bounds() const override { return sphere_->bounds(); }
+
+    private:
+        std::shared_ptr<const Field> sphere_ = make_sphere(Vec3d::Zero(), 1.0);
+    };
+    const auto sphere = make_sphere(Vec3d::Zero(), 1.0);
+    const TriMesh mc =
+        marching_cubes(*sphere, grid_over(sphere->bounds(), 0.05), {.refine_steps = 0}).mesh;
+    const LowerSphere lower;
+    const BaseMeshResult result = build_base_mesh(mc, lower, {.target_faces = 400});
+    EXPECT_TRUE(result.stats.topology_kept) << result.stats.topology_change;
+
+    std::vector<std::array<float, 3>> mc_positions;
+    for (const Vec3f& p : mc.vertices.positions)
+    {
+        mc_positions.push_back({p.x(), p.y(), p.z()});
+    }
+    std::sort(mc_positions.begin(), mc_positions.end());
+    std::size_t off_surface = 0;
+    for (std::size_t v = 0; v < result.mesh.vertex_count(); ++v)
+    {
+        const Vec3f& p = result.mesh.vertices.positions[v];
+        if (std::abs(sphere->evaluate(p.cast<double>()).value) < 1e-6)
+        {
+            continue;
+        }
+        ++off_surface;
+        EXPECT_GT(p.z(), 0.1F) << "vertex " << v; // at or above the undefined region
+        EXPECT_TRUE(std::binary_search(mc_positions.begin(), mc_positions.end(),
+                                       std::array<float, 3>{p.x(), p.y(), p.z()}))
+            << "vertex " << v << " moved though it was not projected";
+    }
+    EXPECT_GT(result.stats.unprojected, 0U);
+    EXPECT_EQ(result.stats.unprojected, off_surface);
+}
+
+TEST(BaseMesh, SameMeshWhateverTheThreadCount)
+{
+    const Scene scene = sampled(Shape::Sphere, 3000, sphere_area);
+    const int saved = thread_count();
+    set_thread_count(1);
+    const TriMesh one = build_base_mesh(scene.mc, *scene.field, {.target_faces = 200}).mesh;
+    set_thread_count(2);
+    const TriMesh two = build_base_mesh(scene.mc, *scene.field, {.target_faces = 200}).mesh;
+    set_thread_count(saved);
+    EXPECT_EQ(one.triangles, two.triangles);
+    EXPECT_EQ(one.vertices.positions, two.vertices.positions);
+}
+
+TEST(BaseMesh, RejectsBadTargetsAndMeshes)
+{
+    const Scene scene = sampled(Shape::Sphere, 2000, sphere_area);
+    EXPECT_THROW((void)build_base_mesh(scene.mc, *scene.field, {.target_faces = 0}), InvalidInput);
+    EXPECT_THROW(
+        (void)build_base_mesh(scene.mc, *scene.field, {.target_faces = scene.mc.face_count() + 1}),
+        InvalidInput);
+    try
+    {
+        (void)build_base_mesh(scene.mc, *scene.field, {.target_faces = 10 * scene.mc.face_count()});
+        ADD_FAILURE() << "no exception";
+    }
+    catch (const InvalidInput& e)
+    {
+        EXPECT_NE(std::string(e.what()).find(std::to_string(scene.mc.face_count())),
+                  std::string::npos)
+            << e.what();
+    }
+    EXPECT_THROW((void)build_base_mesh(TriMesh{}, *scene.field), InvalidInput);
+    EXPECT_THROW((void)build_base_mesh(scene.mc, *scene.field, {.min_angle_degrees = 70.0}),
+                 InvalidInput);
+    // Three triangles on one edge.
+    TriMesh fin;
+    fin.vertices.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0), Vec3f(0, -1, 0),
+                              Vec3f(0, 0, 1)};
+    fin.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};
+    EXPECT_THROW((void)build_base_mesh(fin, *scene.field, {.target_faces = 2}), InvalidInput);
+    // Cancelled through the progress callback.
+    EXPECT_THROW((void)build_base_mesh(scene.mc, *scene.field,
+                                       {.target_faces = 100,
+                                        .progress =
+                                            [](std::string_view, double) {
+                                                return false;
+                                            }}),
+                 Cancelled);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Interactive base mesh.
+
+struct Picks
+{
+    std::unique_ptr<PointField> field;
+    std::array<std::uint32_t, 6> axis{}; ///< samples nearest to +x, -x, +y, -y, +z, -z
+};
+
+Picks sphere_picks()
+{
+    Picks picks;
+    const PointCloud samples = sample_shape(Shape::Sphere, {.count = 2000, .seed = 7});
+    picks.field = std::make_unique<PointField>(
+        compute_surfels(samples, {.radius_scale = default_field_radius_scale}).surfels);
+    const PointCloud& surfels = picks.field->surfels();
+    const KdTree tree(surfels.positions);
+    const std::array<Vec3d, 6> directions = {Vec3d::UnitX(), Vec3d(-Vec3d::UnitX()),
+                                             Vec3d::UnitY(), Vec3d(-Vec3d::UnitY()),
+                                             Vec3d::UnitZ(), Vec3d(-Vec3d::UnitZ())};
+    for (std::size_t i = 0; i < 6; ++i)
+    {
+        picks.axis[i] = tree.nearest((directions[i] - surfels.origin).cast<float>()).value;
+    }
+    return picks;
+}
+
+/// The octahedron's faces over the axis picks (indices into Picks::axis), outward.
+constexpr std::array<std::array<int, 3>, 8> octahedron = {
+    {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}}};
+
+TEST(PickedBaseMesh, OctahedronOfIndexTriplesIsOrientedOutwards)
+{
+    const Picks picks = sphere_picks();
+    const PointCloud& samples = picks.field->surfels();
+    // Every other triangle written the wrong way round; comments and blank lines in between.
+    std::ostringstream text;
+    text << "# octahedron over six picked samples\n\n";
+    for (std::size_t f = 0; f < octahedron.size(); ++f)
+    {
+        const auto& t = octahedron[f];
+        if (f % 2 == 0)
+        {
+            text << picks.axis[t[0]] << ' ' << picks.axis[t[1]] << ' ' << picks.axis[t[2]];
+        }
+        else
+        {
+            text << picks.axis[t[0]] << '\t' << picks.axis[t[2]] << "  " << picks.axis[t[1]];
+        }
+        text << "   # face " << f << '\n';
+    }
+    const test::TempDir dir;
+    test::write_file(dir / "octahedron.txt", text.str());
+    const PickedBaseMesh picked =
+        read_picked_base_mesh(dir / "octahedron.txt", samples, *picks.field);
+
+    const TriMesh& mesh = picked.mesh;
+    ASSERT_EQ(mesh.face_count(), 8U);
+    ASSERT_EQ(mesh.vertex_count(), 6U);
+    ASSERT_EQ(picked.samples.size(), 6U);
+    EXPECT_EQ(picked.reoriented_faces, 4U);
+    EXPECT_TRUE(picked.topology.is_oriented_manifold());
+    EXPECT_TRUE(picked.topology.is_closed());
+    EXPECT_EQ(picked.topology.euler_characteristic, 2);
+    for (std::size_t v = 0; v < 6; ++v)
+    {
+        const std::uint32_t s = picked.samples[v].value;
+        EXPECT_NE(std::find(picks.axis.begin(), picks.axis.end(), s), picks.axis.end());
+        EXPECT_EQ((mesh.vertices.world(v) - samples.world(s)).norm(), 0.0);
+    }
+    for (const Triangle& t : mesh.triangles)
+    {
+        const Vec3d centre =
+            (mesh.vertices.world(t[0]) + mesh.vertices.world(t[1]) + mesh.vertices.world(t[2])) /
+            3.0;
+        EXPECT_GT(face_normal(mesh, t).normalized().dot(centre.normalized()), 0.9);
+    }
+
+    // All eight written inwards: the whole component is turned outwards.
+    std::vector<Triangle> inwards;
+    for (const auto& t : octahedron)
+    {
+        inwards.push_back({picks.axis[t[0]], picks.axis[t[2]], picks.axis[t[1]]});
+    }
+    const PickedBaseMesh turned = base_mesh_from_samples(inwards, samples, *picks.field);
+    EXPECT_EQ(turned.reoriented_faces, 8U);
+    for (const Triangle& t : turned.mesh.triangles)
+    {
+        const Vec3d a = turned.mesh.vertices.world(t[0]);
+        EXPECT_GT(face_normal(turned.mesh, t).dot(a), 0.0);
+    }
+}
+
+/// The message of the InvalidInput that `read` throws, or a failure.
+template <typename Read>
+std::string invalid_input_message(Read read)
+{
+    try
+    {
+        read();
+    }
+    catch (const InvalidInput& e)
+    {
+        return e.what();
+    }
+    ADD_FAILURE() << "no InvalidInput";
+    return {};
+}
+
+TEST(PickedBaseMesh, BadFilesNameTheFileAndLine)
+{
+    const Picks picks = sphere_picks();
+    const PointCloud& samples = picks.field->surfels();
+    const test::TempDir dir;
+    const auto read = [&](const std::string& name, const std::string& content) {
+        test::write_file(dir / name, content);
+        return invalid_input_message(
+            [&] { (void)read_picked_base_mesh(dir / name, samples, *picks.field); });
+    };
+    const std::string a = std::to_string(picks.axis[0]);
+    const std::string b = std::to_string(picks.axis[2]);
+    const std::string c = std::to_string(picks.axis[4]);
+    const std::string d = std::to_string(picks.axis[1]);
+    const std::string e = std::to_string(picks.axis[3]);
+
+    // A sample that does not exist, on line 3.
+    std::string message = read("range.txt", "# picks\n" + a + " " + b + " " + c + "\n" + a + " " +
+                                                b + " " + std::to_string(samples.size()) + "\n");
+    EXPECT_NE(message.find("range.txt:3"), std::string::npos) << message;
+    EXPECT_NE(message.find(std::to_string(samples.size())), std::string::npos) << message;
+    // Not three integers.
+    message = read("malformed.txt", a + " " + b + "\n");
+    EXPECT_NE(message.find("malformed.txt:1"), std::string::npos) << message;
+    message = read("negative.txt", a + " " + b + " -" + c + "\n");
+    EXPECT_NE(message.find("negative.txt:1"), std::string::npos) << message;
+    message = read("four.txt", a + " " + b + " " + c + " " + d + "\n");
+    EXPECT_NE(message.find("four.txt:1"), std::string::npos) << message;
+    // A degenerate and a repeated triangle.
+    message = read("degenerate.txt", a + " " + b + " " + a + "\n");
+    EXPECT_NE(message.find("degenerate.txt:1"), std::string::npos) << message;
+    message = read("duplicate.txt", a + " " + b + " " + c + "\n\n" + b + " " + a + " " + c + "\n");
+    EXPECT_NE(message.find("duplicate.txt:3"), std::string::npos) << message;
+    // Three triangles on the edge (a, b): non-manifold.
+    message = read("fin.txt", a + " " + b + " " + c + "\n" + b + " " + a + " " + d + "\n" + a +
+                                  " " + b + " " + e + "\n");
+    EXPECT_NE(message.find("fin.txt:3"), std::string::npos) << message;
+    // Two triangles that meet only at one sample: a non-manifold vertex.
+    message = read("bowtie.txt", a + " " + b + " " + c + "\n" + a + " " + d + " " + e + "\n");
+    EXPECT_NE(message.find("bowtie.txt"), std::string::npos) << message;
+    EXPECT_NE(message.find("non-manifold vertex"), std::string::npos) << message;
+    // Empty.
+    message = read("empty.txt", "# nothing\n");
+    EXPECT_NE(message.find("empty.txt"), std::string::npos) << message;
+    // Missing file.
+    EXPECT_THROW((void)read_picked_base_mesh(dir / "missing.txt", samples, *picks.field), IoError);
+}
+
+TEST(PickedBaseMesh, NonOrientableTrianglesAreRejected)
+{
+    const Picks picks = sphere_picks();
+    // The five-vertex Möbius band: triangles (i, i+1, i+2) mod 5.
+    const std::array<std::uint32_t, 5> v = {picks.axis[0], picks.axis[2], picks.axis[1],
+                                            picks.axis[3], picks.axis[4]};
+    std::vector<Triangle> band;
+    for (std::size_t i = 0; i < 5; ++i)
+    {
+        band.push_back({v[i], v[(i + 1) % 5], v[(i + 2) % 5]});
+    }
+    const std::string message = invalid_input_message(
+        [&] { (void)base_mesh_from_samples(band, picks.field->surfels(), *picks.field); });
+    EXPECT_NE(message.find("orient"), std::string::npos) << message;
+}
+
+TEST(PickedBaseMesh, ObjVerticesSnapToTheNearestSamples)
+{
+    const Picks picks = sphere_picks();
+    const PointCloud& samples = picks.field->surfels();
+    // The octahedron's corners a little off the axes; the nearest samples, by brute force.
+    const std::array<Vec3d, 6> corners = {Vec3d(1.02, 0.01, 0.0),  Vec3d(-0.98, 0.0, 0.01),
+                                          Vec3d(0.0, 1.01, -0.01), Vec3d(0.01, -1.0, 0.0),
+                                          Vec3d(0.0, 0.01, 0.99),  Vec3d(-0.01, 0.0, -1.02)};
+    std::ostringstream obj;
+    std::array<std::uint32_t, 6> nearest{};
+    double farthest = 0.0;
+    for (std::size_t i = 0; i < 6; ++i)
+    {
+        obj << "v " << corners[i].x() << ' ' << corners[i].y() << ' ' << corners[i].z() << '\n';
+        double best = 1e300;
+        for (std::size_t s = 0; s < samples.size(); ++s)
+        {
+            const double distance = (samples.world(s) - corners[i]).norm();
+            if (distance < best)
+            {
+                best = distance;
+                nearest[i] = static_cast<std::uint32_t>(s);
+            }
+        }
+        farthest = std::max(farthest, best);
+    }
+    for (const auto& t : octahedron)
+    {
+        obj << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+    }
+    const test::TempDir dir;
+    test::write_file(dir / "picked.obj", obj.str());
+    const PickedBaseMesh picked = read_picked_base_mesh(dir / "picked.obj", samples, *picks.field);
+    ASSERT_EQ(picked.mesh.face_count(), 8U);
+    ASSERT_EQ(picked.samples.size(), 6U);
+    EXPECT_EQ(picked.reoriented_faces, 0U);
+    EXPECT_EQ(picked.topology.euler_characteristic, 2);
+    for (std::size_t i = 0; i < 6; ++i)
+    {
+        EXPECT_NE(std::find_if(picked.samples.begin(), picked.samples.end(),
+                               [&](PointId id) { return id.value == nearest[i]; }),
+                  picked.samples.end())
+            << "corner " << i;
+    }
+    EXPECT_NEAR(picked.max_snap_distance, farthest, 1e-5);
+
+    // Two vertices that snap to the same sample.
+    test::write_file(dir / "twice.obj", "v 1 0 0\nv 1.0001 0 0\nv 0 1 0\nf 1 2 3\n");
+    const std::string message = invalid_input_message(
+        [&] { (void)read_picked_base_mesh(dir / "twice.obj", samples, *picks.field); });
+    EXPECT_NE(message.find("twice.obj"), std::string::npos) << message;
+    EXPECT_NE(message.find("same sample"), std::string::npos) << message;
+}
+
+} // namespace
+} // namespace pointform
