@@ -2,6 +2,7 @@
 // Copyright (c) 2026 the pointform authors
 
 #include "pointform/core/parallel.h"
+#include "pointform/io/hierarchy.h"
 #include "pointform/io/io.h"
 #include "pointform/spatial/kd_tree.h"
 
@@ -66,9 +67,43 @@ std::string vec_text(const Vec3d& v)
     return format_number(v.x()) + " " + format_number(v.y()) + " " + format_number(v.z());
 }
 
+/// A hierarchy file's summary: its levels (`pointform lod` extracts them).
+void run_hierarchy_info(const InfoOptions& options, const GlobalOptions& global)
+{
+    const MultiresMesh mesh = read_hierarchy(options.input);
+    nlohmann::json levels = nlohmann::json::array();
+    for (std::size_t l = 0; l < mesh.level_count(); ++l)
+        levels.push_back(
+            {{"level", l}, {"vertices", mesh.vertex_count(l)}, {"faces", mesh.face_count(l)}});
+    if (options.json)
+    {
+        const nlohmann::json out = {
+            {"file", options.input},
+            {"format", "pointform hierarchy version " + std::to_string(hierarchy_format_version)},
+            {"origin", vec_json(mesh.origin())},
+            {"levels", levels}};
+        std::printf("%s\n", out.dump(2).c_str());
+        return;
+    }
+    if (global.quiet)
+        return;
+    std::printf("%s\n", options.input.c_str());
+    print_row("format", "pointform hierarchy version " + std::to_string(hierarchy_format_version));
+    for (const auto& level : levels)
+        print_row("level " + level["level"].dump(),
+                  level["vertices"].dump() + " vertices, " + level["faces"].dump() + " faces");
+    if (mesh.origin() != Vec3d::Zero())
+        print_row("storage origin", vec_text(mesh.origin()));
+}
+
 void run_info(const InfoOptions& options, const GlobalOptions& global)
 {
     set_thread_count(global.threads);
+    if (is_hierarchy_file(options.input))
+    {
+        run_hierarchy_info(options, global);
+        return;
+    }
     TerminalProgress progress(!global.quiet && !options.json);
     const ReadResult read = read_geometry(options.input);
     const PointCloud& cloud = read.points;
@@ -139,7 +174,8 @@ void register_info(CLI::App& app, const GlobalOptions& global)
     CLI::App* cmd = app.add_subcommand(
         "info", "Print point count, bounding box, sampling density and attributes of a file");
     cmd->add_option("input", options->input,
-                    "Point set or mesh: .ply .xyz .pts .csv .txt .pwn .off .obj .pcd .las")
+                    "Point set or mesh: .ply .xyz .pts .csv .txt .pwn .off .obj .pcd .las; or a "
+                    "hierarchy file (.pfh)")
         ->required();
     cmd->add_flag("--json", options->json, "Print the summary as JSON");
     cmd->callback([options, &global] { run_info(*options, global); });

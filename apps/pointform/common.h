@@ -91,5 +91,6 @@ void register_render(CLI::App& app, const GlobalOptions& global);
 void register_distance(CLI::App& app, const GlobalOptions& global);
 void register_model(CLI::App& app, const GlobalOptions& global);
 void register_morph(CLI::App& app, const GlobalOptions& global);
+void register_lod(CLI::App& app, const GlobalOptions& global);
 
 } // namespace pointform::cli

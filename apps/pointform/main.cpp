@@ -43,6 +43,7 @@ int run(int argc, char** argv)
     pointform::cli::register_distance(app, global);
     pointform::cli::register_model(app, global);
     pointform::cli::register_morph(app, global);
+    pointform::cli::register_lod(app, global);
 
     try
     {

@@ -276,30 +276,36 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
     const std::size_t fit_k =
         options.fit == PlaneFit::Quadric ? options.quadric_k : options.centroid_k;
     const std::size_t k = std::min(std::max<std::size_t>(fit_k, 2) + 1, n);
-    const KnnTable knn = knn_batch(m.tree, m.surfels.positions, k);
-    double area = 0.0;
-    for (std::size_t i = 0; i < n; ++i)
-    {
-        // The ball to the last neighbour holds k samples: π d² / k of surface per sample.
-        area += std::numbers::pi * static_cast<double>(knn.distances2(i)[k - 1]) /
-                static_cast<double>(k);
-    }
-    m.area = area;
 
     // Grid cells of about twice a query's farthest neighbour, so that queries near the surface
-    // find their neighbours in the 8 cells around them (PointGrid).
-    const std::size_t query_k = blends(options.fit) ? options.blend_k + 1 : 9;
-    std::vector<float> reach(n);
-    for (std::size_t i = 0; i < n; ++i)
-    {
-        reach[i] = knn.distances2(i)[std::min(query_k, k) - 1];
-    }
-    auto reach_middle = reach.begin() + static_cast<std::ptrdiff_t>(n / 2);
+    // find their neighbours in the 8 cells around them (PointGrid); the median is taken over
+    // a fixed subsample.
+    const std::size_t query_k = std::min(blends(options.fit) ? options.blend_k + 1 : 9, n);
+    const std::size_t stride = std::max<std::size_t>(1, n / 20000);
+    std::vector<float> reach((n + stride - 1) / stride);
+    parallel_blocks(reach.size(), 256, [&](std::size_t begin, std::size_t end) {
+        std::vector<std::uint32_t> index(query_k);
+        std::vector<float> d2(query_k);
+        for (std::size_t r = begin; r < end; ++r)
+        {
+            m.tree.knn(m.surfels.positions[r * stride], query_k, index, d2);
+            reach[r] = d2[query_k - 1];
+        }
+    });
+    auto reach_middle = reach.begin() + static_cast<std::ptrdiff_t>(reach.size() / 2);
     std::nth_element(reach.begin(), reach_middle, reach.end());
     const float cell = grid_cell_scale * std::sqrt(*reach_middle);
     m.grid = std::make_unique<PointGrid>(m.surfels.positions, cell > 0.0F ? cell : 1.0F, m.tree);
+
+    // Each sample's local surface from its k nearest, in grid order (neighbouring queries
+    // after each other), without keeping a table of every sample's neighbours.
+    constexpr std::size_t block = 4096;
     m.packed.assign(m.grid->slot_count(), PackedSurfel{});
-    parallel_blocks(m.packed.size(), 4096, [&](std::size_t begin, std::size_t end) {
+    std::vector<double> block_area((m.packed.size() + block - 1) / block, 0.0);
+    parallel_blocks(m.packed.size(), block, [&](std::size_t begin, std::size_t end) {
+        std::vector<std::uint32_t> index(k);
+        std::vector<float> d2(k);
+        double area = 0.0;
         for (std::size_t slot = begin; slot < end; ++slot)
         {
             const std::uint32_t i = m.grid->original_index(static_cast<std::uint32_t>(slot));
@@ -307,14 +313,23 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
             {
                 continue;
             }
+            m.tree.knn(m.surfels.positions[i], k, index, d2);
+            // The ball to the last neighbour holds k samples: π d² / k of surface per sample.
+            area += std::numbers::pi * static_cast<double>(d2[k - 1]) / static_cast<double>(k);
             PackedSurfel& packed = m.packed[slot];
             packed.position = m.surfels.positions[i];
             packed.radius = m.surfels.radii[i];
             packed.normal = m.surfels.normals[i];
             packed.tangent = tangent_of(packed.normal);
-            fit_local_surface(m.surfels, knn.neighbors(i), i, options.fit, packed);
+            fit_local_surface(m.surfels, index, i, options.fit, packed);
         }
+        block_area[begin / block] = area;
     });
+    m.area = 0.0;
+    for (const double area : block_area)
+    {
+        m.area += area;
+    }
 
     float max_radius = 0.0F;
     for (const float r : m.surfels.radii)
