@@ -27,6 +27,10 @@
 
 namespace pointform::detail {
 
+/// \brief The whole file as bytes. \throw IoError naming the file if it is missing, a
+/// directory, empty or unreadable
+[[nodiscard]] std::string read_whole_file(const std::filesystem::path& path);
+
 /// Where in a file a problem was found: a 1-based line (text) or a byte offset (binary).
 struct Location
 {

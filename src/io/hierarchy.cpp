@@ -82,30 +82,6 @@ struct FileCloser
 };
 using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
 
-std::string read_whole_file(const std::filesystem::path& path)
-{
-    std::error_code ec;
-    const auto status = std::filesystem::status(path, ec);
-    if (!std::filesystem::exists(status))
-        fail(path, "file does not exist");
-    if (std::filesystem::is_directory(status))
-        fail(path, "is a directory, not a file");
-    const std::uintmax_t size = std::filesystem::file_size(path, ec);
-    if (ec)
-        fail(path, "cannot get the file size: " + ec.message());
-    if (size == 0)
-        fail(path, "file is empty");
-    const FilePtr file(std::fopen(path.c_str(), "rb"));
-    if (!file)
-        fail(path, std::string("cannot open file: ") + std::strerror(errno));
-    std::string bytes(static_cast<std::size_t>(size), '\0');
-    const std::size_t got = std::fread(bytes.data(), 1, bytes.size(), file.get());
-    if (got != bytes.size())
-        fail(path, "could not read the whole file (" + std::to_string(got) + " of " +
-                       std::to_string(bytes.size()) + " bytes)");
-    return bytes;
-}
-
 MultiresMesh decode(const std::filesystem::path& path, std::string_view bytes)
 {
     const std::string_view magic = magic_bytes();
@@ -239,7 +215,7 @@ void write_hierarchy(const std::filesystem::path& path, const MultiresMesh& mesh
 
 MultiresMesh read_hierarchy(const std::filesystem::path& path)
 {
-    const std::string bytes = read_whole_file(path);
+    const std::string bytes = detail::read_whole_file(path);
     return decode(path, bytes);
 }
 

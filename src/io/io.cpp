@@ -33,31 +33,6 @@ struct FileCloser
     }
 };
 
-std::string read_whole_file(const std::filesystem::path& path)
-{
-    std::error_code ec;
-    const auto status = std::filesystem::status(path, ec);
-    if (!std::filesystem::exists(status))
-        fail(path, "file does not exist");
-    if (std::filesystem::is_directory(status))
-        fail(path, "is a directory, not a file");
-    const std::uintmax_t size = std::filesystem::file_size(path, ec);
-    if (ec)
-        fail(path, "cannot get the file size: " + ec.message());
-    if (size == 0)
-        fail(path, "file is empty");
-
-    FileCloser closer{std::fopen(path.c_str(), "rb")};
-    if (closer.file == nullptr)
-        fail(path, std::string("cannot open file: ") + std::strerror(errno));
-    std::string bytes(static_cast<std::size_t>(size), '\0');
-    const std::size_t got = std::fread(bytes.data(), 1, bytes.size(), closer.file);
-    if (got != bytes.size())
-        fail(path, "could not read the whole file (" + std::to_string(got) + " of " +
-                       std::to_string(bytes.size()) + " bytes)");
-    return bytes;
-}
-
 std::filesystem::path temporary_name(const std::filesystem::path& path)
 {
     static std::atomic<unsigned> counter{0};
@@ -174,7 +149,7 @@ FileFormat format_from_extension(const std::filesystem::path& path)
 ReadResult read_geometry(const std::filesystem::path& path, const ReadOptions& options)
 {
     const FileFormat format = resolve_format(path, options.format);
-    const std::string bytes = read_whole_file(path);
+    const std::string bytes = detail::read_whole_file(path);
     const NonFinitePolicy policy = detail::resolve_policy(options.non_finite, format);
 
     ReadResult result;
@@ -263,5 +238,34 @@ void write_mesh(const std::filesystem::path& path, const TriMesh& mesh, const Wr
         }
     });
 }
+
+namespace detail {
+
+std::string read_whole_file(const std::filesystem::path& path)
+{
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (!std::filesystem::exists(status))
+        fail(path, "file does not exist");
+    if (std::filesystem::is_directory(status))
+        fail(path, "is a directory, not a file");
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec)
+        fail(path, "cannot get the file size: " + ec.message());
+    if (size == 0)
+        fail(path, "file is empty");
+
+    FileCloser closer{std::fopen(path.c_str(), "rb")};
+    if (closer.file == nullptr)
+        fail(path, std::string("cannot open file: ") + std::strerror(errno));
+    std::string bytes(static_cast<std::size_t>(size), '\0');
+    const std::size_t got = std::fread(bytes.data(), 1, bytes.size(), closer.file);
+    if (got != bytes.size())
+        fail(path, "could not read the whole file (" + std::to_string(got) + " of " +
+                       std::to_string(bytes.size()) + " bytes)");
+    return bytes;
+}
+
+} // namespace detail
 
 } // namespace pointform
