@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # From a fresh Debian 12 machine: install dependencies, build, and run the main job on the
-# shipped bunny scan: oriented surfels with influence radii (Level 1 -> 2), then the
-# marching-cubes surface of their field and a picture of it.
+# shipped bunny scan: raw points -> oriented surfels with influence radii (Level 1 -> 2) -> their
+# field -> a semi-regular multiresolution mesh (Level 3: base mesh refined until it is within the
+# sampling density of the scan), then a picture of it with its edges drawn.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -10,6 +11,6 @@ bash scripts/setup.sh
 cmake --preset release
 cmake --build --preset release --target pointform_cli
 ./build/release/apps/pointform/pointform info data/bunny/bun_zipper.ply
-./build/release/apps/pointform/pointform normals data/bunny/bun_zipper.ply -o bunny_surfels.ply
-./build/release/apps/pointform/pointform mc data/bunny/bun_zipper.ply -o bunny_mc.ply
-./build/release/apps/pointform/pointform render bunny_mc.ply -o bunny_mc.png --wireframe
+./build/release/apps/pointform/pointform reconstruct data/bunny/bun_zipper.ply -o bunny.ply \
+    --save-hierarchy bunny.pfh
+./build/release/apps/pointform/pointform render bunny.ply -o bunny.png --wireframe

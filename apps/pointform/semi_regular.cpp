@@ -1,0 +1,486 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "semi_regular.h"
+
+#include "pointform/core/error.h"
+#include "pointform/io/hierarchy.h"
+#include "pointform/io/io.h"
+#include "pointform/metrics/hausdorff.h"
+
+#include "common.h"
+
+#include <nlohmann/json.hpp>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <numbers>
+
+namespace pointform::cli {
+namespace {
+
+/// Bytes a refinement needs per face of the level it makes: the hierarchy's positions (double)
+/// and parent edges, the faces and edge vertices of the level below, the extracted output mesh,
+/// the triangle BVH of the distance measurement and the per-vertex refinement state.
+constexpr double bytes_per_refined_face = 256.0;
+
+constexpr const char* sampling_density_definition =
+    "median over the samples of the distance to the nearest other sample";
+constexpr const char* hausdorff_definition =
+    "one-sided Hausdorff distance: the largest distance from a sample to the mesh (exact "
+    "closest point on the triangles)";
+
+double physical_memory_bytes()
+{
+    const long pages = ::sysconf(_SC_PHYS_PAGES);
+    const long page_size = ::sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || page_size <= 0)
+    {
+        return std::numeric_limits<double>::infinity();
+    }
+    return static_cast<double>(pages) * static_cast<double>(page_size);
+}
+
+double faces_at_level(std::size_t base_faces, std::size_t level)
+{
+    return static_cast<double>(base_faces) * std::pow(4.0, static_cast<double>(level));
+}
+
+bool fits(std::size_t base_faces, std::size_t level)
+{
+    const double faces = faces_at_level(base_faces, level);
+    return faces <= static_cast<double>(std::numeric_limits<std::uint32_t>::max()) &&
+           bytes_per_refined_face * faces <= 0.8 * physical_memory_bytes();
+}
+
+std::string percent_of(double value, double diagonal)
+{
+    return diagonal > 0.0 ? format_number(100.0 * value / diagonal) + "%" : "-";
+}
+
+std::string stop_reason(const SemiRegularResult& r)
+{
+    const std::size_t finest = r.hierarchy.finest_level();
+    const double last =
+        r.report.levels.empty() ? r.report.initial_hausdorff : *r.report.levels.back().hausdorff;
+    const std::string distances = "Hausdorff " + format_number(last) + ", sampling density " +
+                                  format_number(r.report.sampling_density);
+    switch (r.report.stop)
+    {
+        case RefineStop::BelowSamplingDensity:
+            return finest == 0
+                       ? "the base mesh is already within the sampling density (" + distances + ")"
+                       : "the Hausdorff distance from the samples fell below the sampling "
+                         "density at level " +
+                             std::to_string(finest) + " (" + distances + ")";
+        case RefineStop::Stalled:
+            return "level " + std::to_string(finest + 1) +
+                   " lowered the Hausdorff distance by less than 5%, so it is not kept and level " +
+                   std::to_string(finest) + " is the output (" + distances +
+                   "): the samples still farther than the density lie where refinement cannot "
+                   "reach (outliers, noise, beyond a hole's rim)";
+        case RefineStop::LevelCap:
+            break;
+    }
+    return "reached the level cap " + std::to_string(r.level_cap) +
+           (r.cap_from_memory ? " (the deepest level that fits in memory)"
+                              : " (the default; --levels J refines further)") +
+           " with the distance still above the sampling density (" + distances + ")";
+}
+
+nlohmann::json level_json(const RefineLevelStats& s, double diagonal)
+{
+    nlohmann::json out;
+    out["level"] = s.level;
+    out["faces"] = s.faces;
+    out["vertices"] = s.vertices;
+    out["new_vertices"] = s.new_vertices;
+    out["hausdorff"] = s.hausdorff.value_or(0.0);
+    out["hausdorff_relative"] = diagonal > 0.0 ? s.hausdorff.value_or(0.0) / diagonal : 0.0;
+    out["mean_distance"] = s.mean_distance.value_or(0.0);
+    out["fold_vertices"] = s.fold_vertices;
+    out["folds_fixed_by_ven"] = s.folds_fixed_by_ven;
+    out["folds_unresolved"] = s.folds_unresolved;
+    out["unprojected"] = s.unprojected;
+    out["relaxed"] = s.relaxed;
+    out["relax_undone"] = s.relax_undone;
+    out["folded_faces"] = s.folded_faces;
+    out["seconds"] = s.seconds;
+    return out;
+}
+
+CLI::Validator levels_range()
+{
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            long long value = 0;
+            try
+            {
+                std::size_t used = 0;
+                value = std::stoll(text, &used);
+                if (used != text.size())
+                {
+                    return "--levels must be an integer, not '" + text + "'";
+                }
+            }
+            catch (const std::exception&)
+            {
+                return "--levels must be an integer, not '" + text + "'";
+            }
+            if (value < 0 || value > max_levels_option)
+            {
+                return "--levels must be between 0 and " + std::to_string(max_levels_option) +
+                       " (each level has 4 times the faces of the one below: level 8 has 65536 "
+                       "times the base mesh's), not " +
+                       text;
+            }
+            return {};
+        },
+        "0.." + std::to_string(max_levels_option));
+}
+
+} // namespace
+
+void add_refine_options(CLI::App& cmd, SemiRegularOptions& options)
+{
+    cmd.add_option("--levels", options.levels,
+                   "Refine exactly to level J (0 = the base mesh only); default: until the "
+                   "one-sided Hausdorff distance from the samples is below the sampling density "
+                   "(at most level " +
+                       std::to_string(default_max_level) + ")")
+        ->check(levels_range());
+    cmd.add_option("--predictor", options.predictor,
+                   "Where a new edge vertex starts before its projection onto the surface: "
+                   "midpoint, or butterfly (the displaced butterfly subdivision)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"midpoint", "butterfly"}));
+    cmd.add_option("--save-hierarchy", options.save_hierarchy,
+                   "Also write every level as a hierarchy file (.pfh; extract levels with "
+                   "`pointform lod`)");
+    cmd.add_flag("--ascii", options.ascii, "Write ascii PLY instead of binary");
+    cmd.add_flag("--json", options.json, "Print the report as JSON");
+}
+
+CLI::Option* add_base_faces_option(CLI::App& cmd, SemiRegularOptions& options)
+{
+    return cmd
+        .add_option("--base-faces", options.base_faces,
+                    "Faces of the automatic base mesh (default: the intermediate mesh's faces / "
+                    "64, within [200, 20000])")
+        ->check(CLI::Validator(
+            [](std::string& text) -> std::string {
+                try
+                {
+                    std::size_t used = 0;
+                    if (std::stoll(text, &used) >= 1 && used == text.size())
+                    {
+                        return {};
+                    }
+                }
+                catch (const std::exception&)
+                {}
+                return "--base-faces must be a whole number of faces, at least 1, not '" + text +
+                       "'";
+            },
+            "N >= 1"));
+}
+
+std::size_t base_face_target(const SemiRegularOptions& options, const TriMesh& intermediate)
+{
+    if (!options.base_faces)
+    {
+        return default_base_faces(intermediate);
+    }
+    const long long wanted = *options.base_faces;
+    if (wanted < 1)
+    {
+        throw InvalidInput("--base-faces must be at least 1, not " + std::to_string(wanted));
+    }
+    if (static_cast<unsigned long long>(wanted) > intermediate.face_count())
+    {
+        throw InvalidInput("--base-faces " + std::to_string(wanted) +
+                           " is larger than the intermediate (marching-cubes) mesh, which has " +
+                           std::to_string(intermediate.face_count()) +
+                           " faces; the base mesh simplifies it");
+    }
+    return static_cast<std::size_t>(wanted);
+}
+
+void check_refinement_memory(std::size_t base_faces, std::size_t level)
+{
+    const double faces = faces_at_level(base_faces, level);
+    if (faces > static_cast<double>(std::numeric_limits<std::uint32_t>::max()))
+    {
+        throw InvalidInput("level " + std::to_string(level) + " of a base mesh of " +
+                           std::to_string(base_faces) + " faces would have " +
+                           format_number(faces) +
+                           " faces, more than 32-bit indices allow; use fewer --levels or "
+                           "--base-faces");
+    }
+    const double need = bytes_per_refined_face * faces;
+    const double have = physical_memory_bytes();
+    if (need > 0.8 * have)
+    {
+        constexpr double gib = 1024.0 * 1024.0 * 1024.0;
+        char text[300];
+        std::snprintf(text, sizeof text,
+                      "level %zu of a base mesh of %zu faces would have %.4g faces and need about "
+                      "%.1f GiB, more than the %.1f GiB of memory this machine has; use fewer "
+                      "--levels or --base-faces",
+                      level, base_faces, faces, need / gib, have / gib);
+        throw InvalidInput(text);
+    }
+}
+
+std::size_t affordable_level(std::size_t base_faces, std::size_t cap)
+{
+    std::size_t level = 0;
+    while (level < cap && fits(base_faces, level + 1))
+    {
+        ++level;
+    }
+    return level;
+}
+
+SemiRegularResult refine_semi_regular(const TriMesh& base, const PointField& field,
+                                      const SemiRegularOptions& options,
+                                      const ProgressCallback& progress)
+{
+    const PointCloud& samples = field.surfels();
+    SemiRegularResult r;
+    r.hierarchy = MultiresMesh(base);
+    r.diagonal = samples.bounds().diagonal();
+    r.sample_count = samples.size();
+    r.predictor = options.predictor;
+    RefineOptions refine_options;
+    refine_options.predictor = parse_predictor(options.predictor);
+    refine_options.progress = progress;
+    const std::size_t base_faces = base.face_count();
+    if (options.levels)
+    {
+        const auto levels = static_cast<std::size_t>(*options.levels);
+        check_refinement_memory(base_faces, levels);
+        r.exact_levels = true;
+        r.level_cap = levels;
+        r.report.sampling_density = estimate_sampling_density(samples);
+        const DistanceStats initial =
+            summarize_distances(distances_to_mesh(samples, r.hierarchy.level_mesh(0)));
+        r.report.initial_hausdorff = initial.max;
+        r.report.initial_mean_distance = initial.mean;
+        refine_options.sampling_density = r.report.sampling_density;
+        refine_options.min_improvement = 0.0;
+        refine_options.max_level = levels;
+        for (std::size_t level = 0; level < levels; ++level)
+        {
+            r.report.levels.push_back(refine_once(r.hierarchy, field, refine_options, &samples));
+        }
+        r.report.stop = RefineStop::LevelCap;
+        r.stop_reason = "--levels " + std::to_string(levels) + ": refined exactly to level " +
+                        std::to_string(levels);
+        return r;
+    }
+    r.level_cap = affordable_level(base_faces, default_max_level);
+    r.cap_from_memory = r.level_cap < default_max_level;
+    refine_options.max_level = r.level_cap;
+    r.report = refine(r.hierarchy, field, samples, refine_options);
+    if (r.report.stop == RefineStop::Stalled && !r.report.levels.empty())
+    {
+        r.dropped = r.report.levels.back();
+        r.report.levels.pop_back();
+        r.hierarchy.truncate(r.hierarchy.finest_level() - 1);
+    }
+    r.stop_reason = stop_reason(r);
+    return r;
+}
+
+void write_semi_regular(const std::string& output, const SemiRegularOptions& options,
+                        const MultiresMesh& hierarchy)
+{
+    write_mesh(output, hierarchy.level_mesh(hierarchy.finest_level()), {.ascii = options.ascii});
+    if (options.save_hierarchy.empty())
+    {
+        return;
+    }
+    try
+    {
+        write_hierarchy(options.save_hierarchy, hierarchy);
+    }
+    catch (...)
+    {
+        std::error_code ignored;
+        std::filesystem::remove(output, ignored);
+        throw;
+    }
+}
+
+AngleStats angle_stats(const TriMesh& mesh)
+{
+    AngleStats stats;
+    if (mesh.face_count() == 0)
+    {
+        return stats;
+    }
+    double smallest = 180.0;
+    double sum = 0.0;
+    std::size_t below = 0;
+    for (const Triangle& t : mesh.triangles)
+    {
+        const Vec3d p[3] = {mesh.vertices.positions[t[0]].cast<double>(),
+                            mesh.vertices.positions[t[1]].cast<double>(),
+                            mesh.vertices.positions[t[2]].cast<double>()};
+        double min_angle = 180.0;
+        for (int k = 0; k < 3; ++k)
+        {
+            const Vec3d a = p[(k + 1) % 3] - p[k];
+            const Vec3d b = p[(k + 2) % 3] - p[k];
+            const double denom = a.norm() * b.norm();
+            const double angle = denom > 0.0 ? std::acos(std::clamp(a.dot(b) / denom, -1.0, 1.0)) *
+                                                   180.0 / std::numbers::pi
+                                             : 0.0;
+            min_angle = std::min(min_angle, angle);
+        }
+        smallest = std::min(smallest, min_angle);
+        sum += min_angle;
+        below += min_angle < 20.0 ? 1 : 0;
+    }
+    const auto faces = static_cast<double>(mesh.face_count());
+    stats.min_degrees = smallest;
+    stats.mean_min_degrees = sum / faces;
+    stats.share_below_20 = static_cast<double>(below) / faces;
+    return stats;
+}
+
+nlohmann::json base_mesh_json(const BaseMeshStats& stats)
+{
+    nlohmann::json out;
+    out["input_faces"] = stats.input_faces;
+    out["target_faces"] = stats.target_faces;
+    out["faces"] = stats.faces;
+    out["vertices"] = stats.vertices;
+    out["min_angle_degrees"] = stats.min_angle_degrees;
+    out["mean_min_angle_degrees"] = stats.mean_min_angle_degrees;
+    out["share_below_20_degrees"] = stats.share_below_20_degrees;
+    out["share_below_20_degrees_off_boundary"] = stats.share_below_20_degrees_off_boundary;
+    out["smoothing_rounds"] = stats.smoothing_rounds;
+    out["flips"] = stats.flips;
+    out["unprojected"] = stats.unprojected;
+    out["max_vertex_move"] = stats.max_vertex_move;
+    out["topology_kept"] = stats.topology_kept;
+    out["topology_change"] = stats.topology_change;
+    out["euler_characteristic"] = stats.topology_after.euler_characteristic;
+    out["boundary_loops"] = stats.topology_after.boundary_loops;
+    out["components"] = stats.topology_after.components;
+    out["seconds"] = stats.seconds;
+    return out;
+}
+
+void print_base_mesh(const BaseMeshStats& stats)
+{
+    print_row("base mesh", std::to_string(stats.faces) + " faces, " +
+                               std::to_string(stats.vertices) + " vertices (target " +
+                               std::to_string(stats.target_faces) + ", from " +
+                               std::to_string(stats.input_faces) + " faces)");
+    print_row("base min angle",
+              format_number(stats.min_angle_degrees) + "° (mean of minima " +
+                  format_number(stats.mean_min_angle_degrees) + "°; " +
+                  format_number(100.0 * stats.share_below_20_degrees) +
+                  "% of the triangles below 20°, " +
+                  format_number(100.0 * stats.share_below_20_degrees_off_boundary) +
+                  "% away from the boundary)");
+    print_row("base topology",
+              stats.topology_kept
+                  ? "kept (Euler characteristic " +
+                        std::to_string(stats.topology_after.euler_characteristic) + ", " +
+                        std::to_string(stats.topology_after.boundary_loops) + " boundary loops, " +
+                        std::to_string(stats.topology_after.components) + " components)"
+                  : "CHANGED: " + stats.topology_change);
+    print_row("base unprojected", std::to_string(stats.unprojected) + " vertices off f = 0");
+}
+
+nlohmann::json refinement_json(const SemiRegularResult& r)
+{
+    nlohmann::json out;
+    out["samples"] = r.sample_count;
+    out["sampling_density"] = r.report.sampling_density;
+    out["sampling_density_definition"] = sampling_density_definition;
+    out["hausdorff_definition"] = hausdorff_definition;
+    out["diagonal"] = r.diagonal;
+    nlohmann::json levels = nlohmann::json::array();
+    nlohmann::json base;
+    base["level"] = 0;
+    base["faces"] = r.hierarchy.face_count(0);
+    base["vertices"] = r.hierarchy.vertex_count(0);
+    base["hausdorff"] = r.report.initial_hausdorff;
+    base["hausdorff_relative"] = r.diagonal > 0.0 ? r.report.initial_hausdorff / r.diagonal : 0.0;
+    base["mean_distance"] = r.report.initial_mean_distance;
+    base["folds_fixed_by_ven"] = 0;
+    base["unprojected"] = r.base_unprojected;
+    base["seconds"] = r.base_seconds;
+    levels.push_back(base);
+    for (const RefineLevelStats& s : r.report.levels)
+    {
+        levels.push_back(level_json(s, r.diagonal));
+    }
+    out["levels"] = levels;
+    if (r.dropped)
+    {
+        out["dropped_level"] = level_json(*r.dropped, r.diagonal);
+    }
+    out["finest_level"] = r.hierarchy.finest_level();
+    out["faces"] = r.hierarchy.face_count(r.hierarchy.finest_level());
+    out["vertices"] = r.hierarchy.vertex_count();
+    out["predictor"] = r.predictor;
+    out["exact_levels"] = r.exact_levels;
+    out["level_cap"] = r.level_cap;
+    out["level_cap_from_memory"] = r.cap_from_memory;
+    out["stop"] = r.exact_levels ? std::string("levels") : std::string(to_string(r.report.stop));
+    out["stop_reason"] = r.stop_reason;
+    return out;
+}
+
+void print_refinement(const SemiRegularResult& r)
+{
+    print_row("sampling density", format_number(r.report.sampling_density) + " (" +
+                                      sampling_density_definition + ", " +
+                                      std::to_string(r.sample_count) + " samples)");
+    print_row("Hausdorff", hausdorff_definition);
+    print_row("VEN fix",
+              "fold vertices whose fold the vertex-based edge normal fixed / fold "
+              "vertices after projection along the face normal (§5.2.2)");
+    std::printf("  %5s %10s %10s %12s %9s %12s %9s %11s %8s\n", "level", "faces", "vertices",
+                "Hausdorff", "% diag", "mean", "VEN fix", "unprojected", "seconds");
+    const auto row = [&](std::size_t level, std::size_t faces, std::size_t vertices, double h,
+                         double mean, const std::string& ven, std::size_t unprojected,
+                         double seconds) {
+        std::printf("  %5zu %10zu %10zu %12s %9s %12s %9s %11zu %8.3f\n", level, faces, vertices,
+                    format_number(h).c_str(), percent_of(h, r.diagonal).c_str(),
+                    format_number(mean).c_str(), ven.c_str(), unprojected, seconds);
+    };
+    row(0, r.hierarchy.face_count(0), r.hierarchy.vertex_count(0), r.report.initial_hausdorff,
+        r.report.initial_mean_distance, "-", r.base_unprojected, r.base_seconds);
+    for (const RefineLevelStats& s : r.report.levels)
+    {
+        row(s.level, s.faces, s.vertices, s.hausdorff.value_or(0.0), s.mean_distance.value_or(0.0),
+            std::to_string(s.folds_fixed_by_ven) + "/" + std::to_string(s.fold_vertices),
+            s.unprojected, s.seconds);
+    }
+    if (r.dropped)
+    {
+        const RefineLevelStats& s = *r.dropped;
+        std::printf(
+            "  %5zu %10zu %10zu %12s %9s %12s %9s %11zu %8.3f  (not kept)\n", s.level, s.faces,
+            s.vertices, format_number(s.hausdorff.value_or(0.0)).c_str(),
+            percent_of(s.hausdorff.value_or(0.0), r.diagonal).c_str(),
+            format_number(s.mean_distance.value_or(0.0)).c_str(),
+            (std::to_string(s.folds_fixed_by_ven) + "/" + std::to_string(s.fold_vertices)).c_str(),
+            s.unprojected, s.seconds);
+    }
+    print_row("stopped", r.stop_reason);
+}
+
+} // namespace pointform::cli
