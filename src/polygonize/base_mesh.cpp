@@ -219,13 +219,14 @@ void check_options(const BaseMeshOptions& options)
     }
 }
 
+/// The mesh in OpenMesh, in world coordinates (where the field is evaluated).
 OmMesh to_openmesh(const TriMesh& mesh)
 {
     OmMesh om;
     om.reserve(mesh.vertex_count(), mesh.face_count() * 3 / 2, mesh.face_count());
     for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
     {
-        om.add_vertex(to_om(mesh.vertices.positions[v].cast<double>()));
+        om.add_vertex(to_om(mesh.vertices.world(v)));
     }
     for (const Triangle& t : mesh.triangles)
     {
@@ -616,7 +617,7 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
     for (const auto v : mesh.vertices())
     {
         const auto i = static_cast<std::size_t>(v.idx());
-        out.vertices.positions.push_back(state.position[i].cast<float>());
+        out.vertices.positions.push_back((state.position[i] - out.vertices.origin).cast<float>());
         if (options.project)
         {
             stats.unprojected += state.on_surface[i] ? 0 : 1;

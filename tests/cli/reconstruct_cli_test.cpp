@@ -254,9 +254,9 @@ TEST(RemeshCli, IrregularMeshBecomesSemiRegularOnTheSameSurface)
     remesh_irregular_sphere(0.1);
 }
 
-// Known failure, reported: at radius 1 build_base_mesh leaves nearly every base vertex
-// unprojected on this field (261 of 268; none at radius 0.1), and the output misses the sphere.
-TEST(RemeshCli, DISABLED_IrregularUnitSphereBecomesSemiRegularOnTheSameSurface)
+// Regression: the base mesh once evaluated the field at positions relative to the mesh's origin
+// instead of world positions, and left nearly every vertex of this sphere unprojected.
+TEST(RemeshCli, IrregularUnitSphereBecomesSemiRegularOnTheSameSurface)
 {
     remesh_irregular_sphere(1.0);
 }
