@@ -1,0 +1,161 @@
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 the pointform authors
+"""Side-by-side benchmark of the whole reconstruction, from raw points, in one run:
+pointform reconstruct (semi-regular, §5) against pointform mc at the same vertex count (the
+paper's Fig. 4 claim), Open3D's Poisson at depth 9 and, with --bpa, ball pivoting.
+
+Every tool starts from the same raw points (an analytic shape sampled by `pointform sample`,
+clean or with 0.2% noise and holes) and estimates its own normals: pointform inside its
+commands, Open3D with estimate_normals + orient_normals_consistent_tangent_plane (k = 16), so
+times are end to end. Per tool: wall time, peak memory (/usr/bin/time), vertices, accuracy
+against the true analytic surface (symmetric Hausdorff and Chamfer in % of the diagonal,
+F-score at 0.5% and 1%; see run_surface_bench.py), the share of triangles with a minimum angle
+under 20°, and the share of interior vertices of valence 6.
+
+Run with /usr/bin/python3 (Debian's python3-open3d):
+  /usr/bin/python3 bench/peers/run_reconstruct_bench.py --pointform build/release/apps/pointform/pointform
+"""
+
+from __future__ import annotations
+
+import argparse
+import faulthandler
+import json
+import math
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import open3d as o3d
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from run_normals_bench import run_measured  # noqa: E402
+from run_surface_bench import VARIANTS, evaluate_isolated, load_points  # noqa: E402
+
+HERE = Path(__file__).resolve().parent
+
+
+def mesh_quality(path: Path) -> dict:
+    """Minimum-angle distribution and valence-6 share of a triangle mesh."""
+    mesh = o3d.io.read_triangle_mesh(str(path))
+    v = np.asarray(mesh.vertices)
+    f = np.asarray(mesh.triangles)
+    if len(f) == 0:
+        return {}
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+
+    def angle(p, q, r):
+        u, w = q - p, r - p
+        cos = np.einsum("ij,ij->i", u, w) / np.maximum(
+            np.linalg.norm(u, axis=1) * np.linalg.norm(w, axis=1), 1e-300)
+        return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+
+    min_angle = np.minimum(np.minimum(angle(a, b, c), angle(b, c, a)), angle(c, a, b))
+    # Valence over interior vertices: a vertex is on the boundary if one of its edges has one face.
+    edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    unique, counts = np.unique(edges, axis=0, return_counts=True)
+    boundary = np.zeros(len(v), bool)
+    boundary[unique[counts == 1].ravel()] = True
+    valence = np.bincount(unique.ravel(), minlength=len(v))
+    used = valence > 0
+    interior = used & ~boundary
+    return {
+        "vertices": int(np.count_nonzero(np.bincount(f.ravel(), minlength=len(v)))),
+        "faces": int(len(f)),
+        "min_angle_under_20": float(np.mean(min_angle < 20.0)),
+        "min_angle_p1": float(np.percentile(min_angle, 1)),
+        "valence6": float(np.mean(valence[interior] == 6)) if interior.any() else float("nan"),
+    }
+
+
+def main(argv=None) -> int:
+    faulthandler.enable()
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--pointform", default="build/release/apps/pointform/pointform")
+    ap.add_argument("--shapes", default="sphere,torus")
+    ap.add_argument("--variants", default="clean,noisy+holes")
+    ap.add_argument("--size", type=int, default=100000)
+    ap.add_argument("--bpa", action="store_true", help="also ball pivoting (slow)")
+    ap.add_argument("--reconstruct-args", default="", help="extra arguments for pointform reconstruct")
+    ap.add_argument("--matched-levels", type=int, default=3,
+                    help="levels of the semi-regular mesh that marching cubes is matched against "
+                         "(the automatic stop can end at a mesh coarser than any marching cubes "
+                         "of the field: its cells would be larger than the influence radii)")
+    ap.add_argument("--timeout", type=float, default=1800)
+    args = ap.parse_args(argv)
+    env = os.environ.copy()
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="pf-reconstruct-") as tmp:
+        work = Path(tmp)
+        for shape in args.shapes.split(","):
+            truth_path = work / "truth.ply"
+            run_measured([args.pointform, "sample", shape, "-n", "200000", "--seed", "99", "-o",
+                          truth_path], env, 600, work / "truth")
+            truth = load_points(truth_path)
+            for variant in args.variants.split(","):
+                raw = work / "raw.ply"
+                run_measured([args.pointform, "sample", shape, "-n", str(args.size), "-o", raw,
+                              *VARIANTS[variant]], env, 600, work / "sample")
+                samples = load_points(raw)
+                diag = float(np.linalg.norm(samples.max(0) - samples.min(0)))
+
+                def measure(name, cmd, out):
+                    status, wall, peak, _ = run_measured(cmd, env, args.timeout, work / "tool")
+                    row = {"shape": shape, "variant": variant, "size": args.size, "tool": name,
+                           "status": status, "wall_s": wall, "peak_mib": peak}
+                    if status == "ok" and out.exists():
+                        row.update(mesh_quality(out))
+                        row.update(evaluate_isolated(shape, out, truth, samples, diag,
+                                                     args.pointform, work))
+                    rows.append(row)
+                    print(json.dumps(row), flush=True)
+                    return row
+
+                measure("pointform reconstruct",
+                               [args.pointform, "reconstruct", raw, "-o", work / "semi.ply", "--json",
+                                *args.reconstruct_args.split()], work / "semi.ply")
+                measure(f"pointform reconstruct --levels {args.matched_levels}",
+                        [args.pointform, "reconstruct", raw, "-o", work / "semi_j.ply", "--json",
+                         "--levels", str(args.matched_levels), *args.reconstruct_args.split()],
+                        work / "semi_j.ply")
+                # Marching cubes at that semi-regular mesh's vertex count: vertices grow with the
+                # square of the resolution, so one probe run sets the resolution.
+                target = o3d.io.read_triangle_mesh(str(work / "semi_j.ply")).vertices
+                probe = run_measured([args.pointform, "mc", raw, "-o", work / "probe.ply", "--json",
+                                      "--resolution", "128"], env, args.timeout, work / "probe")[3] or {}
+                if len(target) and probe.get("vertices"):
+                    resolution = max(8, round(128 * math.sqrt(len(target) / probe["vertices"])))
+                    measure(f"pointform mc at the same vertex count (resolution {resolution})",
+                            [args.pointform, "mc", raw, "-o", work / "mc.ply", "--json",
+                             "--resolution", str(resolution)], work / "mc.ply")
+                measure("pointform mc (default cell)",
+                        [args.pointform, "mc", raw, "-o", work / "mc_default.ply", "--json"],
+                        work / "mc_default.ply")
+                measure("Open3D Poisson 9",
+                        ["/usr/bin/python3", HERE / "open3d_surface.py", raw, work / "poisson9.ply",
+                         "poisson", "9", "--estimate-normals", "16"], work / "poisson9.ply")
+                if args.bpa:
+                    measure("Open3D ball pivoting",
+                            ["/usr/bin/python3", HERE / "open3d_surface.py", raw, work / "bpa.ply",
+                             "bpa", "--estimate-normals", "16"], work / "bpa.ply")
+    print()
+    header = ["shape", "variant", "tool", "wall s", "peak MiB", "vertices", "Hausdorff %diag",
+              "Chamfer %diag", "F@0.5%", "F@1%", "min angle < 20°", "valence 6"]
+    print("| " + " | ".join(header) + " |")
+    print("|" + "---|" * len(header))
+    for r in rows:
+        if "chamfer" not in r:
+            print(f"| {r['shape']} | {r['variant']} | {r['tool']} | {r['status']} |" + " |" * 8)
+            continue
+        vertices = r.get("vertices") or ""
+        print(f"| {r['shape']} | {r['variant']} | {r['tool']} | {r['wall_s']:.1f} | "
+              f"{r['peak_mib']:.0f} | {vertices} | {100 * r['hausdorff']:.3f} | "
+              f"{100 * r['chamfer']:.4f} | {r['f0.005']:.4f} | {r['f0.01']:.4f} | "
+              f"{100 * r['min_angle_under_20']:.2f}% | {100 * r['valence6']:.1f}% |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
