@@ -93,26 +93,12 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
     }
     const double base_seconds = timings.stages().back().second;
 
-    SemiRegularResult result =
-        refine_semi_regular(base, field, options.refine, progress.callback());
-    result.base_seconds = base_seconds;
-    result.base_unprojected = base_stats ? base_stats->unprojected : 0;
-    timings.lap("refinement");
-    write_semi_regular(options.output, options.refine, result.hierarchy);
-    timings.lap("write");
-    progress.clear();
-
-    const MeshTopology topo =
-        analyze_topology(result.hierarchy.level_mesh(result.hierarchy.finest_level()));
+    const SemiRegularOutput run =
+        refine_and_write(base, field, options.refine, options.output, base_seconds,
+                         base_stats ? base_stats->unprojected : 0, timings, progress);
     if (options.refine.json)
     {
-        nlohmann::json out = refinement_json(result);
-        out["input"] = options.input;
-        out["output"] = options.output;
-        if (!options.refine.save_hierarchy.empty())
-        {
-            out["hierarchy"] = options.refine.save_hierarchy;
-        }
+        nlohmann::json out = semi_regular_json(run, options.refine, options.input, options.output);
         out["estimated_normals"] = input.estimated_normals;
         out["fit"] = options.fit;
         if (base_stats)
@@ -139,10 +125,6 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
             b["components"] = picked->topology.components;
             out["base_mesh"] = b;
         }
-        out["components"] = topo.components;
-        out["boundary_loops"] = topo.boundary_loops;
-        out["euler_characteristic"] = topo.euler_characteristic;
-        out["manifold"] = topo.is_oriented_manifold();
         add_run_report(out, timings);
         std::printf("%s\n", out.dump(2).c_str());
         return;
@@ -172,18 +154,7 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
                                         format_number(100.0 * angles.share_below_20) +
                                         "% of the triangles below 20°)");
     }
-    print_refinement(result);
-    print_row("output",
-              std::to_string(result.hierarchy.face_count(result.hierarchy.finest_level())) +
-                  " faces, " + std::to_string(result.hierarchy.vertex_count()) +
-                  " vertices, level " + std::to_string(result.hierarchy.finest_level()) +
-                  "; Euler " + std::to_string(topo.euler_characteristic) + ", " +
-                  std::to_string(topo.boundary_loops) + " boundary loops");
-    if (!options.refine.save_hierarchy.empty())
-    {
-        print_row("hierarchy", options.refine.save_hierarchy + " (" +
-                                   std::to_string(result.hierarchy.level_count()) + " levels)");
-    }
+    print_semi_regular(run, options.refine);
     print_timings(timings);
     if (input.unoriented > 0)
     {

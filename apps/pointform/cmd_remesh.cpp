@@ -163,36 +163,18 @@ void run_remesh(const RemeshOptions& options, const GlobalOptions& global)
     timings.lap("base mesh");
     const double base_seconds = timings.stages().back().second;
 
-    SemiRegularResult result =
-        refine_semi_regular(built.mesh, field, options.refine, progress.callback());
-    result.base_seconds = base_seconds;
-    result.base_unprojected = built.stats.unprojected;
-    timings.lap("refinement");
-    write_semi_regular(options.output, options.refine, result.hierarchy);
-    timings.lap("write");
-    progress.clear();
-
-    const MeshTopology topo =
-        analyze_topology(result.hierarchy.level_mesh(result.hierarchy.finest_level()));
+    const SemiRegularOutput run =
+        refine_and_write(built.mesh, field, options.refine, options.output, base_seconds,
+                         built.stats.unprojected, timings, progress);
     if (options.refine.json)
     {
-        nlohmann::json out = refinement_json(result);
-        out["input"] = options.input;
-        out["output"] = options.output;
-        if (!options.refine.save_hierarchy.empty())
-        {
-            out["hierarchy"] = options.refine.save_hierarchy;
-        }
+        nlohmann::json out = semi_regular_json(run, options.refine, options.input, options.output);
         out["input_faces"] = mesh.face_count();
         out["input_vertices"] = mesh.vertex_count();
         out["area_samples"] = count;
         out["fit"] = options.fit;
         out["base_mesh"] = base_mesh_json(built.stats);
         out["base_mesh"]["source"] = "automatic";
-        out["components"] = topo.components;
-        out["boundary_loops"] = topo.boundary_loops;
-        out["euler_characteristic"] = topo.euler_characteristic;
-        out["manifold"] = topo.is_oriented_manifold();
         add_run_report(out, timings);
         std::printf("%s\n", out.dump(2).c_str());
         return;
@@ -204,22 +186,11 @@ void run_remesh(const RemeshOptions& options, const GlobalOptions& global)
     std::printf("%s -> %s\n", options.input.c_str(), options.output.c_str());
     print_row("input mesh", std::to_string(mesh.face_count()) + " faces, " +
                                 std::to_string(mesh.vertex_count()) + " vertices");
-    print_row("surfels", std::to_string(result.sample_count) +
+    print_row("surfels", std::to_string(run.result.sample_count) +
                              " (the vertices with area-weighted normals, and " +
                              std::to_string(count) + " area-uniform samples with face normals)");
     print_base_mesh(built.stats);
-    print_refinement(result);
-    print_row("output",
-              std::to_string(result.hierarchy.face_count(result.hierarchy.finest_level())) +
-                  " faces, " + std::to_string(result.hierarchy.vertex_count()) +
-                  " vertices, level " + std::to_string(result.hierarchy.finest_level()) +
-                  "; Euler " + std::to_string(topo.euler_characteristic) + ", " +
-                  std::to_string(topo.boundary_loops) + " boundary loops");
-    if (!options.refine.save_hierarchy.empty())
-    {
-        print_row("hierarchy", options.refine.save_hierarchy + " (" +
-                                   std::to_string(result.hierarchy.level_count()) + " levels)");
-    }
+    print_semi_regular(run, options.refine);
     print_timings(timings);
 }
 

@@ -483,4 +483,54 @@ void print_refinement(const SemiRegularResult& r)
     print_row("stopped", r.stop_reason);
 }
 
+SemiRegularOutput refine_and_write(const TriMesh& base, const PointField& field,
+                                   const SemiRegularOptions& options, const std::string& output,
+                                   double base_seconds, std::size_t base_unprojected,
+                                   Timings& timings, TerminalProgress& progress)
+{
+    SemiRegularOutput run{refine_semi_regular(base, field, options, progress.callback()), {}};
+    run.result.base_seconds = base_seconds;
+    run.result.base_unprojected = base_unprojected;
+    timings.lap("refinement");
+    write_semi_regular(output, options, run.result.hierarchy);
+    timings.lap("write");
+    progress.clear();
+    run.topology =
+        analyze_topology(run.result.hierarchy.level_mesh(run.result.hierarchy.finest_level()));
+    return run;
+}
+
+nlohmann::json semi_regular_json(const SemiRegularOutput& run, const SemiRegularOptions& options,
+                                 const std::string& input, const std::string& output)
+{
+    nlohmann::json out = refinement_json(run.result);
+    out["input"] = input;
+    out["output"] = output;
+    if (!options.save_hierarchy.empty())
+    {
+        out["hierarchy"] = options.save_hierarchy;
+    }
+    out["components"] = run.topology.components;
+    out["boundary_loops"] = run.topology.boundary_loops;
+    out["euler_characteristic"] = run.topology.euler_characteristic;
+    out["manifold"] = run.topology.is_oriented_manifold();
+    return out;
+}
+
+void print_semi_regular(const SemiRegularOutput& run, const SemiRegularOptions& options)
+{
+    const MultiresMesh& hierarchy = run.result.hierarchy;
+    print_refinement(run.result);
+    print_row("output", std::to_string(hierarchy.face_count(hierarchy.finest_level())) +
+                            " faces, " + std::to_string(hierarchy.vertex_count()) +
+                            " vertices, level " + std::to_string(hierarchy.finest_level()) +
+                            "; Euler " + std::to_string(run.topology.euler_characteristic) + ", " +
+                            std::to_string(run.topology.boundary_loops) + " boundary loops");
+    if (!options.save_hierarchy.empty())
+    {
+        print_row("hierarchy", options.save_hierarchy + " (" +
+                                   std::to_string(hierarchy.level_count()) + " levels)");
+    }
+}
+
 } // namespace pointform::cli

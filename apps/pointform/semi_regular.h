@@ -7,6 +7,7 @@
 
 #pragma once
 
+#include "pointform/geometry/mesh_topology.h"
 #include "pointform/geometry/multires_mesh.h"
 #include "pointform/implicit/point_field.h"
 #include "pointform/polygonize/base_mesh.h"
@@ -86,6 +87,34 @@ struct SemiRegularResult
 /// the hierarchy; if the second write fails the first file is removed.
 void write_semi_regular(const std::string& output, const SemiRegularOptions& options,
                         const MultiresMesh& hierarchy);
+
+class Timings;
+class TerminalProgress;
+
+/// What reconstruct and remesh do once they have a base mesh, and what came of it.
+struct SemiRegularOutput
+{
+    SemiRegularResult result;
+    MeshTopology topology; ///< of the finest level, as written
+};
+
+/// \brief Refines `base` (refine_semi_regular), writes the output (write_semi_regular), lapping
+/// "refinement" and "write" in `timings`, and measures the finest level's topology.
+[[nodiscard]] SemiRegularOutput refine_and_write(const TriMesh& base, const PointField& field,
+                                                 const SemiRegularOptions& options,
+                                                 const std::string& output, double base_seconds,
+                                                 std::size_t base_unprojected, Timings& timings,
+                                                 TerminalProgress& progress);
+
+/// \brief The JSON report's shared part: the refinement (refinement_json), input, output, the
+/// hierarchy file if one was written, and the output's topology.
+[[nodiscard]] nlohmann::json semi_regular_json(const SemiRegularOutput& run,
+                                               const SemiRegularOptions& options,
+                                               const std::string& input, const std::string& output);
+
+/// \brief Prints the per-level table (print_refinement), the output's counts and topology, and
+/// the hierarchy file if one was written.
+void print_semi_regular(const SemiRegularOutput& run, const SemiRegularOptions& options);
 
 /// \brief Smallest angle of any triangle, mean of the per-triangle smallest angles and the
 /// share below 20°, degrees.
