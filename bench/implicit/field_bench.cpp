@@ -96,7 +96,7 @@ void BM_FieldEvaluate(benchmark::State& state)
 }
 BENCHMARK(BM_FieldEvaluate)
     ->ArgsProduct({{static_cast<int>(PlaneFit::Raw), static_cast<int>(PlaneFit::Centroid),
-                    static_cast<int>(PlaneFit::Blend)},
+                    static_cast<int>(PlaneFit::Blend), static_cast<int>(PlaneFit::Quadric)},
                    {1, 0},
                    {1, 0}})
     ->Unit(benchmark::kMillisecond)
