@@ -3,6 +3,7 @@
 
 #include "pointform/geometry/mesh_topology.h"
 
+#include "pointform/core/disjoint_sets.h"
 #include "pointform/core/error.h"
 
 #include <algorithm>
@@ -14,29 +15,6 @@
 namespace pointform {
 
 namespace {
-
-/// Union–find with path halving.
-class DisjointSets
-{
-public:
-    explicit DisjointSets(std::size_t n) : parent_(n)
-    {
-        std::iota(parent_.begin(), parent_.end(), 0);
-    }
-    std::size_t find(std::size_t x)
-    {
-        while (parent_[x] != x)
-        {
-            parent_[x] = parent_[parent_[x]];
-            x = parent_[x];
-        }
-        return x;
-    }
-    void unite(std::size_t a, std::size_t b) { parent_[find(a)] = find(b); }
-
-private:
-    std::vector<std::size_t> parent_;
-};
 
 struct HalfEdge
 {

@@ -3,6 +3,7 @@
 
 #include "pointform/hermite/orientation.h"
 
+#include "pointform/core/disjoint_sets.h"
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 
@@ -48,41 +49,6 @@ bool row_contains(const KnnTable& table, std::size_t row, std::size_t columns, s
     const auto nbrs = table.neighbors(row).first(columns);
     return std::find(nbrs.begin(), nbrs.end(), value) != nbrs.end();
 }
-
-/// Union-find with path halving and union by size.
-class DisjointSets
-{
-public:
-    explicit DisjointSets(std::size_t n) : parent_(n), size_(n, 1)
-    {
-        std::iota(parent_.begin(), parent_.end(), 0U);
-    }
-
-    std::uint32_t find(std::uint32_t x)
-    {
-        while (parent_[x] != x)
-            x = parent_[x] = parent_[parent_[x]];
-        return x;
-    }
-
-    /// Joins the sets of a and b; false if they were one already.
-    bool unite(std::uint32_t a, std::uint32_t b)
-    {
-        a = find(a);
-        b = find(b);
-        if (a == b)
-            return false;
-        if (size_[a] < size_[b])
-            std::swap(a, b);
-        parent_[b] = a;
-        size_[a] += size_[b];
-        return true;
-    }
-
-private:
-    std::vector<std::uint32_t> parent_;
-    std::vector<std::uint32_t> size_;
-};
 
 /// Stable LSD radix sort of edges by cost (three 11-bit digits): ties keep their order.
 void sort_by_cost(std::vector<WeightedEdge>& edges)

@@ -10,6 +10,7 @@
 
 #include "pointform/polygonize/base_mesh.h"
 
+#include "pointform/core/disjoint_sets.h"
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 #include "pointform/io/io.h"
@@ -686,25 +687,6 @@ std::string where(const std::string& source, std::span<const std::size_t> lines,
                          : source + ":" + std::to_string(lines[face]);
 }
 
-class UnionFind
-{
-public:
-    explicit UnionFind(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
-    std::size_t find(std::size_t x)
-    {
-        while (parent_[x] != x)
-        {
-            parent_[x] = parent_[parent_[x]];
-            x = parent_[x];
-        }
-        return x;
-    }
-    void unite(std::size_t a, std::size_t b) { parent_[find(a)] = find(b); }
-
-private:
-    std::vector<std::size_t> parent_;
-};
-
 } // namespace
 
 PickedBaseMesh base_mesh_from_samples(std::span<const Triangle> triangles,
@@ -798,7 +780,7 @@ PickedBaseMesh base_mesh_from_samples(std::span<const Triangle> triangles,
     }
     for (const auto& [v, faces] : around)
     {
-        UnionFind fans(faces.size());
+        DisjointSets fans(faces.size());
         for (std::size_t i = 0; i < faces.size(); ++i)
         {
             for (std::size_t j = i + 1; j < faces.size(); ++j)
