@@ -116,11 +116,7 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
               format_number(distance.max) + " (" + format_number(100.0 * distance.max / diagonal) +
                   "% of the diagonal; mean " + format_number(distance.mean) + ")");
     print_timings(timings);
-    if (input.unoriented > 0)
-    {
-        std::fprintf(stderr, "pointform: warning: %zu samples without a normal were left out\n",
-                     input.unoriented);
-    }
+    warn_unoriented(options.input, input.unoriented);
 }
 
 } // namespace

@@ -118,12 +118,7 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
     print_timings(timings);
     for (const LoadedScan& scan : arguments.scans())
     {
-        if (scan.unoriented > 0)
-        {
-            std::fprintf(stderr,
-                         "pointform: warning: %s: %zu samples without a normal were left out\n",
-                         scan.path.c_str(), scan.unoriented);
-        }
+        warn_unoriented(scan.path, scan.unoriented);
     }
 }
 

@@ -156,11 +156,7 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
     }
     print_semi_regular(run, options.refine);
     print_timings(timings);
-    if (input.unoriented > 0)
-    {
-        std::fprintf(stderr, "pointform: warning: %zu samples without a normal were left out\n",
-                     input.unoriented);
-    }
+    warn_unoriented(options.input, input.unoriented);
 }
 
 } // namespace

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace pointform::cli {
 
@@ -118,6 +119,15 @@ SurfelInput load_surfels(const std::string& path, const SurfelInputOptions& opti
     }
     out.surfels = std::move(cloud);
     return out;
+}
+
+void warn_unoriented(const std::string& path, std::size_t unoriented)
+{
+    if (unoriented > 0)
+    {
+        std::fprintf(stderr, "pointform: warning: %s: %zu samples without a normal were left out\n",
+                     path.c_str(), unoriented);
+    }
 }
 
 } // namespace pointform::cli

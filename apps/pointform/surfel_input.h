@@ -39,4 +39,8 @@ struct SurfelInput
 [[nodiscard]] SurfelInput load_surfels(const std::string& path, const SurfelInputOptions& options,
                                        const ProgressCallback& progress);
 
+/// \brief Warns on stderr that `unoriented` samples of `path` (no usable normal) were left out;
+/// says nothing when there were none.
+void warn_unoriented(const std::string& path, std::size_t unoriented);
+
 } // namespace pointform::cli
