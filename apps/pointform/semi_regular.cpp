@@ -159,6 +159,17 @@ void add_refine_options(CLI::App& cmd, SemiRegularOptions& options)
                    "midpoint, or butterfly (the displaced butterfly subdivision)")
         ->capture_default_str()
         ->check(CLI::IsMember({"midpoint", "butterfly"}));
+    cmd.add_option("--relax", options.relax,
+                   "Rounds of tangential relaxation of the new vertices per level (§5.2.3), each "
+                   "followed by their re-projection; 0 keeps the projected predictions")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 10));
+    cmd.add_option("--relaxation", options.relaxation,
+                   "Which part of the umbrella move relaxation makes: across (the part across "
+                   "the parent edge, which keeps the split ratio) or umbrella (all of it, as in "
+                   "the paper)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"across", "umbrella"}));
     cmd.add_option("--save-hierarchy", options.save_hierarchy,
                    "Also write every level as a hierarchy file (.pfh; extract levels with "
                    "`pointform lod`)");
@@ -257,8 +268,12 @@ SemiRegularResult refine_semi_regular(const TriMesh& base, const PointField& fie
     r.diagonal = samples.bounds().diagonal();
     r.sample_count = samples.size();
     r.predictor = options.predictor;
+    r.relaxation = options.relaxation;
+    r.relax_rounds = options.relax;
     RefineOptions refine_options;
     refine_options.predictor = parse_predictor(options.predictor);
+    refine_options.relax_iterations = options.relax;
+    refine_options.relaxation = parse_relaxation(options.relaxation);
     refine_options.progress = progress;
     const std::size_t base_faces = base.face_count();
     if (options.levels)
@@ -435,6 +450,7 @@ nlohmann::json refinement_json(const SemiRegularResult& r)
     out["faces"] = r.hierarchy.face_count(r.hierarchy.finest_level());
     out["vertices"] = r.hierarchy.vertex_count();
     out["predictor"] = r.predictor;
+    out["relaxation"] = {{"move", r.relaxation}, {"rounds", r.relax_rounds}};
     out["exact_levels"] = r.exact_levels;
     out["level_cap"] = r.level_cap;
     out["level_cap_from_memory"] = r.cap_from_memory;

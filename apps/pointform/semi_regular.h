@@ -33,12 +33,14 @@ struct SemiRegularOptions
     std::optional<long long> base_faces; ///< --base-faces N (automatic base mesh)
     std::optional<long long> levels;     ///< --levels J: refine exactly to J
     std::string predictor = "midpoint";
+    int relax = RefineOptions{}.relax_iterations; ///< --relax N: relaxation rounds per level
+    std::string relaxation = "across";            ///< --relaxation across|umbrella
     std::string save_hierarchy;
     bool ascii = false;
     bool json = false;
 };
 
-/// Adds --levels, --predictor, --save-hierarchy, --ascii and --json.
+/// Adds --levels, --predictor, --relax, --relaxation, --save-hierarchy, --ascii and --json.
 void add_refine_options(CLI::App& cmd, SemiRegularOptions& options);
 /// Adds --base-faces. \return the option, for excludes()
 CLI::Option* add_base_faces_option(CLI::App& cmd, SemiRegularOptions& options);
@@ -70,6 +72,8 @@ struct SemiRegularResult
     double diagonal = 0.0;        ///< of the samples' bounding box
     std::size_t sample_count = 0;
     std::string predictor;
+    std::string relaxation; ///< "across" or "umbrella", with the rounds per level
+    int relax_rounds = 0;
     /// A level that stalled (improved the Hausdorff distance by less than 5%) is measured but
     /// not kept: four times the faces for next to nothing. Its stats, when that happened.
     std::optional<RefineLevelStats> dropped;

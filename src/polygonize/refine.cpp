@@ -535,7 +535,12 @@ std::vector<Triangle> refine_split_level(MultiresMesh& mesh, MultiresMesh::Split
                                              ? Vec3d(0.5 * (x[level.from(h1)] + x[level.to(h1)]))
                                              : Vec3d(sum / static_cast<double>(count));
                     const Vec3d umbrella = target - p;
-                    const Vec3d tangential = umbrella - n * n.dot(umbrella);
+                    Vec3d tangential = umbrella - n * n.dot(umbrella);
+                    if (h2 != none && options.relaxation == Relaxation::AcrossEdge)
+                    {
+                        const Vec3d along = (x[level.to(h1)] - x[level.from(h1)]).normalized();
+                        tangential -= along * along.dot(tangential);
+                    }
                     const std::optional<Vec3d> hit =
                         project_to_zero(field, origin + p + tangential, n, reach[j]);
                     if (hit)
@@ -610,6 +615,21 @@ Predictor parse_predictor(std::string_view text)
 std::string_view to_string(Predictor predictor)
 {
     return predictor == Predictor::Butterfly ? "butterfly" : "midpoint";
+}
+
+Relaxation parse_relaxation(std::string_view text)
+{
+    if (text == "across")
+        return Relaxation::AcrossEdge;
+    if (text == "umbrella")
+        return Relaxation::Umbrella;
+    throw InvalidInput("unknown relaxation '" + std::string(text) +
+                       "' (expected across or umbrella)");
+}
+
+std::string_view to_string(Relaxation relaxation)
+{
+    return relaxation == Relaxation::Umbrella ? "umbrella" : "across";
 }
 
 std::string_view to_string(RefineStop stop)

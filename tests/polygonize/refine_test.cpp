@@ -205,6 +205,55 @@ TEST(Refine, OctahedronOnAnalyticSphere)
     EXPECT_GT(*std::min_element(min_angles.begin(), min_angles.end()), 30.0);
 }
 
+/// Largest over smallest face area of a level, and the largest depth of a face's centroid
+/// below the unit sphere (how far the flat faces sag: the mesh's distance to the surface).
+std::pair<double, double> area_ratio_and_sag(const MultiresMesh& mesh, std::size_t level)
+{
+    const std::span<const Vec3d> x = mesh.positions();
+    double smallest = std::numeric_limits<double>::max();
+    double largest = 0.0;
+    double sag = 0.0;
+    for (const Triangle& t : mesh.faces(level))
+    {
+        const double area = 0.5 * (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).norm();
+        smallest = std::min(smallest, area);
+        largest = std::max(largest, area);
+        sag = std::max(sag, 1.0 - ((x[t[0]] + x[t[1]] + x[t[2]]) / 3.0).norm());
+    }
+    return {largest / smallest, sag};
+}
+
+TEST(Refine, AcrossEdgeRelaxationKeepsFaceSizesEven)
+{
+    // The octahedron's six vertices have valence 4. The full umbrella move shifts the new
+    // vertices next to them along their parent edges every level, and the shifts compound; the
+    // move across the edge keeps every split ratio, so the faces stay as even as the projected
+    // midpoint subdivision makes them.
+    const auto sphere = make_sphere(Vec3d::Zero(), 1.0);
+    std::array<std::pair<double, double>, 3> measured{};
+    const std::array<std::pair<Relaxation, int>, 3> runs = {
+        {{Relaxation::AcrossEdge, 1}, {Relaxation::Umbrella, 1}, {Relaxation::AcrossEdge, 0}}};
+    for (std::size_t r = 0; r < runs.size(); ++r)
+    {
+        MultiresMesh mesh(octahedron());
+        RefineOptions options;
+        options.relaxation = runs[r].first;
+        options.relax_iterations = runs[r].second;
+        for (int level = 0; level < 5; ++level)
+            (void)refine_once(mesh, *sphere, options);
+        measured[r] = area_ratio_and_sag(mesh, 5);
+        EXPECT_TRUE(check_levels(mesh).nested);
+    }
+    const auto [across_ratio, across_sag] = measured[0];
+    const auto [umbrella_ratio, umbrella_sag] = measured[1];
+    const auto [none_ratio, none_sag] = measured[2];
+    // Measured at level 5: area ratios 1.49 (across), 33 (umbrella), 1.80 (no relaxation).
+    EXPECT_GT(umbrella_ratio, 5.0 * across_ratio); // the umbrella's sizes compound
+    EXPECT_LT(across_ratio, none_ratio);           // and the move across still evens them out
+    EXPECT_LT(across_sag, umbrella_sag);
+    EXPECT_LT(across_sag, none_sag);
+}
+
 TEST(Refine, TorusKeepsGenusOne)
 {
     const auto torus = make_torus(Vec3d::Zero(), Vec3d::UnitZ(), torus_major, torus_minor);
