@@ -137,6 +137,11 @@ OpenMesh::Vec3d to_om(const Vec3d& p)
 }
 
 constexpr double degrees = std::numbers::pi / 180.0;
+/// The base mesh's boundary may pass this many times farther from a removed rim vertex on the
+/// hole's side than on the mesh's side (BaseMeshOptions::boundary_tolerance): a chord across a
+/// hole's rim shrinks the hole, which costs less than growing it, and the rim's vertices are
+/// spent where it turns inwards.
+constexpr double outward_factor = 4.0;
 
 /// Smallest interior angle of triangle abc, radians; 0 for a degenerate one.
 double min_angle(const Vec3d& a, const Vec3d& b, const Vec3d& c)
@@ -201,6 +206,138 @@ private:
     bool cancelled_ = false;
 };
 
+/// Decimater module that keeps the boundary (the rims of holes) where the intermediate mesh
+/// has it. Quadric errors do not see a boundary: removing a rim vertex that lies in the plane
+/// of its faces costs nothing, so rims were cut into long chords, and where a chord passed on
+/// the mesh's side of the rim the hole grew. Here a collapse along the boundary (OpenMesh
+/// already refuses a boundary vertex into an interior one) is refused when the new boundary
+/// edge would pass farther than `inward` from a removed rim vertex on the mesh's side (the hole
+/// grows), or farther than `outward` on the hole's side (the hole shrinks by a flat piece
+/// without samples). Each boundary edge carries the largest deviations of the rim vertices it
+/// replaces (bounded by their sum along the chain), which the new edge inherits plus the
+/// removed vertex's own.
+template <typename MeshT>
+class ModBoundaryT final : public OpenMesh::Decimater::ModBaseT<MeshT>
+{
+public:
+    DECIMATING_MODULE(ModBoundaryT, MeshT, Boundary);
+
+    explicit ModBoundaryT(MeshT& mesh) : Base(mesh, true) { mesh.add_property(deviation_); }
+    ModBoundaryT(const ModBoundaryT&) = delete;
+    ModBoundaryT& operator=(const ModBoundaryT&) = delete;
+    ModBoundaryT(ModBoundaryT&&) = delete;
+    ModBoundaryT& operator=(ModBoundaryT&&) = delete;
+    ~ModBoundaryT() override { Base::mesh().remove_property(deviation_); }
+
+    void set_tolerances(double inward, double outward)
+    {
+        inward_ = inward;
+        outward_ = outward;
+    }
+
+    void initialize() override
+    {
+        Mesh& mesh = Base::mesh();
+        for (const auto e : mesh.edges())
+        {
+            mesh.property(deviation_, e) = {0.0, 0.0};
+        }
+    }
+
+    float collapse_priority(const CollapseInfo& ci) override
+    {
+        if (!Base::mesh().is_boundary(ci.v0))
+        {
+            return Base::LEGAL_COLLAPSE;
+        }
+        const std::optional<Pending> next = pending(ci);
+        return next && next->deviation[0] <= inward_ && next->deviation[1] <= outward_
+                   ? Base::LEGAL_COLLAPSE
+                   : Base::ILLEGAL_COLLAPSE;
+    }
+
+    void preprocess_collapse(const CollapseInfo& ci) override
+    {
+        pending_ = Base::mesh().is_boundary(ci.v0) ? pending(ci) : std::nullopt;
+    }
+
+    void postprocess_collapse(const CollapseInfo& ci) override
+    {
+        if (!pending_)
+        {
+            return;
+        }
+        Mesh& mesh = Base::mesh();
+        const auto h = mesh.find_halfedge(ci.v1, pending_->other);
+        if (h.is_valid())
+        {
+            mesh.property(deviation_, mesh.edge_handle(h)) = pending_->deviation;
+        }
+        pending_.reset();
+    }
+
+private:
+    /// Deviations of a boundary edge from the rim vertices it replaces: towards the mesh
+    /// (inward) and towards the hole (outward).
+    using Deviation = std::array<double, 2>;
+
+    struct Pending
+    {
+        typename Mesh::VertexHandle other; ///< v0's boundary neighbour besides v1
+        Deviation deviation{};             ///< of the boundary edge v1–other after the collapse
+    };
+
+    /// The deviations of the boundary edge that replaces v0's two boundary edges, or none if
+    /// v0 is not a simple boundary vertex collapsing along the boundary.
+    std::optional<Pending> pending(const CollapseInfo& ci)
+    {
+        const Mesh& mesh = Base::mesh();
+        const auto out = mesh.halfedge_handle(ci.v0); // a boundary vertex's is on the boundary
+        if (!mesh.is_boundary(out))
+        {
+            return std::nullopt;
+        }
+        const auto in = mesh.prev_halfedge_handle(out);
+        const auto next = mesh.to_vertex_handle(out);
+        const auto previous = mesh.from_vertex_handle(in);
+        if (next == previous || (ci.v1 != next && ci.v1 != previous))
+        {
+            return std::nullopt;
+        }
+        const auto other = ci.v1 == next ? previous : next;
+        // The mesh's side at v0: towards the centroids of its faces.
+        const Vec3d p0 = to_eigen(ci.p0);
+        Vec3d inside = Vec3d::Zero();
+        for (const auto f : mesh.vf_range(ci.v0))
+        {
+            Vec3d centroid = Vec3d::Zero();
+            for (const auto w : mesh.fv_range(f))
+            {
+                centroid += to_eigen(mesh.point(w));
+            }
+            inside += centroid / 3.0 - p0;
+        }
+        const Vec3d a = to_eigen(mesh.point(ci.v1));
+        const Vec3d b = to_eigen(mesh.point(other));
+        const Vec3d ab = b - a;
+        const double length2 = ab.squaredNorm();
+        const double t = length2 > 0.0 ? std::clamp((p0 - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+        const Vec3d offset = a + t * ab - p0;
+        const std::size_t side = offset.dot(inside) > 0.0 ? 0 : 1;
+        const Deviation& d_out = mesh.property(deviation_, mesh.edge_handle(out));
+        const Deviation& d_in = mesh.property(deviation_, mesh.edge_handle(in));
+        Pending result{.other = other,
+                       .deviation = {std::max(d_out[0], d_in[0]), std::max(d_out[1], d_in[1])}};
+        result.deviation[side] += offset.norm();
+        return result;
+    }
+
+    OpenMesh::EPropHandleT<Deviation> deviation_;
+    double inward_ = 0.0;
+    double outward_ = 0.0;
+    std::optional<Pending> pending_;
+};
+
 void check_options(const BaseMeshOptions& options)
 {
     const auto in_range = [](double value, double low, double high, const std::string& what) {
@@ -213,6 +350,12 @@ void check_options(const BaseMeshOptions& options)
     in_range(options.min_angle_degrees, 0.0, 60.0, "the minimum-angle target");
     in_range(options.max_normal_deviation_degrees, 1.0, 180.0, "the maximum normal deviation");
     in_range(options.max_flip_dihedral_degrees, 0.0, 90.0, "the maximum flip dihedral angle");
+    if (options.boundary_tolerance &&
+        !(*options.boundary_tolerance >= 0.0 && std::isfinite(*options.boundary_tolerance)))
+    {
+        throw InvalidInput("base mesh: the boundary tolerance must be finite and >= 0, got " +
+                           std::to_string(*options.boundary_tolerance));
+    }
     if (options.max_smoothing_rounds < 0)
     {
         throw InvalidInput("base mesh: smoothing rounds must be >= 0, got " +
@@ -525,6 +668,27 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
                            std::to_string(stats.input_faces) + " faces");
     }
 
+    if (options.boundary_tolerance)
+    {
+        stats.boundary_tolerance = *options.boundary_tolerance;
+    }
+    else
+    {
+        std::vector<double> lengths;
+        lengths.reserve(3 * intermediate.face_count());
+        const auto& x = intermediate.vertices.positions;
+        for (const Triangle& t : intermediate.triangles)
+        {
+            for (std::size_t k = 0; k < 3; ++k)
+            {
+                lengths.push_back(static_cast<double>((x[t[k]] - x[t[(k + 1) % 3]]).norm()));
+            }
+        }
+        auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+        std::nth_element(lengths.begin(), middle, lengths.end());
+        stats.boundary_tolerance = 0.5 * *middle;
+    }
+
     // 1. Simplify by edge collapses.
     OmMesh mesh = to_openmesh(intermediate);
     mesh.request_face_normals();
@@ -533,8 +697,12 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
         OpenMesh::Decimater::DecimaterT<OmMesh> decimater(mesh);
         OpenMesh::Decimater::ModQuadricT<OmMesh>::Handle quadric;
         OpenMesh::Decimater::ModNormalFlippingT<OmMesh>::Handle normal_flipping;
+        ModBoundaryT<OmMesh>::Handle boundary;
         decimater.add(quadric);
         decimater.add(normal_flipping);
+        decimater.add(boundary);
+        decimater.module(boundary).set_tolerances(stats.boundary_tolerance,
+                                                  outward_factor * stats.boundary_tolerance);
         decimater.module(quadric).unset_max_err();
         decimater.module(normal_flipping)
             .set_max_normal_deviation(options.max_normal_deviation_degrees);

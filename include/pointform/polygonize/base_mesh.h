@@ -26,6 +26,15 @@ struct BaseMeshOptions
     /// A collapse is refused when it turns any remaining face's normal by more than this,
     /// degrees, in [1, 180) (OpenMesh's ModNormalFlippingT): no fold-overs.
     double max_normal_deviation_degrees = 45.0;
+    /// How far, world units, the base mesh's boundary may pass from a rim vertex of the
+    /// intermediate mesh that decimation removes, on the mesh's side (where the hole would
+    /// grow); on the hole's side four times as far (a chord that shrinks the hole by a flat
+    /// piece). Unset = half the median edge length of the intermediate mesh (half a
+    /// marching-cubes cell: the precision of the marching-cubes rim itself); must be finite and
+    /// >= 0. Measured on a 100k-sample sphere with 8 holes and 0.2% noise, refined to level 3:
+    /// the largest distance from the true sphere to the mesh went from 0.0855 to 0.0776 (marching
+    /// cubes at the same vertex count: 0.0791), the triangles under 20° from 0.15% to 0.37%.
+    std::optional<double> boundary_tolerance;
     /// Triangle-shape target, degrees, in [0, 60): after decimation, rounds of shape improvement
     /// (edge flips that raise the minimum angle, then a tangential umbrella relaxation of every
     /// interior vertex, then the projection of every vertex onto f = 0) go on, at least two, until
@@ -50,12 +59,13 @@ struct BaseMeshOptions
 /// \brief What build_base_mesh() did.
 struct BaseMeshStats
 {
-    std::size_t input_faces = 0;  ///< faces of the intermediate mesh
-    std::size_t target_faces = 0; ///< the target actually used (options or default)
-    std::size_t faces = 0;        ///< faces of the base mesh
-    std::size_t vertices = 0;     ///< vertices of the base mesh
-    int smoothing_rounds = 0;     ///< shape rounds done
-    std::size_t flips = 0;        ///< edge flips made to improve triangle shape
+    std::size_t input_faces = 0;     ///< faces of the intermediate mesh
+    std::size_t target_faces = 0;    ///< the target actually used (options or default)
+    std::size_t faces = 0;           ///< faces of the base mesh
+    std::size_t vertices = 0;        ///< vertices of the base mesh
+    int smoothing_rounds = 0;        ///< shape rounds done
+    std::size_t flips = 0;           ///< edge flips made to improve triangle shape
+    double boundary_tolerance = 0.0; ///< the boundary tolerance used (options or default)
     /// Vertices left off f = 0: no zero crossing within their mean edge length along the
     /// gradient (or the normal), the field undefined there, or a move that would fold a face.
     std::size_t unprojected = 0;
@@ -98,8 +108,9 @@ struct BaseMeshResult
 ///    refused when they break the link condition (so genus, components and boundary loops stay)
 ///    or turn a face by more than max_normal_deviation_degrees (ModNormalFlippingT). A collapse
 ///    keeps the surviving vertex's position. Boundary loops (holes in the samples) are kept: a
-///    boundary vertex only collapses along its boundary, and a loop never shrinks below three
-///    edges.
+///    boundary vertex only collapses along its boundary, a loop never shrinks below three
+///    edges, and the boundary stays within boundary_tolerance of the removed rim vertices (so
+///    holes do not grow).
 /// 2. Shape rounds (see BaseMeshOptions::min_angle_degrees): flips, tangential relaxation and
 ///    projection. Measured on the sampled bunny at its default target: 24% of the triangles
 ///    have a minimum angle under 20° after decimation alone, 0.6% after the rounds (0.05% away
