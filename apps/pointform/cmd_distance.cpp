@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace pointform::cli {
 namespace {
@@ -25,6 +26,7 @@ struct DistanceCommandOptions
     std::string b;
     std::size_t samples = 100000;
     std::uint64_t seed = 1;
+    std::vector<double> fscore; ///< --fscore: thresholds, fractions of the diagonal
     bool json = false;
 };
 
@@ -119,6 +121,7 @@ void run_distance(const DistanceCommandOptions& options, const GlobalOptions& gl
                                               {.samples = options.samples,
                                                .seed = options.seed,
                                                .include_vertices = true,
+                                               .fscore_thresholds = options.fscore,
                                                .progress = progress.callback()});
     timings.lap("measure");
     progress.clear();
@@ -133,6 +136,14 @@ void run_distance(const DistanceCommandOptions& options, const GlobalOptions& gl
         out["diagonal"] = result.diagonal;
         out["absolute"] = summary_json(result.absolute);
         out["relative_to_diagonal"] = summary_json(result.relative);
+        nlohmann::json scores = nlohmann::json::array();
+        for (const FScore& f : result.fscores)
+            scores.push_back({{"threshold", f.threshold},
+                              {"absolute_threshold", f.absolute_threshold},
+                              {"precision", f.precision},
+                              {"recall", f.recall},
+                              {"f", f.f}});
+        out["fscore"] = scores;
         add_run_report(out, timings);
         std::printf("%s\n", out.dump(2).c_str());
         return;
@@ -148,6 +159,11 @@ void run_distance(const DistanceCommandOptions& options, const GlobalOptions& gl
                              format_number(result.relative.chamfer) + " of the diagonal)");
     print_table("absolute (input units)", result.absolute);
     print_table("relative to the bounding box diagonal", result.relative);
+    for (const FScore& f : result.fscores)
+        print_row("F-score at " + format_number(100.0 * f.threshold) + "%",
+                  format_number(f.f) + " (precision " + format_number(f.precision) + ": B within " +
+                      format_number(f.absolute_threshold) + " of A; recall " +
+                      format_number(f.recall) + ": A within it of B)");
     print_timings(timings);
 }
 
@@ -172,6 +188,12 @@ void register_distance(CLI::App& app, const GlobalOptions& global)
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
     cmd->add_option("--seed", options->seed, "Seed of the sampling")->capture_default_str();
+    cmd->add_option("--fscore", options->fscore,
+                    "F-score thresholds as fractions of the diagonal, e.g. 0.005,0.01: A is the "
+                    "reference, B the reconstruction (precision: B's samples within the "
+                    "threshold of A; recall: A's within it of B)")
+        ->delimiter(',')
+        ->check(CLI::PositiveNumber);
     cmd->add_flag("--json", options->json, "Print the statistics as JSON");
     cmd->callback([options, &global] { run_distance(*options, global); });
 }

@@ -157,6 +157,10 @@ DistanceStats scaled(const DistanceStats& stats, double factor)
 
 DistanceComparison compare(const TriMesh& a, const TriMesh& b, const CompareOptions& options)
 {
+    for (const double tau : options.fscore_thresholds)
+        if (!(tau > 0.0 && std::isfinite(tau)))
+            throw InvalidInput("F-score threshold must be positive and finite, got " +
+                               std::to_string(tau));
     const PointCloud samples_a =
         samples_of(a, options.samples, options.seed, options.include_vertices, "A");
     const PointCloud samples_b = samples_of(
@@ -177,6 +181,22 @@ DistanceComparison compare(const TriMesh& a, const TriMesh& b, const CompareOpti
     result.relative.symmetric = scaled(result.absolute.symmetric, factor);
     result.relative.hausdorff = result.absolute.hausdorff * factor;
     result.relative.chamfer = result.absolute.chamfer * factor;
+    const auto share_within = [](const std::vector<double>& distances, double limit) {
+        const auto within = std::count_if(distances.begin(), distances.end(),
+                                          [limit](double d) { return d <= limit; });
+        return static_cast<double>(within) / static_cast<double>(distances.size());
+    };
+    for (const double tau : options.fscore_thresholds)
+    {
+        FScore score;
+        score.threshold = tau;
+        score.absolute_threshold = tau * result.diagonal;
+        score.precision = share_within(b_to_a, score.absolute_threshold);
+        score.recall = share_within(a_to_b, score.absolute_threshold);
+        const double sum = score.precision + score.recall;
+        score.f = sum > 0.0 ? 2.0 * score.precision * score.recall / sum : 0.0;
+        result.fscores.push_back(score);
+    }
     return result;
 }
 

@@ -74,6 +74,19 @@ TEST(DistanceCli, CubeAgainstItsTranslateInBothFormats)
                              "relative to the bounding box diagonal"})
         EXPECT_NE(table.out.find(word), std::string::npos) << word << "\n" << table.out;
     EXPECT_NE(table.out.find("0.25"), std::string::npos) << table.out;
+
+    // F-score: every sample of either cube off the one face pair is within t of the other, the
+    // rest too (the faces x = 0 and x = 1 + t are t away): at a threshold just above t both
+    // shares are 1, and far below t they miss the faces that are t away.
+    const RunResult scored = run("distance " + files + " --samples 5000 --json --fscore 0.0001," +
+                                 std::to_string(1.01 * t / diagonal));
+    ASSERT_EQ(scored.exit_code, 0) << scored.out;
+    const auto fscore = nlohmann::json::parse(scored.out)["fscore"];
+    ASSERT_EQ(fscore.size(), 2U);
+    EXPECT_LT(fscore[0]["f"].get<double>(), 1.0);
+    EXPECT_DOUBLE_EQ(fscore[1]["precision"].get<double>(), 1.0);
+    EXPECT_DOUBLE_EQ(fscore[1]["recall"].get<double>(), 1.0);
+    EXPECT_NE(run("distance " + files + " --fscore 0").exit_code, 0);
 }
 
 TEST(DistanceCli, PointSetAgainstMesh)

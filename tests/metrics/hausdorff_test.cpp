@@ -246,6 +246,48 @@ TEST(Compare, SameResultWhateverTheThreadCount)
     EXPECT_TRUE(d1 == d3);
 }
 
+/// The rectangle [0, 1] × [0, height] in the plane z = 0, two triangles.
+TriMesh rectangle(float height)
+{
+    TriMesh mesh;
+    mesh.vertices.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(1, height, 0),
+                               Vec3f(0, height, 0)};
+    mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+    return mesh;
+}
+
+TEST(Compare, FScoreOfAHalfCoveredSquare)
+{
+    // A: the unit square; B: its lower half. Every sample of B lies on A (precision 1); a sample
+    // of A at height y is max(0, y - 1/2) from B, so the share within τ (recall) is 1/2 + τ for
+    // τ < 1/2, with binomial noise of the sampling.
+    const TriMesh a = rectangle(1.0F);
+    const TriMesh b = rectangle(0.5F);
+    const std::size_t samples = 40000;
+    const DistanceComparison result =
+        compare(a, b, {.samples = samples, .fscore_thresholds = {0.05, 0.2}});
+    ASSERT_EQ(result.fscores.size(), 2U);
+    const double diagonal = std::sqrt(2.0);
+    EXPECT_NEAR(result.diagonal, diagonal, 1e-9);
+    for (const FScore& score : result.fscores)
+    {
+        const double tau = score.threshold * diagonal;
+        EXPECT_DOUBLE_EQ(score.absolute_threshold, tau);
+        const double recall = 0.5 + tau;
+        const double tolerance = 4.0 * std::sqrt(recall * (1.0 - recall) / samples) + 1e-3;
+        EXPECT_DOUBLE_EQ(score.precision, 1.0);
+        EXPECT_NEAR(score.recall, recall, tolerance);
+        EXPECT_NEAR(score.f, 2.0 * recall / (1.0 + recall), tolerance);
+    }
+    // Swapping the roles swaps precision and recall.
+    const DistanceComparison swapped =
+        compare(b, a, {.samples = samples, .fscore_thresholds = {0.05}});
+    EXPECT_DOUBLE_EQ(swapped.fscores[0].recall, 1.0);
+    EXPECT_NEAR(swapped.fscores[0].precision, 0.5 + 0.05 * diagonal, 0.01);
+    EXPECT_THROW((void)compare(a, b, {.fscore_thresholds = {0.0}}), InvalidInput);
+    EXPECT_THROW((void)compare(a, b, {.fscore_thresholds = {std::nan("")}}), InvalidInput);
+}
+
 TEST(Compare, BadInputIsRejected)
 {
     const TriMesh cube = test::box_mesh(Vec3d(0, 0, 0), Vec3d(1, 1, 1));

@@ -76,8 +76,24 @@ struct CompareOptions
     std::uint64_t seed = 1;
     /// Add a mesh's vertices to its samples, as Metro does (corners are then measured exactly).
     bool include_vertices = true;
+    /// F-score thresholds τ, as fractions of the diagonal (DistanceComparison::diagonal), each
+    /// > 0 and finite: see FScore.
+    std::vector<double> fscore_thresholds;
     /// Optional progress report, called from one thread.
     ProgressCallback progress;
+};
+
+/// \brief F-score at a distance threshold τ, A taken as the reference (ground truth) and B as
+/// the reconstruction (Knapitsch et al. 2017, Tanks and Temples): precision is the fraction of
+/// B's samples within τ of A, recall the fraction of A's samples within τ of B, and F their
+/// harmonic mean (0 when both are 0).
+struct FScore
+{
+    double threshold = 0.0;          ///< τ relative to the diagonal
+    double absolute_threshold = 0.0; ///< τ in world units
+    double precision = 0.0;
+    double recall = 0.0;
+    double f = 0.0;
 };
 
 /// \brief One direction, the other, and both together, all in one unit.
@@ -103,6 +119,8 @@ struct DistanceComparison
     /// for meshes), like the bounding box MeshLab's Metro uses for its "wrt bounding box
     /// diagonal" figures.
     double diagonal = 0.0;
+    /// One per CompareOptions::fscore_thresholds, in that order.
+    std::vector<FScore> fscores;
 };
 
 /// \brief Compares two shapes the way MeshLab's Metro does: samples both, measures each set of
@@ -113,7 +131,8 @@ struct DistanceComparison
 /// exactly (point-to-triangle, through a TriangleBvh); without triangles it is a point set,
 /// used as its own samples and measured against by nearest point (kd-tree).
 /// \throw InvalidInput if a shape has no points, a mesh has zero area or a bad index, a
-///        coordinate is not finite, or a mesh would get no samples
+///        coordinate is not finite, a mesh would get no samples, or an F-score threshold is not
+///        positive and finite
 [[nodiscard]] DistanceComparison compare(const TriMesh& a, const TriMesh& b,
                                          const CompareOptions& options = {});
 
