@@ -151,7 +151,7 @@ def main(argv=None) -> int:
             continue
         vertices = r.get("vertices") or ""
         print(f"| {r['shape']} | {r['variant']} | {r['tool']} | {r['wall_s']:.1f} | "
-              f"{r['peak_mib']:.0f} | {vertices} | {100 * r['hausdorff']:.3f} | "
+              f"{r['peak_mib']:.0f} | {vertices} | {100 * r['hausdorff']:.4g} | "
               f"{100 * r['chamfer']:.4f} | {r['f0.005']:.4f} | {r['f0.01']:.4f} | "
               f"{100 * r['min_angle_under_20']:.2f}% | {100 * r['valence6']:.1f}% |")
     return 0
