@@ -94,7 +94,9 @@ def evaluate(shape, mesh_path: Path, truth: np.ndarray, samples: np.ndarray, dia
     if "absolute" not in report:
         return {"evaluation": f"pointform distance failed ({pf[0]})"}
     truth_to_mesh = report["absolute"]["a_to_b"]
-    tree = o3d.geometry.KDTreeFlann(o3d.geometry.PointCloud(o3d.utility.Vector3dVector(samples)))
+    # The tree keeps a reference into the cloud's points: the cloud must outlive it.
+    cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(samples))
+    tree = o3d.geometry.KDTreeFlann(cloud)
     spurious = 0
     for p in surface[::20]:
         _, _, d2 = tree.search_knn_vector_3d(p, 1)
