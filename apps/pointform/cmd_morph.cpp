@@ -82,7 +82,9 @@ void run_morph(const MorphCommandOptions& options, const GlobalOptions& global)
     set_thread_count(global.threads);
     TerminalProgress progress(!global.quiet && !options.scene.json);
     Timings timings;
-    SceneArguments arguments(options.scene, progress.callback());
+    SceneCommandOptions scene = options.scene;
+    scene.far_grid = false; // a morph's surface lies deep inside a member: exact inside values
+    SceneArguments arguments(scene, progress.callback());
     const SceneArguments::Loaded from = arguments.load(options.from);
     const SceneArguments::Loaded to = arguments.load(options.to);
     // Refuses fields whose bounds do not overlap before anything is polygonized.

@@ -156,7 +156,8 @@ std::shared_ptr<const Field> SceneArguments::load_scan(const std::string& path)
     scan.estimated_normals = input.estimated_normals;
     scan.unoriented = input.unoriented;
     scan.field = std::make_shared<const PointField>(
-        std::move(input.surfels), PointFieldOptions{.fit = parse_plane_fit(options_.fit)});
+        std::move(input.surfels),
+        PointFieldOptions{.fit = parse_plane_fit(options_.fit), .far_grid = options_.far_grid});
     index_.emplace(key, scans_.size());
     scans_.push_back(std::move(scan));
     return scans_.back().field;

@@ -27,6 +27,9 @@ struct SceneCommandOptions
     double cell = 0.0;
     std::string bounds;
     std::string fit = "quadric";
+    /// Scans answer deep-inside queries from their far grid (PointFieldOptions::far_grid); the
+    /// morph command turns it off, since a morph takes inside values as distances.
+    bool far_grid = true;
     SurfelInputOptions surfels;
     bool ascii = false;
     bool json = false;

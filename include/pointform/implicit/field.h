@@ -18,7 +18,8 @@ namespace pointform {
 /// surface; the gradient points outwards. `defined` is false where the field is the paper's
 /// f = ∞ (beyond every influence radius, §4): there `value` still carries the sign (inside or
 /// outside) and a magnitude that grows with the distance from the surface, so that operators can
-/// tell deep inside from far outside, and polygonization treats the point as "no surface here".
+/// tell deep inside from far outside, and polygonization treats the point as "no surface here"
+/// (how closely it follows the distance depends on the field: see PointField).
 struct FieldSample
 {
     double value = 0.0;

@@ -53,6 +53,11 @@ struct PointFieldOptions
     /// than the centroid's, since six coefficients need more samples to average noise away (on
     /// spheres and tori with 0.1–0.2% noise, 48 beats 16 and 32 and the centroid blend).
     std::size_t quadric_k = 48;
+    /// Answer deep-inside queries from the far grid (see PointField): constant time, within
+    /// 2√3 h of the distance. False: the nearly nearest kd-tree search, as outside (within 1%),
+    /// slower deep inside a closed scan; for callers that take inside values as distances
+    /// (morphs, UndefinedPolicy::Ignore).
+    bool far_grid = true;
 };
 
 /// \brief The signed field of oriented surfels (§4).
@@ -64,9 +69,25 @@ struct PointFieldOptions
 /// widen "defined" to the union of the influence balls of the blended samples: with irregular
 /// sampling the nearest sample's ball alone leaves pinholes between clusters.
 ///
-/// Farther from every sample than the largest influence radius, s_k may be a sample up to 1%
-/// farther than the nearest: there every sample is about as far as the nearest (think of the
-/// middle of a closed scan) and an exact search would visit most of them.
+/// Farther from every sample than the largest influence radius, s_k may be a sample a little
+/// farther than the nearest, at distance D: there every sample is about as far as the nearest
+/// (think of the middle of a closed scan) and an exact search would visit most of them.
+/// - Outside (value > 0): D ≤ |value| ≤ 1.01 D (a nearly nearest kd-tree search), close enough
+///   for offsets and blends, which trust outside values as distances.
+/// - Deep inside (value < 0): D ≤ |value| ≤ D + 2√3 h, with h = (the longest side of bounds())
+///   / 127, answered in constant time by a far grid: a FeatureGrid of 128 nodes along that side
+///   over bounds(), built on the first query that needs it (about 8 bytes a node, at most 16 MiB;
+///   never for a field queried only near its samples). With the 8 nodes around p it proves that
+///   no influence ball reaches p (every sample is farther than the largest radius × 1.01), and
+///   s_k is the nearest to p of those nodes' representative samples (see FeatureGrid), ties to
+///   the smallest index. Its magnitude is never below D, so an undefined inside value stays
+///   beyond every influence radius, as Booleans need; operators that take undefined values as
+///   distances inside too (UndefinedPolicy::Ignore, as morphs do) see the 2√3 h, unless they
+///   turn the far grid off (PointFieldOptions::far_grid; `pointform morph` does). The far grid
+///   answers only where all those representatives' surfaces put p inside and none shares its node
+///   with a sample facing the other way (a wall thinner than h, whose side the node cannot tell);
+///   elsewhere the kd-tree search decides, as outside.
+/// The answers do not depend on the order of queries or on threads.
 ///
 /// Queries are answered by a PointGrid over the samples (a kd-tree far from them), and run
 /// fastest in spatially coherent order (as marching cubes and refinement ask).
