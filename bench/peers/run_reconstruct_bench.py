@@ -102,9 +102,13 @@ def main(argv=None) -> int:
                 diag = float(np.linalg.norm(samples.max(0) - samples.min(0)))
 
                 def measure(name, cmd, out):
-                    status, wall, peak, _ = run_measured(cmd, env, args.timeout, work / "tool")
+                    status, wall, peak, report = run_measured(cmd, env, args.timeout, work / "tool")
                     row = {"shape": shape, "variant": variant, "size": args.size, "tool": name,
                            "status": status, "wall_s": wall, "peak_mib": peak}
+                    levels = (report or {}).get("levels") or []
+                    if levels and "folded_faces" in levels[-1]:
+                        # Child faces turned against their parent (§5.2.2) left in the output.
+                        row["folded_faces"] = levels[-1]["folded_faces"]
                     if status == "ok" and out.exists():
                         row.update(mesh_quality(out))
                         row.update(evaluate_isolated(shape, out, truth, samples, diag,
@@ -142,18 +146,19 @@ def main(argv=None) -> int:
                              "bpa", "--estimate-normals", "16"], work / "bpa.ply")
     print()
     header = ["shape", "variant", "tool", "wall s", "peak MiB", "vertices", "Hausdorff %diag",
-              "Chamfer %diag", "F@0.5%", "F@1%", "min angle < 20°", "valence 6"]
+              "Chamfer %diag", "F@0.5%", "F@1%", "min angle < 20°", "valence 6", "folds"]
     print("| " + " | ".join(header) + " |")
     print("|" + "---|" * len(header))
     for r in rows:
         if "chamfer" not in r:
-            print(f"| {r['shape']} | {r['variant']} | {r['tool']} | {r['status']} |" + " |" * 8)
+            print(f"| {r['shape']} | {r['variant']} | {r['tool']} | {r['status']} |" + " |" * 9)
             continue
         vertices = r.get("vertices") or ""
         print(f"| {r['shape']} | {r['variant']} | {r['tool']} | {r['wall_s']:.1f} | "
               f"{r['peak_mib']:.0f} | {vertices} | {100 * r['hausdorff']:.4g} | "
               f"{100 * r['chamfer']:.4f} | {r['f0.005']:.4f} | {r['f0.01']:.4f} | "
-              f"{100 * r['min_angle_under_20']:.2f}% | {100 * r['valence6']:.1f}% |")
+              f"{100 * r['min_angle_under_20']:.2f}% | {100 * r['valence6']:.1f}% | "
+              f"{r.get('folded_faces', '')} |")
     return 0
 
 

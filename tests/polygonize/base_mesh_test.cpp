@@ -83,6 +83,37 @@ double share_below_20(const TriMesh& mesh)
     return static_cast<double>(bad) / static_cast<double>(mesh.face_count());
 }
 
+/// A unit sphere sampled with exact normals (seed 12) without the samples `removed` picks, radii
+/// 1.5 × the 16th neighbour's distance, its point field and its marching-cubes mesh.
+struct CutSphere
+{
+    PointCloud cloud;
+    std::unique_ptr<PointField> field;
+    TriMesh mc;
+};
+
+template <typename Removed>
+CutSphere cut_sphere(std::size_t count, Removed removed)
+{
+    const PointCloud all = sample_shape(Shape::Sphere, {.count = count, .seed = 12});
+    CutSphere out;
+    for (std::size_t i = 0; i < all.size(); ++i)
+    {
+        if (!removed(all.positions[i].cast<double>()))
+        {
+            out.cloud.positions.push_back(all.positions[i]);
+            out.cloud.normals.push_back(all.normals[i]);
+        }
+    }
+    const KdTree tree(out.cloud.positions);
+    out.cloud.radii = influence_radii(knn_batch(tree, out.cloud.positions, 17), 1.5);
+    out.field = std::make_unique<PointField>(out.cloud);
+    out.mc =
+        marching_cubes(*out.field, grid_over(out.field->bounds(), default_cell_size(*out.field)))
+            .mesh;
+    return out;
+}
+
 TEST(BaseMesh, SampledSphereReachesTheTargetOnTheSurface)
 {
     const Scene scene = sampled(Shape::Sphere, 5000, sphere_area);
@@ -159,21 +190,10 @@ TEST(BaseMesh, TorusKeepsItsGenus)
 TEST(BaseMesh, SphereWithoutItsCapKeepsOneBoundaryLoop)
 {
     // A unit sphere sampled with exact normals, without the cap above z = 0.8.
-    const PointCloud all = sample_shape(Shape::Sphere, {.count = 5000, .seed = 12});
-    PointCloud cloud;
-    for (std::size_t i = 0; i < all.size(); ++i)
-    {
-        if (all.positions[i].z() <= 0.8F)
-        {
-            cloud.positions.push_back(all.positions[i]);
-            cloud.normals.push_back(all.normals[i]);
-        }
-    }
-    const KdTree tree(cloud.positions);
-    cloud.radii = influence_radii(knn_batch(tree, cloud.positions, 17), 1.5);
-    const PointField field(cloud);
-    const TriMesh mc =
-        marching_cubes(field, grid_over(field.bounds(), default_cell_size(field))).mesh;
+    const CutSphere cut = cut_sphere(5000, [](const Vec3d& p) { return p.z() > 0.8; });
+    const PointCloud& cloud = cut.cloud;
+    const PointField& field = *cut.field;
+    const TriMesh& mc = cut.mc;
     ASSERT_EQ(analyze_topology(mc).boundary_loops, 1U);
 
     const BaseMeshResult result = build_base_mesh(mc, field, {.target_faces = 250});
@@ -200,24 +220,12 @@ TEST(BaseMesh, HolesDoNotGrow)
     // caps meet. Decimation keeps the rim within the boundary tolerance on the mesh's side, so
     // no point of the sphere is farther from the base mesh than from the marching-cubes mesh
     // by more than that.
-    const PointCloud all = sample_shape(Shape::Sphere, {.count = 6000, .seed = 12});
     const Vec3d axis_a = Vec3d(0.35, 0.0, 1.0).normalized();
     const Vec3d axis_b = Vec3d(-0.35, 0.0, 1.0).normalized();
-    PointCloud cloud;
-    for (std::size_t i = 0; i < all.size(); ++i)
-    {
-        const Vec3d p = all.positions[i].cast<double>();
-        if (p.dot(axis_a) < 0.93 && p.dot(axis_b) < 0.93)
-        {
-            cloud.positions.push_back(all.positions[i]);
-            cloud.normals.push_back(all.normals[i]);
-        }
-    }
-    const KdTree tree(cloud.positions);
-    cloud.radii = influence_radii(knn_batch(tree, cloud.positions, 17), 1.5);
-    const PointField field(cloud);
-    const TriMesh mc =
-        marching_cubes(field, grid_over(field.bounds(), default_cell_size(field))).mesh;
+    const CutSphere cut = cut_sphere(
+        6000, [&](const Vec3d& p) { return p.dot(axis_a) >= 0.93 || p.dot(axis_b) >= 0.93; });
+    const PointField& field = *cut.field;
+    const TriMesh& mc = cut.mc;
     ASSERT_EQ(analyze_topology(mc).boundary_loops, 1U);
     const BaseMeshResult result = build_base_mesh(mc, field, {.target_faces = 300});
     ASSERT_TRUE(result.stats.topology_kept) << result.stats.topology_change;
