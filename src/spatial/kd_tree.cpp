@@ -110,6 +110,27 @@ PointId KdTree::nearest_within_factor(const Vec3f& query, float factor,
     return PointId{index};
 }
 
+PointId KdTree::nearest_within_factor(const Vec3f& query, float factor, PointId start,
+                                      float* squared_distance) const
+{
+    PF_ASSERT(factor >= 1.0F);
+    PF_ASSERT(start.is_valid() && start.value < size());
+    // The result set's worst distance is the search's bound: preset it to the start's, so
+    // that the search only looks for points nearer than that.
+    std::uint32_t index = 0;
+    float d2 = 0.0F;
+    nanoflann::KNNResultSet<float, std::uint32_t, std::size_t> result(1);
+    result.init(&index, &d2);
+    index = start.value;
+    d2 = (impl_->data.points[start.value] - query).squaredNorm();
+    nanoflann::SearchParams params;
+    params.eps = factor - 1.0F;
+    impl_->tree.findNeighbors(result, query.data(), params);
+    if (squared_distance != nullptr)
+        *squared_distance = d2;
+    return PointId{index};
+}
+
 PointId KdTree::nearest(const Vec3f& query, float* squared_distance) const
 {
     std::uint32_t index = 0;

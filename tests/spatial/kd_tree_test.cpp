@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <random>
 #include <vector>
@@ -54,6 +55,48 @@ TEST(KdTree, KnnMatchesBruteForce)
             EXPECT_NEAR(table.distances2(q)[j], truth[j].first, 1e-6F);
             EXPECT_EQ(table.neighbors(q)[j], truth[j].second);
         }
+    }
+}
+
+TEST(KdTree, NearestWithinFactorWithAndWithoutAStart)
+{
+    // Samples of a unit sphere; queries deep inside (where every sample is nearly as far) and
+    // outside. The point returned is a real point at most `factor` times as far as the nearest,
+    // from any start; with factor 1 it is as near as the nearest.
+    const PointCloud sphere = sample_shape(Shape::Sphere, {.count = 3000, .seed = 4});
+    const std::vector<Vec3f>& points = sphere.positions;
+    const KdTree tree(points);
+    std::mt19937_64 rng(5);
+    std::uniform_int_distribution<std::uint32_t> any(0,
+                                                     static_cast<std::uint32_t>(points.size() - 1));
+    std::vector<Vec3f> queries = random_points(100, 9);
+    for (Vec3f& q : random_points(100, 10))
+        queries.push_back(q * 0.3F);
+    for (Vec3f& q : random_points(100, 11))
+        queries.push_back(q * 3.0F);
+    for (const Vec3f& q : queries)
+    {
+        const float nearest = brute_sorted(points, q).front().first;
+        for (const float factor : {1.0F, 1.01F, 1.2F})
+        {
+            const auto check = [&](PointId found, float d2) {
+                ASSERT_TRUE(found.is_valid());
+                // The tree sums the squares in its own order: equal up to float rounding.
+                const float exact = (points[found.value] - q).squaredNorm();
+                EXPECT_NEAR(d2, exact, 1e-6F * exact);
+                EXPECT_GE(d2, nearest * (1.0F - 1e-6F));
+                EXPECT_LE(std::sqrt(d2), factor * std::sqrt(nearest) * (1.0F + 1e-6F));
+            };
+            float d2 = 0.0F;
+            const PointId plain = tree.nearest_within_factor(q, factor, &d2);
+            check(plain, d2);
+            const PointId started = tree.nearest_within_factor(q, factor, PointId(any(rng)), &d2);
+            check(started, d2);
+        }
+        // A start that is the nearest comes back.
+        const std::uint32_t best = brute_sorted(points, q).front().second;
+        float d2 = 0.0F;
+        EXPECT_EQ(tree.nearest_within_factor(q, 1.5F, PointId(best), &d2).value, best);
     }
 }
 

@@ -63,6 +63,14 @@ public:
     [[nodiscard]] PointId nearest_within_factor(const Vec3f& query, float factor,
                                                 float* squared_distance = nullptr) const;
 
+    /// \brief nearest_within_factor() given a point `start` of the tree known to be near the
+    /// query (say, from a coarser structure): the search starts with its distance as the bound,
+    /// so it skips every subtree farther than that from the start, and returns `start` itself
+    /// when no point is nearer than its distance over `factor`. Same guarantee: the point
+    /// returned is at most `factor` times as far as the nearest.
+    [[nodiscard]] PointId nearest_within_factor(const Vec3f& query, float factor, PointId start,
+                                                float* squared_distance = nullptr) const;
+
     /// \brief Appends to the buffers every point within `radius` of `query`, nearest first.
     /// \return the number appended
     std::size_t radius_search(const Vec3f& query, float radius, std::vector<std::uint32_t>& indices,
