@@ -102,6 +102,31 @@ BENCHMARK(BM_FieldEvaluate)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
+/// BM_FieldEvaluate's queries one evaluate() call at a time (the same values as the batch, which
+/// answers coherent queries near the samples together).
+void BM_FieldEvaluateOneByOne(benchmark::State& state)
+{
+    const auto fit = static_cast<PlaneFit>(state.range(0));
+    const PointField field(surfels(), {.fit = fit});
+    const std::vector<Vec3d> points = near_surface_queries(1 << 20, true, default_cell_size(field));
+    std::vector<FieldSample> out(points.size());
+    for (auto _ : state)
+    {
+        for (std::size_t i = 0; i < points.size(); ++i)
+        {
+            out[i] = field.evaluate(points[i]);
+        }
+        benchmark::DoNotOptimize(out.data());
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * points.size()));
+    state.SetLabel(std::string(to_string(fit)) + ", ±1 cell, Morton order, one by one");
+}
+BENCHMARK(BM_FieldEvaluateOneByOne)
+    ->Arg(static_cast<int>(PlaneFit::Raw))
+    ->Arg(static_cast<int>(PlaneFit::Quadric))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
 void BM_MarchingCubes512(benchmark::State& state)
 {
     const PointField field(surfels());

@@ -20,6 +20,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace pointform {
 
@@ -304,6 +305,18 @@ struct PointField::Impl
         return *far;
     }
 
+    /// How many neighbours a query needs: the blended ones and the next, or the nearest.
+    [[nodiscard]] std::size_t wanted() const;
+    /// False where `p` (relative to the origin) is certainly too far from the samples for the
+    /// point grid to answer (knn_nearby() would find none).
+    [[nodiscard]] bool maybe_nearby(const Vec3d& p, const FarField* far_data) const;
+    /// The field at `p` (relative to the origin; `query` is it in floats) given what the point
+    /// grid's knn_nearby() found there: `found` (0 if it was not asked) neighbours in `slot`
+    /// and `dist2`, which have room for wanted() and may be overwritten.
+    [[nodiscard]] FieldSample evaluate_with(const Vec3d& p, const Vec3f& query,
+                                            const FarField* far_data, std::size_t found,
+                                            std::uint32_t* slot, float* dist2) const;
+
     /// The value at `p` (relative to the origin) where the far grid proves that no influence
     /// ball reaches and every candidate sample's surface puts `p` inside; false (and `out`
     /// untouched) otherwise.
@@ -454,41 +467,40 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
 
 PointField::~PointField() = default;
 
-FieldSample PointField::evaluate(const Vec3d& world_point) const
+std::size_t PointField::Impl::wanted() const
 {
-    const Impl& m = *impl_;
-    const Vec3d p = world_point - m.surfels.origin;
-    const Vec3f query = p.cast<float>();
-    FieldSample out;
+    return blends(options.fit) ? std::min(options.blend_k + 1, surfels.size()) : std::size_t{1};
+}
 
-    std::array<std::uint32_t, max_blend_k + 1> slot{};
-    std::array<float, max_blend_k + 1> dist2{};
+bool PointField::Impl::maybe_nearby(const Vec3d& p, const FarField* far_data) const
+{
     // Far from the samples the point grid finds none, and the far grid answers what it can
     // (deep inside). A lower bound on the distance to the samples (from their box and, once it
     // is built, the far grid) tells directly where the point grid would find none, which saves
     // scanning its cells; the answers are the same either way, so they do not depend on when
     // the far grid was built (or on the order of queries).
-    const std::size_t want =
-        blends(m.options.fit) ? std::min(m.options.blend_k + 1, m.surfels.size()) : std::size_t{1};
-    const FarField* far = m.far_built.load(std::memory_order_acquire);
-    double lower = (p - p.cwiseMax(m.sample_box.min).cwiseMin(m.sample_box.max)).norm();
-    if (far != nullptr && !(lower > m.nearby_reach))
+    double lower = (p - p.cwiseMax(sample_box.min).cwiseMin(sample_box.max)).norm();
+    if (far_data != nullptr && !(lower > nearby_reach))
     {
-        lower = std::max(lower, far->grid.lower_bound(p));
+        lower = std::max(lower, far_data->grid.lower_bound(p));
     }
-    std::size_t found = 0;
-    if (!(lower > m.nearby_reach))
-    {
-        found = m.grid->knn_nearby(query, want, std::span(slot.data(), want),
-                                   std::span(dist2.data(), want));
-    }
+    return !(lower > nearby_reach);
+}
+
+FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
+                                            const FarField* far_data, std::size_t found,
+                                            std::uint32_t* slot, float* dist2) const
+{
+    const Impl& m = *this;
+    FieldSample out;
+    const std::size_t want = wanted();
     if (found == 0 && m.options.far_grid)
     {
-        if (far == nullptr)
+        if (far_data == nullptr)
         {
-            far = &m.far_field();
+            far_data = &m.far_field();
         }
-        if (m.evaluate_deep_inside(*far, p, out))
+        if (m.evaluate_deep_inside(*far_data, p, out))
         {
             return out;
         }
@@ -499,7 +511,7 @@ FieldSample PointField::evaluate(const Vec3d& world_point) const
         if (found == 0)
         {
             std::array<std::uint32_t, 1> index{};
-            m.tree.knn(query, 1, index, std::span(dist2.data(), 1));
+            m.tree.knn(query, 1, index, std::span(dist2, 1));
             slot[0] = m.grid->slot_of(index[0]);
         }
         const PackedSurfel& nearest = m.packed[slot[0]];
@@ -530,8 +542,7 @@ FieldSample PointField::evaluate(const Vec3d& world_point) const
             out.gradient = nearest.normal.cast<double>();
             return out;
         }
-        found =
-            m.grid->knn(query, want, std::span(slot.data(), want), std::span(dist2.data(), want));
+        found = m.grid->knn(query, want, std::span(slot, want), std::span(dist2, want));
     }
     const PackedSurfel& nearest = m.packed[slot[0]];
     // Defined inside the union of the blended samples' influence balls, so that a gap next to
@@ -596,6 +607,75 @@ FieldSample PointField::evaluate(const Vec3d& world_point) const
     out.value = value_sum / weight_sum;
     out.gradient = (normal_sum + weighted_gradient_sum - out.value * gradient_sum) / weight_sum;
     return out;
+}
+
+FieldSample PointField::evaluate(const Vec3d& world_point) const
+{
+    const Impl& m = *impl_;
+    const Vec3d p = world_point - m.surfels.origin;
+    const Vec3f query = p.cast<float>();
+    std::array<std::uint32_t, max_blend_k + 1> slot{};
+    std::array<float, max_blend_k + 1> dist2{};
+    const std::size_t want = m.wanted();
+    const FarField* far = m.far_built.load(std::memory_order_acquire);
+    std::size_t found = 0;
+    if (m.maybe_nearby(p, far))
+    {
+        found = m.grid->knn_nearby(query, want, std::span(slot.data(), want),
+                                   std::span(dist2.data(), want));
+    }
+    return m.evaluate_with(p, query, far, found, slot.data(), dist2.data());
+}
+
+void PointField::evaluate(std::span<const Vec3d> points, std::span<FieldSample> out) const
+{
+    PF_ASSERT(points.size() == out.size());
+    const Impl& m = *impl_;
+    const std::size_t want = m.wanted();
+    // Blocks of consecutive queries, fixed whatever the thread count; the point grid answers
+    // each block's queries near the samples together (faster on coherent queries, the same
+    // neighbours as one by one), then each is finished as evaluate() finishes it.
+    parallel_blocks(points.size(), 1024, [&](std::size_t begin, std::size_t end) {
+        const std::size_t n = end - begin;
+        const FarField* far = m.far_built.load(std::memory_order_acquire);
+        std::vector<Vec3d> local(n);
+        std::vector<Vec3f> nearby;
+        std::vector<std::uint32_t> which; // the block's queries that the grid is asked
+        nearby.reserve(n);
+        which.reserve(n);
+        for (std::size_t i = 0; i < n; ++i)
+        {
+            local[i] = points[begin + i] - m.surfels.origin;
+            if (m.maybe_nearby(local[i], far))
+            {
+                nearby.push_back(local[i].cast<float>());
+                which.push_back(static_cast<std::uint32_t>(i));
+            }
+        }
+        std::vector<std::uint32_t> slots(nearby.size() * want);
+        std::vector<float> dist2(nearby.size() * want);
+        std::vector<std::uint32_t> found(nearby.size());
+        m.grid->knn_nearby(nearby, want, slots, dist2, found);
+        std::array<std::uint32_t, max_blend_k + 1> none_slot{};
+        std::array<float, max_blend_k + 1> none_dist2{};
+        std::size_t next = 0;
+        for (std::size_t i = 0; i < n; ++i)
+        {
+            const Vec3f query = local[i].cast<float>();
+            if (next < which.size() && which[next] == i)
+            {
+                out[begin + i] =
+                    m.evaluate_with(local[i], query, far, found[next], slots.data() + next * want,
+                                    dist2.data() + next * want);
+                ++next;
+            }
+            else
+            {
+                out[begin + i] =
+                    m.evaluate_with(local[i], query, far, 0, none_slot.data(), none_dist2.data());
+            }
+        }
+    });
 }
 
 Aabb PointField::bounds() const

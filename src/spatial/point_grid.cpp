@@ -12,10 +12,28 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numeric>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#endif
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#define PF_GRID_AVX2 1
+#else
+#define PF_GRID_AVX2 0
+#endif
+
+// Keeps a product apart from the sum it goes into: where the compiler may fuse multiplies and
+// adds (a target with FMA), the squared distances are rounded the same on every path (Within's,
+// Selection's scalar and wide loops) all the same.
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#define PF_GRID_UNFUSED(value) asm("" : "+x"(value))
+#elif defined(__GNUC__) && defined(__aarch64__)
+#define PF_GRID_UNFUSED(value) asm("" : "+w"(value))
+#else
+#define PF_GRID_UNFUSED(value) static_cast<void>(value)
 #endif
 
 namespace pointform {
@@ -58,6 +76,23 @@ std::uint64_t hash_of(std::uint64_t key, int shift)
     return (key * 0x9E3779B97F4A7C15ULL) >> static_cast<unsigned>(shift);
 }
 
+/// std::floor for finite floats, without a library call: below 2^23 in magnitude through the
+/// integers, above it every float is an integer.
+float floor_of(float x)
+{
+    constexpr float exact = 8388608.0F; // 2^23
+    if (!(std::abs(x) < exact))
+    {
+        return x;
+    }
+    const auto truncated = static_cast<float>(static_cast<std::int32_t>(x));
+    return truncated > x ? truncated - 1.0F : truncated;
+}
+
+/// How much wider than the last query's spread the first limit of a selection is (Selection):
+/// wide enough that a second look is rare, narrow enough that few points are sorted.
+constexpr float spread_margin = 1.25F;
+
 } // namespace
 
 /// The points of some cells within a distance of the query, then the k nearest of them.
@@ -85,8 +120,13 @@ public:
             const __m128 dx = _mm_sub_ps(_mm_load_ps(xs + s), qx);
             const __m128 dy = _mm_sub_ps(_mm_load_ps(ys + s), qy);
             const __m128 dz = _mm_sub_ps(_mm_load_ps(zs + s), qz);
-            const __m128 d2 =
-                _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+            __m128 xx = _mm_mul_ps(dx, dx);
+            __m128 yy = _mm_mul_ps(dy, dy);
+            __m128 zz = _mm_mul_ps(dz, dz);
+            PF_GRID_UNFUSED(xx);
+            PF_GRID_UNFUSED(yy);
+            PF_GRID_UNFUSED(zz);
+            const __m128 d2 = _mm_add_ps(_mm_add_ps(xx, yy), zz);
             auto inside = static_cast<unsigned>(_mm_movemask_ps(_mm_cmple_ps(d2, reach2)));
             if (inside == 0)
             {
@@ -106,7 +146,13 @@ public:
             const float dx = xs[s] - q.x();
             const float dy = ys[s] - q.y();
             const float dz = zs[s] - q.z();
-            const float d2 = dx * dx + dy * dy + dz * dz;
+            float xx = dx * dx;
+            float yy = dy * dy;
+            float zz = dz * dz;
+            PF_GRID_UNFUSED(xx);
+            PF_GRID_UNFUSED(yy);
+            PF_GRID_UNFUSED(zz);
+            const float d2 = xx + yy + zz;
             key_[count_] = key_of(std::bit_cast<std::uint32_t>(d2), s);
             count_ += d2 <= reach2_ ? 1U : 0U;
         }
@@ -162,6 +208,398 @@ private:
     bool overflow_ = false;
     std::array<std::uint64_t, capacity> key_;
 };
+
+#if PF_GRID_AVX2
+
+namespace {
+
+/// The k smallest of keys[0, count) (k <= count), smallest first, as slots and squared distances.
+void take_smallest(std::uint64_t* keys, std::size_t count, std::size_t k, std::uint32_t* slots,
+                   float* d2)
+{
+    // Insertion into the sorted first k; later candidates mostly fail the first comparison.
+    for (std::size_t i = 1; i < count; ++i)
+    {
+        const std::uint64_t key = keys[i];
+        if (i >= k && key >= keys[k - 1])
+        {
+            continue;
+        }
+        std::size_t j = std::min(i, k - 1);
+        for (; j > 0 && key < keys[j - 1]; --j)
+        {
+            keys[j] = keys[j - 1];
+        }
+        keys[j] = key;
+    }
+    for (std::size_t j = 0; j < k; ++j)
+    {
+        slots[j] = static_cast<std::uint32_t>(keys[j]);
+        d2[j] = std::bit_cast<float>(static_cast<std::uint32_t>(keys[j] >> 32U));
+    }
+}
+
+/// For each 8-bit mask, the lanes set, in order, as 4-bit fields (a permutation that packs them
+/// to the front).
+constexpr std::array<std::uint32_t, 256> packing = [] {
+    std::array<std::uint32_t, 256> table{};
+    for (std::uint32_t mask = 0; mask < 256; ++mask)
+    {
+        std::uint32_t fields = 0;
+        std::uint32_t at = 0;
+        for (std::uint32_t lane = 0; lane < 8; ++lane)
+        {
+            if (((mask >> lane) & 1U) != 0)
+            {
+                fields |= lane << (4U * at++);
+            }
+        }
+        table[mask] = fields;
+    }
+    return table;
+}();
+
+bool has_avx2()
+{
+    static const bool supported = [] {
+        __builtin_cpu_init();
+        return __builtin_cpu_supports("avx2") != 0;
+    }();
+    return supported;
+}
+
+/// (x − q)² + (y − q)² + (z − q)² of eight points, rounded as Within's four.
+__attribute__((target("avx2"))) __m256 squared_distances_avx2(const float* xs, const float* ys,
+                                                              const float* zs, __m256 qx, __m256 qy,
+                                                              __m256 qz)
+{
+    const __m256 dx = _mm256_sub_ps(_mm256_loadu_ps(xs), qx);
+    const __m256 dy = _mm256_sub_ps(_mm256_loadu_ps(ys), qy);
+    const __m256 dz = _mm256_sub_ps(_mm256_loadu_ps(zs), qz);
+    __m256 xx = _mm256_mul_ps(dx, dx);
+    __m256 yy = _mm256_mul_ps(dy, dy);
+    __m256 zz = _mm256_mul_ps(dz, dz);
+    PF_GRID_UNFUSED(xx);
+    PF_GRID_UNFUSED(yy);
+    PF_GRID_UNFUSED(zz);
+    return _mm256_add_ps(_mm256_add_ps(xx, yy), zz);
+}
+
+__attribute__((target("avx2"))) float smallest_lane(__m256 v)
+{
+    __m128 low = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+    low = _mm_min_ps(low, _mm_movehl_ps(low, low));
+    low = _mm_min_ss(low, _mm_shuffle_ps(low, low, 1));
+    return _mm_cvtss_f32(low);
+}
+
+} // namespace
+
+/// One pass of knn_nearby() (the k nearest of the points of some cells within a reach) with
+/// AVX2, with the answer of Within (the k smallest keys of the points within the reach, or
+/// none if fewer than k are there or too many crowd in): every squared distance is computed
+/// once, with the nearest; then only the points within a limit are sorted, the nearest's
+/// distance plus about the last query's spread from its nearest to its k-th (widened while
+/// fewer than k are within it).
+class PointGrid::Selection
+{
+public:
+    enum class Outcome
+    {
+        found,
+        fewer,     ///< fewer than k within the reach
+        crowded,   ///< Within would overflow
+        too_large, ///< more points than the buffer holds: the caller asks Within
+    };
+
+    /// The points of an octant block (its eight cells' slots one after the other), gathered
+    /// into one run padded to whole vectors of eight with points at infinity.
+    struct Block
+    {
+        static constexpr std::size_t capacity = 256; ///< below Within's: never crowded
+        std::array<std::int64_t, 3> low{};
+        bool valid = false;
+        std::size_t count = 0;
+        alignas(32) std::array<float, capacity> xs;
+        alignas(32) std::array<float, capacity> ys;
+        alignas(32) std::array<float, capacity> zs;
+        alignas(32) std::array<std::uint32_t, capacity> slots;
+
+        /// \return false (and invalid) if the cells hold too many points
+        bool fill(const std::array<std::int64_t, 3>& block_low, std::span<const Range> ranges,
+                  const float* grid_xs, const float* grid_ys, const float* grid_zs)
+        {
+            low = block_low;
+            valid = false;
+            std::size_t total = 0;
+            for (const Range& range : ranges)
+            {
+                total += range.end - range.begin;
+            }
+            if (total > capacity)
+            {
+                return false;
+            }
+            count = 0;
+            for (const Range& range : ranges)
+            {
+                std::copy(grid_xs + range.begin, grid_xs + range.end, xs.data() + count);
+                std::copy(grid_ys + range.begin, grid_ys + range.end, ys.data() + count);
+                std::copy(grid_zs + range.begin, grid_zs + range.end, zs.data() + count);
+                std::iota(slots.data() + count, slots.data() + count + (range.end - range.begin),
+                          range.begin);
+                count += range.end - range.begin;
+            }
+            for (; count % 8 != 0; ++count)
+            {
+                xs[count] = ys[count] = zs[count] = std::numeric_limits<float>::infinity();
+                slots[count] = 0;
+            }
+            valid = true;
+            return true;
+        }
+    };
+
+    /// The pass over the points of `ranges`, in order.
+    /// \param spread2  the last query's k-th squared distance minus its nearest's (a guess that
+    ///                 only sets how many points are sorted; NaN or <= 0: unknown)
+    __attribute__((target("avx2,popcnt"))) Outcome run(std::span<const Range> ranges,
+                                                       const Vec3f& q, std::size_t k, float reach2,
+                                                       float spread2, const float* xs,
+                                                       const float* ys, const float* zs,
+                                                       std::uint32_t* slots, float* d2)
+    {
+        const __m256 qx = _mm256_set1_ps(q.x());
+        const __m256 qy = _mm256_set1_ps(q.y());
+        const __m256 qz = _mm256_set1_ps(q.z());
+        const __m256 reach = _mm256_set1_ps(reach2);
+        const __m256i lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+        __m256 nearest = _mm256_set1_ps(std::numeric_limits<float>::infinity());
+        std::size_t used = 0;
+        std::size_t within = 0;
+        for (const Range& range : ranges)
+        {
+            const std::uint32_t length = range.end - range.begin;
+            if (within + length > capacity)
+            {
+                return Outcome::crowded;
+            }
+            if (used + length > buffered)
+            {
+                return Outcome::too_large;
+            }
+            // Eight at a time; a last group of four reads four more (the arrays are padded),
+            // taken as infinitely far and then overwritten.
+            for (std::uint32_t s = range.begin; s < range.end; s += 8)
+            {
+                __m256 dist2 = squared_distances_avx2(xs + s, ys + s, zs + s, qx, qy, qz);
+                const bool four = range.end - s < 8;
+                if (four)
+                {
+                    dist2 = _mm256_blend_ps(
+                        dist2, _mm256_set1_ps(std::numeric_limits<float>::infinity()), 0xF0);
+                }
+                _mm256_storeu_ps(d2_.data() + used, dist2);
+                _mm256_storeu_si256(
+                    reinterpret_cast<__m256i*>(slot_.data() + used),
+                    _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(s)), lanes));
+                nearest = _mm256_min_ps(nearest, dist2);
+                within += static_cast<std::size_t>(std::popcount(static_cast<unsigned>(
+                    _mm256_movemask_ps(_mm256_cmp_ps(dist2, reach, _CMP_LE_OQ)))));
+                used += four ? 4U : 8U;
+            }
+        }
+        if (within < k)
+        {
+            return Outcome::fewer;
+        }
+        return pick(used, slot_.data(), smallest_lane(nearest), k, reach2, spread2, slots, d2);
+    }
+
+    /// run() over an octant block's cells gathered in `block`.
+    __attribute__((target("avx2,popcnt"))) Outcome run(const Block& block, const Vec3f& q,
+                                                       std::size_t k, float reach2, float spread2,
+                                                       std::uint32_t* slots, float* d2)
+    {
+        const __m256 qx = _mm256_set1_ps(q.x());
+        const __m256 qy = _mm256_set1_ps(q.y());
+        const __m256 qz = _mm256_set1_ps(q.z());
+        const __m256 reach = _mm256_set1_ps(reach2);
+        __m256 nearest = _mm256_set1_ps(std::numeric_limits<float>::infinity());
+        std::size_t within = 0;
+        for (std::size_t i = 0; i < block.count; i += 8)
+        {
+            const __m256 dist2 = squared_distances_avx2(block.xs.data() + i, block.ys.data() + i,
+                                                        block.zs.data() + i, qx, qy, qz);
+            _mm256_storeu_ps(d2_.data() + i, dist2);
+            nearest = _mm256_min_ps(nearest, dist2);
+            within += static_cast<std::size_t>(std::popcount(static_cast<unsigned>(
+                _mm256_movemask_ps(_mm256_cmp_ps(dist2, reach, _CMP_LE_OQ)))));
+        }
+        if (within < k)
+        {
+            return Outcome::fewer;
+        }
+        return pick(block.count, block.slots.data(), smallest_lane(nearest), k, reach2, spread2,
+                    slots, d2);
+    }
+
+private:
+    /// The k smallest keys of the `used` buffered points within the reach (k of them at least),
+    /// whose slots are `slot_of`, given the smallest squared distance.
+    __attribute__((target("avx2,popcnt"))) Outcome pick(std::size_t used,
+                                                        const std::uint32_t* slot_of, float nearest,
+                                                        std::size_t k, float reach2, float spread2,
+                                                        std::uint32_t* slots, float* d2)
+    {
+        if (k == 1)
+        {
+            slots[0] = first_at(used, slot_of, nearest);
+            d2[0] = nearest;
+            return Outcome::found;
+        }
+        const float guess = nearest + spread2 * spread_margin;
+        float limit2 = guess > nearest && guess < reach2 ? guess : reach2;
+        while (true)
+        {
+            const std::size_t kept = gather(used, slot_of, limit2);
+            if (kept >= k)
+            {
+                if (kept <= max_ranked)
+                {
+                    rank_smallest(kept, k, slots, d2);
+                }
+                else
+                {
+                    take_smallest(keys_.data(), kept, k, slots, d2);
+                }
+                return Outcome::found;
+            }
+            // Fewer than k within the limit (so it is below the reach): twice as wide.
+            const float wider = nearest + 2.0F * (limit2 - nearest);
+            limit2 = wider > limit2 && wider < reach2 ? wider : reach2;
+        }
+    }
+
+    /// The first slot of the buffered points at `distance2`.
+    __attribute__((target("avx2"))) std::uint32_t first_at(std::size_t used,
+                                                           const std::uint32_t* slot_of,
+                                                           float distance2) const
+    {
+        const __m256 at = _mm256_set1_ps(distance2);
+        std::uint32_t first = std::numeric_limits<std::uint32_t>::max();
+        for (std::size_t i = 0; i < used; i += 8)
+        {
+            auto equal = static_cast<unsigned>(
+                _mm256_movemask_ps(_mm256_cmp_ps(_mm256_loadu_ps(d2_.data() + i), at, _CMP_EQ_OQ)));
+            if (used - i < 8)
+            {
+                equal &= 0x0FU;
+            }
+            for (; equal != 0; equal &= equal - 1)
+            {
+                first =
+                    std::min(first, slot_of[i + static_cast<std::size_t>(std::countr_zero(equal))]);
+            }
+        }
+        return first;
+    }
+
+    /// The keys of the buffered points within the limit, in keys_; how many.
+    __attribute__((target("avx2,popcnt"))) std::size_t gather(std::size_t used,
+                                                              const std::uint32_t* slot_of,
+                                                              float limit2)
+    {
+        const __m256 limit = _mm256_set1_ps(limit2);
+        const __m256i shifts = _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28);
+        const __m256i seven = _mm256_set1_epi32(7);
+        std::size_t count = 0;
+        for (std::size_t i = 0; i < used; i += 8)
+        {
+            const __m256 dist2 = _mm256_loadu_ps(d2_.data() + i);
+            auto mask =
+                static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(dist2, limit, _CMP_LE_OQ)));
+            if (used - i < 8)
+            {
+                mask &= 0x0FU;
+            }
+            const __m256i order = _mm256_and_si256(
+                _mm256_srlv_epi32(_mm256_set1_epi32(static_cast<int>(packing[mask])), shifts),
+                seven);
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(packed_d2_.data() + count),
+                                _mm256_permutevar8x32_epi32(_mm256_castps_si256(dist2), order));
+            _mm256_storeu_si256(
+                reinterpret_cast<__m256i*>(packed_slot_.data() + count),
+                _mm256_permutevar8x32_epi32(
+                    _mm256_loadu_si256(reinterpret_cast<const __m256i*>(slot_of + i)), order));
+            count += static_cast<std::size_t>(std::popcount(mask));
+        }
+        for (std::size_t j = 0; j < count; ++j)
+        {
+            keys_[j] = key_of(packed_d2_[j], packed_slot_[j]);
+        }
+        return count;
+    }
+
+    /// take_smallest() of the first `count` keys (at most max_ranked), by counting for each
+    /// how many are smaller (the keys differ: their slots do).
+    __attribute__((target("avx2"))) void rank_smallest(std::size_t count, std::size_t k,
+                                                       std::uint32_t* slots, float* d2)
+    {
+        // Keys are below 2^63 (squared distances are not negative), so signed comparisons
+        // order them; the padding is larger than all.
+        constexpr auto padding =
+            static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
+        const std::size_t vectors = (count + 3) / 4;
+        for (std::size_t i = count; i < 4 * vectors; ++i)
+        {
+            keys_[i] = padding;
+        }
+        __m256i keys[max_ranked / 4]; // NOLINT(*-avoid-c-arrays): std::array drops the
+                                      // vector type's attributes
+        for (std::size_t v = 0; v < vectors; ++v)
+        {
+            keys[v] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(keys_.data() + 4 * v));
+        }
+        for (std::size_t i = 0; i < count; ++i)
+        {
+            const std::uint64_t key = keys_[i];
+            const __m256i probe = _mm256_set1_epi64x(static_cast<long long>(key));
+            __m256i smaller = _mm256_setzero_si256();
+            for (std::size_t v = 0; v < vectors; ++v)
+            {
+                smaller = _mm256_sub_epi64(smaller, _mm256_cmpgt_epi64(probe, keys[v]));
+            }
+            const __m128i half = _mm_add_epi64(_mm256_castsi256_si128(smaller),
+                                               _mm256_extracti128_si256(smaller, 1));
+            const auto rank = static_cast<std::size_t>(
+                _mm_cvtsi128_si64(_mm_add_epi64(half, _mm_unpackhi_epi64(half, half))));
+            if (rank < k)
+            {
+                slots[rank] = static_cast<std::uint32_t>(key);
+                d2[rank] = std::bit_cast<float>(static_cast<std::uint32_t>(key >> 32U));
+            }
+        }
+    }
+
+    /// As Within's keys.
+    static std::uint64_t key_of(std::uint32_t d2_bits, std::uint32_t slot)
+    {
+        return (std::uint64_t{d2_bits} << 32U) | slot;
+    }
+
+    static constexpr std::size_t capacity = 1024; ///< Within's
+    static constexpr std::size_t buffered = 2048;
+    static constexpr std::size_t max_ranked = 24;
+    /// Every point's squared distance and slot (+ 8: the loops write whole vectors).
+    std::array<float, buffered + 8> d2_;
+    std::array<std::uint32_t, buffered + 8> slot_;
+    std::array<std::uint32_t, capacity + 8> packed_d2_;
+    std::array<std::uint32_t, capacity + 8> packed_slot_;
+    std::array<std::uint64_t, capacity + 8> keys_; ///< + 8: rank_smallest() pads them
+};
+
+#endif // PF_GRID_AVX2
 
 /// The cells of the octant block that a thread searched last, and in which grid.
 struct PointGrid::OctantCache
@@ -245,9 +683,10 @@ PointGrid::PointGrid(std::span<const Vec3f> points, float cell, const KdTree& fa
     constexpr float far = std::numeric_limits<float>::infinity();
     order_.assign(slots, padding_slot);
     slot_of_.resize(n);
-    xs_.assign(slots, far);
-    ys_.assign(slots, far);
-    zs_.assign(slots, far);
+    // Four more at the end: Selection reads whole vectors of eight.
+    xs_.assign(slots + group, far);
+    ys_.assign(slots + group, far);
+    zs_.assign(slots + group, far);
     std::size_t next = 0;
     for (const auto& [key, range] : cells)
     {
@@ -301,6 +740,31 @@ PointGrid::Range PointGrid::cell_range(std::int64_t x, std::int64_t y, std::int6
     }
 }
 
+bool PointGrid::placed(const Vec3f& query, Placement& place) const
+{
+    place.octant_reach = std::numeric_limits<float>::max();
+    place.ring_reach = std::numeric_limits<float>::max();
+    for (Eigen::Index axis = 0; axis < 3; ++axis)
+    {
+        const float scaled = (query[axis] - min_[axis]) * inv_cell_;
+        const float floor = floor_of(scaled);
+        // Cells far outside the grid cannot be addressed (nor non-finite queries): those
+        // queries go to the kd-tree.
+        if (!std::isfinite(query[axis]) || !(std::abs(floor) < static_cast<float>(max_cells)))
+        {
+            return false;
+        }
+        const float frac = scaled - floor;
+        const auto a = static_cast<std::size_t>(axis);
+        place.cell[a] = static_cast<std::int64_t>(floor);
+        const bool lower = frac < 0.5F;
+        place.low[a] = lower ? place.cell[a] - 1 : place.cell[a];
+        place.octant_reach = std::min(place.octant_reach, lower ? 1.0F - frac : frac);
+        place.ring_reach = std::min(place.ring_reach, std::min(frac, 1.0F - frac));
+    }
+    return true;
+}
+
 std::size_t PointGrid::knn(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
                            std::span<float> squared_distances) const
 {
@@ -317,27 +781,14 @@ std::size_t PointGrid::knn_nearby(const Vec3f& query, std::size_t k, std::span<s
     {
         return 0;
     }
-    if (k <= max_k && query.allFinite())
+    Placement place;
+    if (k <= max_k && placed(query, place))
     {
-        const Vec3f scaled = (query - min_) * inv_cell_;
-        const Vec3f floor = scaled.array().floor().matrix();
-        const Vec3f frac = scaled - floor;
-        // Cells far outside the grid cannot be addressed; those queries go to the kd-tree.
-        if ((floor.array().abs() < static_cast<float>(max_cells)).all())
         {
-            std::array<std::int64_t, 3> c{};
-            std::array<std::int64_t, 3> low{}; // the octant block is low..low+1 on each axis
-            float octant_reach = std::numeric_limits<float>::max();
-            float ring_reach = std::numeric_limits<float>::max();
-            for (std::size_t a = 0; a < 3; ++a)
-            {
-                const auto axis = static_cast<Eigen::Index>(a);
-                c[a] = static_cast<std::int64_t>(floor[axis]);
-                const bool lower = frac[axis] < 0.5F;
-                low[a] = lower ? c[a] - 1 : c[a];
-                octant_reach = std::min(octant_reach, lower ? 1.0F - frac[axis] : frac[axis]);
-                ring_reach = std::min(ring_reach, std::min(frac[axis], 1.0F - frac[axis]));
-            }
+            const std::array<std::int64_t, 3>& c = place.cell;
+            const std::array<std::int64_t, 3>& low = place.low;
+            const float octant_reach = place.octant_reach;
+            const float ring_reach = place.ring_reach;
             // First the octant block, then the 3 × 3 × 3 block around the query's cell: each
             // keeps the points within the distance its cells guarantee, and succeeds when k
             // are there (every point outside is farther).
@@ -395,6 +846,172 @@ std::size_t PointGrid::knn_nearby(const Vec3f& query, std::size_t k, std::span<s
     }
 
     return 0;
+}
+
+void PointGrid::knn_nearby(std::span<const Vec3f> queries, std::size_t k,
+                           std::span<std::uint32_t> slots, std::span<float> squared_distances,
+                           std::span<std::uint32_t> found) const
+{
+    const std::size_t n = queries.size();
+    PF_ASSERT(found.size() >= n && slots.size() >= k * n && squared_distances.size() >= k * n);
+    const std::size_t want = std::min(k, count_);
+#if PF_GRID_AVX2
+    const bool wide = has_avx2();
+#else
+    const bool wide = false;
+#endif
+    if (n == 0)
+    {
+        return;
+    }
+    if (want == 0 || want > max_k || !wide)
+    {
+        for (std::size_t i = 0; i < n; ++i)
+        {
+            found[i] = static_cast<std::uint32_t>(knn_nearby(queries[i], k, slots.subspan(i * k, k),
+                                                             squared_distances.subspan(i * k, k)));
+        }
+        return;
+    }
+#if PF_GRID_AVX2
+    // Each query gets Within's answer for the same passes as knn_nearby() (the octant block
+    // with its reach, then the 3 × 3 × 3 block with its), only found faster (Selection), so the
+    // answers are the same whatever the order of the queries and the guesses.
+    // Runs of consecutive queries whose cells fit in a small table are looked up once.
+    constexpr std::size_t run = 32;
+    constexpr std::int64_t side = 6;
+    std::array<Placement, run> places;
+    std::array<bool, run> placed_ok{};
+    std::array<Range, side * side * side> table;
+    std::array<std::uint8_t, side * side * side> known{};
+    std::array<std::int64_t, 3> origin{};
+    bool coherent = false;
+    const auto range_at = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+        if (!coherent)
+        {
+            return cell_range(x, y, z);
+        }
+        const auto at = static_cast<std::size_t>(((z - origin[2]) * side + (y - origin[1])) * side +
+                                                 (x - origin[0]));
+        if (known[at] == 0)
+        {
+            table[at] = cell_range(x, y, z);
+            known[at] = 1;
+        }
+        return table[at];
+    };
+    auto selection = std::make_unique_for_overwrite<Selection>();
+    // Coherent queries come back to a few octant blocks: the last few are kept gathered
+    // (direct-mapped by their position).
+    auto block_store = std::make_unique_for_overwrite<std::array<Selection::Block, 8>>();
+    std::array<Selection::Block, 8>& blocks = *block_store;
+    for (Selection::Block& block : blocks)
+    {
+        block.valid = false;
+    }
+    std::array<Range, 27> ranges;
+    // The last query's k-th squared distance minus its nearest's: about the next one's.
+    float spread2 = std::numeric_limits<float>::quiet_NaN();
+    for (std::size_t start = 0; start < n; start += run)
+    {
+        const std::size_t end = std::min(n, start + run);
+        std::array<std::int64_t, 3> lo{};
+        std::array<std::int64_t, 3> hi{};
+        lo.fill(std::numeric_limits<std::int64_t>::max());
+        hi.fill(std::numeric_limits<std::int64_t>::min());
+        for (std::size_t i = start; i < end; ++i)
+        {
+            Placement& place = places[i - start];
+            placed_ok[i - start] = placed(queries[i], place);
+            if (placed_ok[i - start])
+            {
+                for (std::size_t a = 0; a < 3; ++a)
+                {
+                    lo[a] = std::min(lo[a], place.cell[a]);
+                    hi[a] = std::max(hi[a], place.cell[a]);
+                }
+            }
+        }
+        coherent = true;
+        for (std::size_t a = 0; a < 3; ++a)
+        {
+            coherent = coherent && hi[a] >= lo[a] && hi[a] - lo[a] + 3 <= side;
+            origin[a] = lo[a] - 1;
+        }
+        if (coherent)
+        {
+            known.fill(0);
+        }
+        for (std::size_t i = start; i < end; ++i)
+        {
+            found[i] = 0;
+            if (!placed_ok[i - start])
+            {
+                continue;
+            }
+            const Placement& place = places[i - start];
+            const Vec3f& query = queries[i];
+            std::uint32_t* slot = slots.data() + i * k;
+            float* d2 = squared_distances.data() + i * k;
+            const auto octant_cells = [&] {
+                for (std::size_t j = 0; j < 8; ++j)
+                {
+                    ranges[j] = range_at(place.low[0] + static_cast<std::int64_t>(j & 1U),
+                                         place.low[1] + static_cast<std::int64_t>((j >> 1U) & 1U),
+                                         place.low[2] + static_cast<std::int64_t>((j >> 2U) & 1U));
+                }
+                return std::span<const Range>(ranges.data(), 8);
+            };
+            const float octant = place.octant_reach * cell_;
+            Selection::Block* block = nullptr;
+            if (coherent)
+            {
+                block = &blocks[static_cast<std::size_t>(
+                    (place.low[0] + 3 * place.low[1] + 5 * place.low[2]) & 7)];
+                if ((!block->valid || block->low != place.low) &&
+                    !block->fill(place.low, octant_cells(), xs_.data(), ys_.data(), zs_.data()))
+                {
+                    block = nullptr;
+                }
+            }
+            auto outcome =
+                block != nullptr
+                    ? selection->run(*block, query, want, octant * octant, spread2, slot, d2)
+                    : selection->run(octant_cells(), query, want, octant * octant, spread2,
+                                     xs_.data(), ys_.data(), zs_.data(), slot, d2);
+            if (outcome == Selection::Outcome::fewer)
+            {
+                std::size_t j = 0;
+                for (std::int64_t z = place.cell[2] - 1; z <= place.cell[2] + 1; ++z)
+                {
+                    for (std::int64_t y = place.cell[1] - 1; y <= place.cell[1] + 1; ++y)
+                    {
+                        for (std::int64_t x = place.cell[0] - 1; x <= place.cell[0] + 1; ++x)
+                        {
+                            ranges[j++] = range_at(x, y, z);
+                        }
+                    }
+                }
+                const float ring = (1.0F + place.ring_reach) * cell_;
+                outcome = selection->run(ranges, query, want, ring * ring, spread2, xs_.data(),
+                                         ys_.data(), zs_.data(), slot, d2);
+            }
+            if (outcome == Selection::Outcome::too_large)
+            {
+                found[i] = static_cast<std::uint32_t>(
+                    knn_nearby(query, k, std::span(slot, k), std::span(d2, k)));
+            }
+            else if (outcome == Selection::Outcome::found)
+            {
+                found[i] = static_cast<std::uint32_t>(want);
+            }
+            if (found[i] != 0)
+            {
+                spread2 = d2[want - 1] - d2[0];
+            }
+        }
+    }
+#endif
 }
 
 std::size_t PointGrid::knn_far(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,

@@ -6,11 +6,14 @@
 #include "pointform/core/error.h"
 #include "pointform/geometry/shapes.h"
 #include "pointform/spatial/kd_tree.h"
+#include "pointform/spatial/spatial_sort.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
+#include <bit>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -141,6 +144,144 @@ TEST(PointGrid, FarOutlierGrowsTheCellsButStaysExact)
     {
         expect_exact(grid, cloud.positions, q, 4);
     }
+}
+
+/// The batch knn_nearby() against one query at a time: the same count, slots and distance bits.
+/// \return how many queries the grid answered
+std::size_t expect_batch_as_single(const PointGrid& grid, std::span<const Vec3f> queries,
+                                   std::size_t k)
+{
+    std::vector<std::uint32_t> slots(queries.size() * k);
+    std::vector<float> d2(queries.size() * k);
+    std::vector<std::uint32_t> found(queries.size());
+    grid.knn_nearby(queries, k, slots, d2, found);
+    std::vector<std::uint32_t> single_slots(k);
+    std::vector<float> single_d2(k);
+    std::size_t answered = 0;
+    for (std::size_t i = 0; i < queries.size(); ++i)
+    {
+        const std::size_t single = grid.knn_nearby(queries[i], k, single_slots, single_d2);
+        EXPECT_EQ(found[i], single) << "query " << i << " k " << k;
+        if (found[i] != single)
+        {
+            return answered;
+        }
+        answered += single > 0 ? 1 : 0;
+        for (std::size_t j = 0; j < single; ++j)
+        {
+            EXPECT_EQ(slots[i * k + j], single_slots[j]) << "query " << i << " k " << k;
+            EXPECT_EQ(std::bit_cast<std::uint32_t>(d2[i * k + j]),
+                      std::bit_cast<std::uint32_t>(single_d2[j]))
+                << "query " << i << " k " << k;
+        }
+    }
+    return answered;
+}
+
+TEST(PointGrid, BatchAnswersAsOneByOneInAnyOrder)
+{
+    // A sphere with a cell as a point field chooses it, queried within a few cells of the
+    // surface (some beyond, for the 3 × 3 × 3 pass and none), in Morton order (coherent runs)
+    // and at random, for k from 1 to beyond the grid's limit.
+    const PointCloud cloud = sample_shape(Shape::Sphere, {.count = 20000, .seed = 4});
+    const KdTree tree(cloud.positions);
+    std::vector<std::uint32_t> index(9);
+    std::vector<float> d2(9);
+    tree.knn(cloud.positions[0], 9, index, d2);
+    const float cell = 2.5F * std::sqrt(d2[8]);
+    const PointGrid grid(cloud.positions, cell, tree);
+    std::mt19937_64 rng(12);
+    std::normal_distribution<float> gauss;
+    std::uniform_real_distribution<float> shell(-1.5F * cell, 1.5F * cell);
+    std::vector<Vec3f> random(4000);
+    for (Vec3f& q : random)
+    {
+        q = Vec3f(gauss(rng), gauss(rng), gauss(rng)).normalized() * (1.0F + shell(rng));
+    }
+    const std::vector<std::uint32_t> order = spatial_order(random);
+    std::vector<Vec3f> coherent(random.size());
+    for (std::size_t i = 0; i < order.size(); ++i)
+    {
+        coherent[i] = random[order[i]];
+    }
+    for (const std::size_t k : {1U, 2U, 9U, 17U, 33U, 64U})
+    {
+        // Not a comparison of empty answers: for few neighbours the grid answers most of
+        // these queries, for many about half (the rest is the kd-tree's).
+        const std::size_t enough = k <= 17 ? random.size() * 2 / 3 : random.size() / 3;
+        EXPECT_GT(expect_batch_as_single(grid, coherent, k), enough) << "k " << k;
+        EXPECT_GT(expect_batch_as_single(grid, random, k), enough) << "k " << k;
+    }
+}
+
+TEST(PointGrid, BatchHandlesTiesCrowdsAndQueriesItCannotPlace)
+{
+    // A lattice (ties everywhere), with a pile of duplicates in one cell (more than a pass
+    // holds: none from the grid) and queries at lattice points, far away and not finite.
+    std::vector<Vec3f> points;
+    for (int z = 0; z < 8; ++z)
+    {
+        for (int y = 0; y < 8; ++y)
+        {
+            for (int x = 0; x < 8; ++x)
+            {
+                points.emplace_back(static_cast<float>(x), static_cast<float>(y),
+                                    static_cast<float>(z));
+            }
+        }
+    }
+    points.insert(points.end(), 1500, Vec3f(6.2F, 6.2F, 6.2F));
+    const KdTree tree(points);
+    const PointGrid grid(points, 1.5F, tree);
+    std::vector<Vec3f> queries;
+    for (float z = 0.0F; z <= 7.0F; z += 0.5F)
+    {
+        for (float y = 0.0F; y <= 7.0F; y += 0.5F)
+        {
+            for (float x = 0.0F; x <= 7.0F; x += 0.5F)
+            {
+                queries.emplace_back(x, y, z);
+            }
+        }
+    }
+    queries.emplace_back(1e9F, 0.0F, 0.0F);
+    queries.emplace_back(std::numeric_limits<float>::quiet_NaN(), 1.0F, 1.0F);
+    queries.emplace_back(1.0F, std::numeric_limits<float>::infinity(), 1.0F);
+    queries.emplace_back(6.2F, 6.2F, 6.2F);
+    for (const std::size_t k : {1U, 8U, 27U})
+    {
+        EXPECT_GT(expect_batch_as_single(grid, queries, k), queries.size() / 10) << "k " << k;
+    }
+    // The crowd: one by one and together, none.
+    std::array<std::uint32_t, 8> slots{};
+    std::array<float, 8> d2{};
+    EXPECT_EQ(grid.knn_nearby(Vec3f(6.2F, 6.2F, 6.2F), 8, slots, d2), 0U);
+}
+
+TEST(PointGrid, BatchOfNothingAndOfAnEmptyGrid)
+{
+    const std::vector<Vec3f> points = {Vec3f(0, 0, 0), Vec3f(1, 0, 0)};
+    const KdTree tree(points);
+    const PointGrid grid(points, 2.0F, tree);
+    std::vector<std::uint32_t> found(2, 7U);
+    std::vector<std::uint32_t> slots(6);
+    std::vector<float> d2(6);
+    grid.knn_nearby(std::span<const Vec3f>(), 3, slots, d2, std::span<std::uint32_t>());
+    const std::vector<Vec3f> queries = {Vec3f(0.1F, 0, 0), Vec3f(0.9F, 0, 0)};
+    grid.knn_nearby(queries, 3, slots, d2, found); // k beyond the count: both points
+    EXPECT_EQ(found[0], 2U);
+    EXPECT_EQ(grid.original_index(slots[0]), 0U);
+    EXPECT_EQ(grid.original_index(slots[3]), 1U);
+    grid.knn_nearby(queries, 0, slots, d2, found);
+    EXPECT_EQ(found[0], 0U);
+
+    const std::vector<Vec3f> none;
+    const KdTree empty_tree(none);
+    const PointGrid empty(none, 1.0F, empty_tree);
+    found.assign(2, 7U);
+    empty.knn_nearby(queries, 3, slots, d2, found);
+    EXPECT_EQ(found[0], 0U);
+    EXPECT_EQ(found[1], 0U);
 }
 
 } // namespace

@@ -101,7 +101,10 @@ public:
     ~PointField() override;
 
     [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override;
-    using Field::evaluate;
+    /// \brief The same values as evaluate() per point (bit for bit, whatever the thread
+    /// count), faster: the point grid answers each block of consecutive queries together, which
+    /// pays where they are coherent (as marching cubes and refinement ask).
+    void evaluate(std::span<const Vec3d> points, std::span<FieldSample> out) const override;
     [[nodiscard]] Aabb bounds() const override;
     void append_seeds(std::vector<Vec3d>& seeds) const override;
 

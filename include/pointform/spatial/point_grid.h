@@ -5,6 +5,7 @@
 
 #include "pointform/core/types.h"
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -47,6 +48,19 @@ public:
     std::size_t knn_nearby(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
                            std::span<float> squared_distances) const;
 
+    /// \brief knn_nearby() for many queries at once: query i's answer (the same neighbours, in
+    /// the same order, with the same distances, bit for bit) goes to found[i] (the count, or 0)
+    /// and to slots and squared_distances from i · k on.
+    ///
+    /// Faster where consecutive queries are close to each other (as in Morton order): the cells
+    /// around a run of them are looked up once, an octant block's points are gathered once for
+    /// the queries that share it, and each query sorts only the points within its nearest's
+    /// distance plus about the previous query's spread to its k-th (widened while fewer than k
+    /// are there) instead of all those within the reach. Uses AVX2 where the CPU has it.
+    /// \param slots, squared_distances  caller buffers of size >= k · queries.size()
+    void knn_nearby(std::span<const Vec3f> queries, std::size_t k, std::span<std::uint32_t> slots,
+                    std::span<float> squared_distances, std::span<std::uint32_t> found) const;
+
     /// \brief The slot of an original point index.
     [[nodiscard]] std::uint32_t slot_of(std::uint32_t index) const { return slot_of_[index]; }
     [[nodiscard]] std::uint32_t original_index(std::uint32_t slot) const { return order_[slot]; }
@@ -70,7 +84,21 @@ private:
         Range range;
     };
     class Within;
+    class Selection;
     struct OctantCache;
+    /// Where a query falls: its cell, its octant block (the 2 × 2 × 2 cells from low to low + 1
+    /// on each axis) and, in cells, the distance within which every point is in the octant
+    /// block (octant_reach), and in the 3 × 3 × 3 block around the cell, minus 1 (ring_reach).
+    struct Placement
+    {
+        std::array<std::int64_t, 3> cell{};
+        std::array<std::int64_t, 3> low{};
+        float octant_reach = 0.0F;
+        float ring_reach = 0.0F;
+    };
+
+    /// \return false for queries that no cell can answer (non-finite, or too far out)
+    [[nodiscard]] bool placed(const Vec3f& query, Placement& place) const;
 
     std::size_t knn_far(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
                         std::span<float> squared_distances) const;
