@@ -6,19 +6,42 @@
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 
+#include <limits>
+#include <vector>
+
 namespace pointform {
 
 Field::~Field() = default;
 
 void Field::evaluate(std::span<const Vec3d> points, std::span<FieldSample> out) const
 {
+    // Through the batch evaluate_within(), which operators answer member by member.
     PF_ASSERT(points.size() == out.size());
+    const std::vector<double> lo(points.size(), -std::numeric_limits<double>::infinity());
+    const std::vector<double> hi(points.size(), std::numeric_limits<double>::infinity());
+    evaluate_within(points, lo, hi, out);
+}
+
+FieldSample Field::evaluate_within(const Vec3d& p, double /*lo*/, double /*hi*/) const
+{
+    return evaluate(p);
+}
+
+void Field::evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
+                            std::span<const double> hi, std::span<FieldSample> out) const
+{
+    PF_ASSERT(points.size() == out.size() && lo.size() == out.size() && hi.size() == out.size());
     parallel_blocks(points.size(), 1024, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
         {
-            out[i] = evaluate(points[i]);
+            out[i] = evaluate_within(points[i], lo[i], hi[i]);
         }
     });
+}
+
+double Field::cost() const
+{
+    return 1.0;
 }
 
 void Field::append_seeds(std::vector<Vec3d>& /*seeds*/) const {}

@@ -4,18 +4,54 @@
 #include "pointform/implicit/operators.h"
 
 #include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <string>
+#include <tuple>
 #include <utility>
+#include <vector>
 
 namespace pointform {
 namespace {
 
 using FieldPtr = std::shared_ptr<const Field>;
+
+constexpr double infinity = std::numeric_limits<double>::infinity();
+
+/// Points per block of an operator's batch evaluation: its members answer each block together.
+constexpr std::size_t operator_block = 1024;
+
+/// An operator's cost: its members' and its own.
+double summed_cost(std::span<const FieldPtr> members)
+{
+    double sum = 1.0;
+    for (const FieldPtr& m : members)
+    {
+        sum += m->cost();
+    }
+    return sum;
+}
+
+/// [lo, hi] moved by `shift` and widened by a few rounding errors, so that a member's value that
+/// the operator's rounding puts within the operator's range is within the member's.
+std::pair<double, double> shifted_range(double lo, double hi, double shift)
+{
+    const auto moved = [shift](double x, double direction) {
+        if (!std::isfinite(x))
+        {
+            return x;
+        }
+        const double y = x + shift;
+        return y + direction * 4.0 * std::numeric_limits<double>::epsilon() *
+                       (std::abs(y) + std::abs(shift) + std::abs(x));
+    };
+    return {moved(lo, -1.0), moved(hi, 1.0)};
+}
 
 void require_member(const FieldPtr& member, const char* what)
 {
@@ -79,6 +115,57 @@ Aabb grown(Aabb box, double margin)
         box.max += Vec3d::Constant(margin);
     }
     return box;
+}
+
+/// A one-member operator's batch evaluation: point i's member range is range(lo[i], hi[i]), its
+/// result finish(the member's sample), as one by one.
+template <class Range, class Finish>
+void unary_batch(const Field& member, std::span<const Vec3d> points, std::span<const double> lo,
+                 std::span<const double> hi, std::span<FieldSample> out, const Range& range,
+                 const Finish& finish)
+{
+    PF_ASSERT(points.size() == out.size() && lo.size() == out.size() && hi.size() == out.size());
+    parallel_blocks(points.size(), operator_block, [&](std::size_t begin, std::size_t end) {
+        const std::size_t n = end - begin;
+        std::vector<double> member_lo(n);
+        std::vector<double> member_hi(n);
+        std::vector<FieldSample> samples(n);
+        for (std::size_t j = 0; j < n; ++j)
+        {
+            std::tie(member_lo[j], member_hi[j]) = range(lo[begin + j], hi[begin + j]);
+        }
+        member.evaluate_within(points.subspan(begin, n), member_lo, member_hi, samples);
+        for (std::size_t j = 0; j < n; ++j)
+        {
+            out[begin + j] = finish(samples[j]);
+        }
+    });
+}
+
+FieldSample offset_of(FieldSample s, double distance, UndefinedPolicy policy)
+{
+    s.defined = usable(s, policy);
+    s.value -= distance;
+    return s;
+}
+
+/// |f| − t/2 ≤ hi needs |f| ≤ hi + t/2; nothing is below −t/2, so `lo` bounds nothing.
+std::pair<double, double> shell_range(double lo, double hi, double thickness)
+{
+    const double reach = shifted_range(lo, hi, 0.5 * thickness).second;
+    return {-reach, reach};
+}
+
+FieldSample shell_of(FieldSample s, double thickness, UndefinedPolicy policy)
+{
+    s.defined = usable(s, policy);
+    if (s.value < 0.0)
+    {
+        s.value = -s.value;
+        s.gradient = -s.gradient;
+    }
+    s.value -= 0.5 * thickness;
+    return s;
 }
 
 /// Newton steps p ← p − f(p)·∇f/‖∇f‖² on seeds[first..], each step at most `max_step` long,
@@ -155,39 +242,124 @@ BooleanField::BooleanField(BooleanOp op, std::vector<FieldPtr> members)
                        : op == BooleanOp::Intersection ? "intersection"
                                                        : "difference";
     require_members(members_, op == BooleanOp::Difference ? 2 : 1, name);
+    order_.resize(members_.size());
+    std::iota(order_.begin(), order_.end(), std::size_t{0});
+    std::stable_sort(order_.begin(), order_.end(), [this](std::size_t i, std::size_t j) {
+        return members_[i]->cost() < members_[j]->cost();
+    });
 }
 
 FieldSample BooleanField::evaluate(const Vec3d& p) const
 {
-    FieldSample best = members_.front()->evaluate(p);
-    for (std::size_t i = 1; i < members_.size(); ++i)
+    return evaluate_within(p, -infinity, infinity);
+}
+
+/// One point's Boolean as a minimum of g_i = s_i f_i: union s_i = 1; intersection s_i = −1
+/// (max f = −min −f); difference −1 for the first member, 1 for the rest
+/// (max(f_0, −f_i) = −min(−f_0, f_i)). The result is ±min g_i (+ for union), in [lo, hi] where
+/// min g_i is in [g_lo, g_hi]. Member i decides only if g_i ≤ the smallest so far (ties go to
+/// the earlier member, hence closed ranges), and matters exactly only within [g_lo, g_hi].
+class BooleanField::Minimum
+{
+public:
+    Minimum(BooleanOp op, std::size_t members, double lo, double hi)
+        : op_(op),
+          g_lo_(op == BooleanOp::Union ? lo : -hi),
+          g_hi_(op == BooleanOp::Union ? hi : -lo),
+          none_(members),
+          best_index_(members)
+    {}
+
+    [[nodiscard]] double sign_of(std::size_t i) const
     {
-        FieldSample s = members_[i]->evaluate(p);
-        switch (op_)
+        return op_ == BooleanOp::Union || (op_ == BooleanOp::Difference && i > 0) ? 1.0 : -1.0;
+    }
+    /// The range to ask of member i.
+    [[nodiscard]] std::pair<double, double> range_of(std::size_t i) const
+    {
+        const double cap = std::min(g_hi_, best_g_);
+        return sign_of(i) > 0.0 ? std::pair{g_lo_, cap} : std::pair{-cap, -g_lo_};
+    }
+    void take(std::size_t i, const FieldSample& s)
+    {
+        const double g = sign_of(i) * s.value;
+        if (g < best_g_ || (g == best_g_ && i < best_index_) || best_index_ == none_)
         {
-            case BooleanOp::Union:
-                if (s.value < best.value)
-                {
-                    best = s;
-                }
-                break;
-            case BooleanOp::Intersection:
-                if (s.value > best.value)
-                {
-                    best = s;
-                }
-                break;
-            case BooleanOp::Difference:
-                s.value = -s.value;
-                s.gradient = -s.gradient;
-                if (s.value > best.value)
-                {
-                    best = s;
-                }
-                break;
+            best_ = s;
+            best_g_ = g;
+            best_index_ = i;
         }
     }
-    return best;
+    /// The chosen member's sample, negated for the subtracted members of a difference.
+    [[nodiscard]] FieldSample result() const
+    {
+        FieldSample out = best_;
+        if (op_ == BooleanOp::Difference && best_index_ > 0)
+        {
+            out.value = -out.value;
+            out.gradient = -out.gradient;
+        }
+        return out;
+    }
+
+private:
+    BooleanOp op_;
+    double g_lo_;
+    double g_hi_;
+    std::size_t none_;
+    FieldSample best_;
+    double best_g_ = infinity;
+    std::size_t best_index_;
+};
+
+FieldSample BooleanField::evaluate_within(const Vec3d& p, double lo, double hi) const
+{
+    Minimum minimum(op_, members_.size(), lo, hi);
+    for (const std::size_t i : order_)
+    {
+        const auto [member_lo, member_hi] = minimum.range_of(i);
+        minimum.take(i, members_[i]->evaluate_within(p, member_lo, member_hi));
+    }
+    return minimum.result();
+}
+
+void BooleanField::evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
+                                   std::span<const double> hi, std::span<FieldSample> out) const
+{
+    PF_ASSERT(points.size() == out.size() && lo.size() == out.size() && hi.size() == out.size());
+    parallel_blocks(points.size(), operator_block, [&](std::size_t begin, std::size_t end) {
+        const std::size_t n = end - begin;
+        std::vector<Minimum> minima;
+        minima.reserve(n);
+        for (std::size_t j = begin; j < end; ++j)
+        {
+            minima.emplace_back(op_, members_.size(), lo[j], hi[j]);
+        }
+        std::vector<double> member_lo(n);
+        std::vector<double> member_hi(n);
+        std::vector<FieldSample> samples(n);
+        for (const std::size_t i : order_)
+        {
+            for (std::size_t j = 0; j < n; ++j)
+            {
+                std::tie(member_lo[j], member_hi[j]) = minima[j].range_of(i);
+            }
+            members_[i]->evaluate_within(points.subspan(begin, n), member_lo, member_hi, samples);
+            for (std::size_t j = 0; j < n; ++j)
+            {
+                minima[j].take(i, samples[j]);
+            }
+        }
+        for (std::size_t j = 0; j < n; ++j)
+        {
+            out[begin + j] = minima[j].result();
+        }
+    });
+}
+
+double BooleanField::cost() const
+{
+    return summed_cost(members_);
 }
 
 Aabb BooleanField::bounds() const
@@ -230,8 +402,34 @@ SmoothBooleanField::SmoothBooleanField(BooleanOp op, FieldPtr a, FieldPtr b, dou
 
 FieldSample SmoothBooleanField::evaluate(const Vec3d& p) const
 {
-    FieldSample sa = a_->evaluate(p);
-    FieldSample sb = b_->evaluate(p);
+    return evaluate_within(p, -infinity, infinity);
+}
+
+// As a smooth minimum of g_a = s_a f_a and g_b = s_b f_b (s = 1 for union; −1 for
+// intersection; difference: s_a = −1, s_b = 1), sign · (min − k h²/4) in [lo, hi] needs min in
+// [g_lo, g_hi + k/4], and both exactly where |g_a − g_b| < k: the cheaper member first within
+// [g_lo, g_hi + 5k/4], then the other also within k of the first.
+
+double SmoothBooleanField::sign_of(bool b) const
+{
+    const double sign = op_ == BooleanOp::Union ? 1.0 : -1.0;
+    return b && op_ == BooleanOp::Difference ? 1.0 : sign;
+}
+
+std::pair<double, double> SmoothBooleanField::range_of(bool b, double lo, double hi,
+                                                       const FieldSample* first) const
+{
+    const double g_lo = op_ == BooleanOp::Union ? lo : -hi;
+    double cap = (op_ == BooleanOp::Union ? hi : -lo) + 1.25 * radius_;
+    if (first != nullptr)
+    {
+        cap = std::min(cap, sign_of(!b) * first->value + radius_);
+    }
+    return sign_of(b) > 0.0 ? std::pair{g_lo, cap} : std::pair{-cap, -g_lo};
+}
+
+FieldSample SmoothBooleanField::combine(const FieldSample& sa, FieldSample sb) const
+{
     if (op_ == BooleanOp::Difference)
     {
         sb.value = -sb.value;
@@ -242,18 +440,69 @@ FieldSample SmoothBooleanField::evaluate(const Vec3d& p) const
     const double a = sign * sa.value;
     const double b = sign * sb.value;
     const bool a_smaller = a <= b;
-    const FieldSample& lo = a_smaller ? sa : sb;
-    const FieldSample& hi = a_smaller ? sb : sa;
+    const FieldSample& low = a_smaller ? sa : sb;
+    const FieldSample& high = a_smaller ? sb : sa;
     const double h = std::max(radius_ - std::abs(a - b), 0.0) / radius_;
     if (h <= 0.0)
     {
-        return lo;
+        return low;
     }
     FieldSample out;
-    out.value = lo.value - sign * 0.25 * radius_ * h * h;
-    out.gradient = (1.0 - 0.5 * h) * lo.gradient + 0.5 * h * hi.gradient;
+    out.value = low.value - sign * 0.25 * radius_ * h * h;
+    out.gradient = (1.0 - 0.5 * h) * low.gradient + 0.5 * h * high.gradient;
     out.defined = usable(sa, policy_) && usable(sb, policy_);
     return out;
+}
+
+FieldSample SmoothBooleanField::evaluate_within(const Vec3d& p, double lo, double hi) const
+{
+    const bool b_first = b_->cost() < a_->cost();
+    const Field& first = b_first ? *b_ : *a_;
+    const Field& second = b_first ? *a_ : *b_;
+    const auto [first_lo, first_hi] = range_of(b_first, lo, hi, nullptr);
+    const FieldSample f = first.evaluate_within(p, first_lo, first_hi);
+    const auto [second_lo, second_hi] = range_of(!b_first, lo, hi, &f);
+    const FieldSample g = second.evaluate_within(p, second_lo, second_hi);
+    return b_first ? combine(g, f) : combine(f, g);
+}
+
+void SmoothBooleanField::evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
+                                         std::span<const double> hi,
+                                         std::span<FieldSample> out) const
+{
+    PF_ASSERT(points.size() == out.size() && lo.size() == out.size() && hi.size() == out.size());
+    const bool b_first = b_->cost() < a_->cost();
+    const Field& first = b_first ? *b_ : *a_;
+    const Field& second = b_first ? *a_ : *b_;
+    parallel_blocks(points.size(), operator_block, [&](std::size_t begin, std::size_t end) {
+        const std::size_t n = end - begin;
+        const std::span<const Vec3d> block = points.subspan(begin, n);
+        std::vector<double> member_lo(n);
+        std::vector<double> member_hi(n);
+        std::vector<FieldSample> f(n);
+        std::vector<FieldSample> g(n);
+        for (std::size_t j = 0; j < n; ++j)
+        {
+            std::tie(member_lo[j], member_hi[j]) =
+                range_of(b_first, lo[begin + j], hi[begin + j], nullptr);
+        }
+        first.evaluate_within(block, member_lo, member_hi, f);
+        for (std::size_t j = 0; j < n; ++j)
+        {
+            std::tie(member_lo[j], member_hi[j]) =
+                range_of(!b_first, lo[begin + j], hi[begin + j], &f[j]);
+        }
+        second.evaluate_within(block, member_lo, member_hi, g);
+        for (std::size_t j = 0; j < n; ++j)
+        {
+            out[begin + j] = b_first ? combine(g[j], f[j]) : combine(f[j], g[j]);
+        }
+    });
+}
+
+double SmoothBooleanField::cost() const
+{
+    return 1.0 + a_->cost() + b_->cost();
 }
 
 Aabb SmoothBooleanField::bounds() const
@@ -403,6 +652,11 @@ FieldSample BlendField::evaluate(const Vec3d& p) const
     return out;
 }
 
+double BlendField::cost() const
+{
+    return summed_cost(members_);
+}
+
 Aabb BlendField::bounds() const
 {
     Aabb box;
@@ -441,10 +695,27 @@ OffsetField::OffsetField(FieldPtr member, double distance, UndefinedPolicy polic
 
 FieldSample OffsetField::evaluate(const Vec3d& p) const
 {
-    FieldSample s = member_->evaluate(p);
-    s.defined = usable(s, policy_);
-    s.value -= distance_;
-    return s;
+    return evaluate_within(p, -infinity, infinity);
+}
+
+FieldSample OffsetField::evaluate_within(const Vec3d& p, double lo, double hi) const
+{
+    const auto [member_lo, member_hi] = shifted_range(lo, hi, distance_);
+    return offset_of(member_->evaluate_within(p, member_lo, member_hi), distance_, policy_);
+}
+
+void OffsetField::evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
+                                  std::span<const double> hi, std::span<FieldSample> out) const
+{
+    unary_batch(
+        *member_, points, lo, hi, out,
+        [this](double l, double h) { return shifted_range(l, h, distance_); },
+        [this](const FieldSample& s) { return offset_of(s, distance_, policy_); });
+}
+
+double OffsetField::cost() const
+{
+    return 1.0 + member_->cost();
 }
 
 Aabb OffsetField::bounds() const
@@ -477,15 +748,27 @@ ShellField::ShellField(FieldPtr member, double thickness, UndefinedPolicy policy
 
 FieldSample ShellField::evaluate(const Vec3d& p) const
 {
-    FieldSample s = member_->evaluate(p);
-    s.defined = usable(s, policy_);
-    if (s.value < 0.0)
-    {
-        s.value = -s.value;
-        s.gradient = -s.gradient;
-    }
-    s.value -= 0.5 * thickness_;
-    return s;
+    return evaluate_within(p, -infinity, infinity);
+}
+
+FieldSample ShellField::evaluate_within(const Vec3d& p, double lo, double hi) const
+{
+    const auto [member_lo, member_hi] = shell_range(lo, hi, thickness_);
+    return shell_of(member_->evaluate_within(p, member_lo, member_hi), thickness_, policy_);
+}
+
+void ShellField::evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
+                                 std::span<const double> hi, std::span<FieldSample> out) const
+{
+    unary_batch(
+        *member_, points, lo, hi, out,
+        [this](double l, double h) { return shell_range(l, h, thickness_); },
+        [this](const FieldSample& s) { return shell_of(s, thickness_, policy_); });
+}
+
+double ShellField::cost() const
+{
+    return 1.0 + member_->cost();
 }
 
 Aabb ShellField::bounds() const
@@ -555,6 +838,11 @@ FieldSample MorphField::evaluate(const Vec3d& p) const
     return {.value = (1.0 - t_) * a.value + t_ * b.value,
             .gradient = (1.0 - t_) * a.gradient + t_ * b.gradient,
             .defined = usable(a, policy_) && usable(b, policy_)};
+}
+
+double MorphField::cost() const
+{
+    return 1.0 + from_->cost() + to_->cost();
 }
 
 Aabb MorphField::bounds() const

@@ -38,6 +38,9 @@ constexpr float grid_cell_scale = 2.5F;
 /// factor farther than the nearest (PointField).
 constexpr float far_distance_factor = 1.01F;
 
+/// A point field's evaluation against an analytic primitive's (Field::cost), roughly.
+constexpr double point_field_cost = 50.0;
+
 /// Nodes along the longest side of the far grid (PointField): at most 128³ ≈ 2.1M nodes, 16 MiB,
 /// built in about 0.1 s on one core (100k samples). Its spacing h follows the box, not the
 /// influence radii: inside values are within 2√3 h of the nearest distance, and the far grid
@@ -313,15 +316,118 @@ struct PointField::Impl
     /// The field at `p` (relative to the origin; `query` is it in floats) given what the point
     /// grid's knn_nearby() found there: `found` (0 if it was not asked) neighbours in `slot`
     /// and `dist2`, which have room for wanted() and may be overwritten.
-    [[nodiscard]] FieldSample evaluate_with(const Vec3d& p, const Vec3f& query,
-                                            const FarField* far_data, std::size_t found,
-                                            std::uint32_t* slot, float* dist2) const;
+    /// Above `hi`, a far value may be any bound above it (Field::evaluate_within).
+    [[nodiscard]] FieldSample evaluate_with(
+        const Vec3d& p, const Vec3f& query, const FarField* far_data, std::size_t found,
+        std::uint32_t* slot, float* dist2,
+        double hi = std::numeric_limits<double>::infinity()) const;
 
     /// The value at `p` (relative to the origin) where the far grid proves that no influence
     /// ball reaches and every candidate sample's surface puts `p` inside; false (and `out`
     /// untouched) otherwise.
     bool evaluate_deep_inside(const FarField& far_data, const Vec3d& p, FieldSample& out) const;
+
+    /// The value at `p` (relative to the origin) where the far grid proves that no influence
+    /// ball reaches and every candidate sample's surface puts `p` outside: the distance to a
+    /// nearly nearest sample, or a lower bound on it where that is above `hi`; false (and `out`
+    /// untouched) otherwise.
+    bool evaluate_far_outside(const FarField& far_data, const Vec3d& p, const Vec3f& query,
+                              double hi, FieldSample& out) const;
+
+    /// A sample at most far_distance_factor times as far from `p` as the nearest (its squared
+    /// distance to `dist2`), started from the nearest of the far grid's representatives around
+    /// `p` where there is a far grid.
+    [[nodiscard]] std::uint32_t nearly_nearest(const Vec3d& p, const Vec3f& query,
+                                               const FarField* far_data, float& dist2) const;
 };
+
+bool PointField::Impl::evaluate_far_outside(const FarField& far_data, const Vec3d& p,
+                                            const Vec3f& query, double hi, FieldSample& out) const
+{
+    // The cell at p, or beyond the grid's box at the nearest point of the box.
+    const Vec3d q = p.cwiseMax(local_box.min).cwiseMin(local_box.max);
+    const auto cell = far_data.grid.query(q);
+    if (!cell)
+    {
+        return false;
+    }
+    const double to_box = (p - p.cwiseMax(sample_box.min).cwiseMin(sample_box.max)).norm();
+    const double lower = std::max(to_box, cell->lower_bound - (p - q).norm());
+    const double reach = max_radius * static_cast<double>(far_distance_factor);
+    if (!(lower > reach))
+    {
+        return false;
+    }
+    // As deep inside (evaluate_deep_inside), the other way round.
+    std::uint32_t best = 0;
+    double best_d2 = std::numeric_limits<double>::infinity();
+    std::uint32_t checked = std::numeric_limits<std::uint32_t>::max();
+    for (const std::uint32_t index : cell->points)
+    {
+        if (index == checked)
+        {
+            continue;
+        }
+        checked = index;
+        const PackedSurfel& sample = packed[grid->slot_of(index)];
+        if (far_data.two_sided[index] != 0 || !(sample.distance(p, nullptr) > 0.0))
+        {
+            return false;
+        }
+        const double d2 = (p - sample.position.cast<double>()).squaredNorm();
+        if (d2 < best_d2 || (d2 == best_d2 && index < best))
+        {
+            best = index;
+            best_d2 = d2;
+        }
+    }
+    out.defined = false;
+    if (lower > hi)
+    {
+        out.value = lower;
+        out.gradient = packed[grid->slot_of(best)].normal.cast<double>();
+        return true;
+    }
+    std::uint32_t nearest = best;
+    if (blends(options.fit))
+    {
+        float d2 = 0.0F;
+        nearest = tree.nearest_within_factor(query, far_distance_factor, PointId{best}, &d2).value;
+    }
+    else
+    {
+        std::array<std::uint32_t, 1> index{};
+        std::array<float, 1> d2{};
+        tree.knn(query, 1, index, d2);
+        nearest = index[0];
+    }
+    const PackedSurfel& sample = packed[grid->slot_of(nearest)];
+    out.value = (p - sample.position.cast<double>()).norm();
+    out.gradient = sample.normal.cast<double>();
+    return true;
+}
+
+std::uint32_t PointField::Impl::nearly_nearest(const Vec3d& p, const Vec3f& query,
+                                               const FarField* far_data, float& dist2) const
+{
+    const auto cell = far_data != nullptr ? far_data->grid.query(p) : std::nullopt;
+    if (!cell)
+    {
+        return tree.nearest_within_factor(query, far_distance_factor, &dist2).value;
+    }
+    std::uint32_t start = cell->points[0];
+    float start_d2 = std::numeric_limits<float>::infinity();
+    for (const std::uint32_t index : cell->points)
+    {
+        const float d2 = (query - surfels.positions[index]).squaredNorm();
+        if (d2 < start_d2 || (d2 == start_d2 && index < start))
+        {
+            start = index;
+            start_d2 = d2;
+        }
+    }
+    return tree.nearest_within_factor(query, far_distance_factor, PointId{start}, &dist2).value;
+}
 
 bool PointField::Impl::evaluate_deep_inside(const FarField& far_data, const Vec3d& p,
                                             FieldSample& out) const
@@ -489,7 +595,7 @@ bool PointField::Impl::maybe_nearby(const Vec3d& p, const FarField* far_data) co
 
 FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
                                             const FarField* far_data, std::size_t found,
-                                            std::uint32_t* slot, float* dist2) const
+                                            std::uint32_t* slot, float* dist2, double hi) const
 {
     const Impl& m = *this;
     FieldSample out;
@@ -500,7 +606,8 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
         {
             far_data = &m.far_field();
         }
-        if (m.evaluate_deep_inside(*far_data, p, out))
+        if (m.evaluate_deep_inside(*far_data, p, out) ||
+            m.evaluate_far_outside(*far_data, p, query, hi, out))
         {
             return out;
         }
@@ -529,9 +636,10 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
         // nearly nearest sample tells whether any influence ball can reach, which mostly ends
         // it. Its distance is within far_distance_factor of the nearest's: deep inside a
         // closed scan the samples are all about equally far, and an exact search visits most.
+        // The far grid's representatives around p (once built) give a start whose distance
+        // bounds the search from the first node, which skips most of the tree.
         float nearest_d2 = 0.0F;
-        const std::uint32_t index =
-            m.tree.nearest_within_factor(query, far_distance_factor, &nearest_d2).value;
+        const std::uint32_t index = m.nearly_nearest(p, query, far_data, nearest_d2);
         const PackedSurfel& nearest = m.packed[m.grid->slot_of(index)];
         const double reach = m.max_radius * static_cast<double>(far_distance_factor);
         if (static_cast<double>(nearest_d2) > reach * reach)
@@ -611,6 +719,12 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
 
 FieldSample PointField::evaluate(const Vec3d& world_point) const
 {
+    return evaluate_within(world_point, -std::numeric_limits<double>::infinity(),
+                           std::numeric_limits<double>::infinity());
+}
+
+FieldSample PointField::evaluate_within(const Vec3d& world_point, double /*lo*/, double hi) const
+{
     const Impl& m = *impl_;
     const Vec3d p = world_point - m.surfels.origin;
     const Vec3f query = p.cast<float>();
@@ -624,12 +738,31 @@ FieldSample PointField::evaluate(const Vec3d& world_point) const
         found = m.grid->knn_nearby(query, want, std::span(slot.data(), want),
                                    std::span(dist2.data(), want));
     }
-    return m.evaluate_with(p, query, far, found, slot.data(), dist2.data());
+    return m.evaluate_with(p, query, far, found, slot.data(), dist2.data(), hi);
+}
+
+double PointField::cost() const
+{
+    return point_field_cost;
 }
 
 void PointField::evaluate(std::span<const Vec3d> points, std::span<FieldSample> out) const
 {
+    evaluate_batch(points, {}, out);
+}
+
+void PointField::evaluate_within(std::span<const Vec3d> points, std::span<const double> /*lo*/,
+                                 std::span<const double> hi, std::span<FieldSample> out) const
+{
+    PF_ASSERT(hi.size() == points.size());
+    evaluate_batch(points, hi, out);
+}
+
+void PointField::evaluate_batch(std::span<const Vec3d> points, std::span<const double> hi,
+                                std::span<FieldSample> out) const
+{
     PF_ASSERT(points.size() == out.size());
+    constexpr double inf = std::numeric_limits<double>::infinity();
     const Impl& m = *impl_;
     const std::size_t want = m.wanted();
     // Blocks of consecutive queries, fixed whatever the thread count; the point grid answers
@@ -666,13 +799,14 @@ void PointField::evaluate(std::span<const Vec3d> points, std::span<FieldSample> 
             {
                 out[begin + i] =
                     m.evaluate_with(local[i], query, far, found[next], slots.data() + next * want,
-                                    dist2.data() + next * want);
+                                    dist2.data() + next * want, hi.empty() ? inf : hi[begin + i]);
                 ++next;
             }
             else
             {
                 out[begin + i] =
-                    m.evaluate_with(local[i], query, far, 0, none_slot.data(), none_dist2.data());
+                    m.evaluate_with(local[i], query, far, 0, none_slot.data(), none_dist2.data(),
+                                    hi.empty() ? inf : hi[begin + i]);
             }
         }
     });

@@ -4,6 +4,7 @@
 #include "pointform/implicit/transform.h"
 
 #include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
 
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
@@ -12,7 +13,9 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <utility>
+#include <vector>
 
 namespace pointform {
 
@@ -41,10 +44,63 @@ TransformedField::TransformedField(std::shared_ptr<const Field> member, const Ma
 
 FieldSample TransformedField::evaluate(const Vec3d& p) const
 {
-    FieldSample s = member_->evaluate(inverse_ * (p - translation_));
+    return evaluate_within(p, -std::numeric_limits<double>::infinity(),
+                           std::numeric_limits<double>::infinity());
+}
+
+// value = value_scale · f (value_scale > 0): f within [lo, hi] / value_scale, widened by a few
+// rounding errors so that rounding cannot move a value across.
+std::pair<double, double> TransformedField::member_range(double lo, double hi) const
+{
+    const auto scaled = [this](double x, double direction) {
+        const double y = x / value_scale_;
+        return std::isfinite(y)
+                   ? y + direction * 8.0 * std::numeric_limits<double>::epsilon() * std::abs(y)
+                   : y;
+    };
+    return {scaled(lo, -1.0), scaled(hi, 1.0)};
+}
+
+FieldSample TransformedField::transformed(FieldSample s) const
+{
     s.value *= value_scale_;
     s.gradient = gradient_map_ * s.gradient;
     return s;
+}
+
+FieldSample TransformedField::evaluate_within(const Vec3d& p, double lo, double hi) const
+{
+    const auto [member_lo, member_hi] = member_range(lo, hi);
+    return transformed(
+        member_->evaluate_within(inverse_ * (p - translation_), member_lo, member_hi));
+}
+
+void TransformedField::evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
+                                       std::span<const double> hi, std::span<FieldSample> out) const
+{
+    PF_ASSERT(points.size() == out.size() && lo.size() == out.size() && hi.size() == out.size());
+    parallel_blocks(points.size(), 1024, [&](std::size_t begin, std::size_t end) {
+        const std::size_t n = end - begin;
+        std::vector<Vec3d> local(n);
+        std::vector<double> member_lo(n);
+        std::vector<double> member_hi(n);
+        std::vector<FieldSample> samples(n);
+        for (std::size_t j = 0; j < n; ++j)
+        {
+            local[j] = inverse_ * (points[begin + j] - translation_);
+            std::tie(member_lo[j], member_hi[j]) = member_range(lo[begin + j], hi[begin + j]);
+        }
+        member_->evaluate_within(local, member_lo, member_hi, samples);
+        for (std::size_t j = 0; j < n; ++j)
+        {
+            out[begin + j] = transformed(samples[j]);
+        }
+    });
+}
+
+double TransformedField::cost() const
+{
+    return 1.0 + member_->cost();
 }
 
 Aabb TransformedField::bounds() const

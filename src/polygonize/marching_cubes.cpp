@@ -284,6 +284,9 @@ enum : std::uint8_t
     evaluated = 1,
     defined = 2,
     visited = 4,
+    /// Evaluated within a range (Field::evaluate_within) and found beyond it: only the sign
+    /// is known until the corner is evaluated exactly.
+    bounded = 8,
 };
 
 struct Block
@@ -476,9 +479,65 @@ void check_marching_cubes_memory(const PointField& field, double cell)
     }
 }
 
+namespace {
+
+/// Stores a corner's sample; `bounded` where its value is beyond ±`range`.
+void store_sample(const FieldSample& sample, double range, const SparseGrid::Slot& slot)
+{
+    *slot.value = static_cast<float>(sample.value);
+    *slot.state |= static_cast<std::uint8_t>(evaluated | (sample.defined ? defined : 0) |
+                                             (std::abs(sample.value) <= range ? 0 : bounded));
+}
+
+/// Field::evaluate_within() with the range ±`range` for every point.
+void evaluate_within(const Field& field, double range, std::span<const Vec3d> points,
+                     std::span<FieldSample> samples)
+{
+    const std::vector<double> lo(points.size(), -range);
+    const std::vector<double> hi(points.size(), range);
+    field.evaluate_within(points, lo, hi, samples);
+}
+
+/// The field's samples at `points`, exact where the value is within ±`range` (asked with
+/// Field::evaluate_within) and beyond it (asked again exactly, which a distance-like field
+/// near its surface never needs).
+void evaluate_near_zero(const Field& field, double range, std::span<const Vec3d> points,
+                        std::span<FieldSample> samples)
+{
+    evaluate_within(field, range, points, samples);
+    std::vector<std::size_t> beyond;
+    for (std::size_t i = 0; i < samples.size(); ++i)
+    {
+        if (!(std::abs(samples[i].value) <= range))
+        {
+            beyond.push_back(i);
+        }
+    }
+    if (beyond.empty())
+    {
+        return;
+    }
+    std::vector<Vec3d> again(beyond.size());
+    std::vector<FieldSample> exact(beyond.size());
+    for (std::size_t j = 0; j < beyond.size(); ++j)
+    {
+        again[j] = points[beyond[j]];
+    }
+    field.evaluate(again, exact);
+    for (std::size_t j = 0; j < beyond.size(); ++j)
+    {
+        samples[beyond[j]] = exact[j];
+    }
+}
+
+} // namespace
+
 MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
                                    const MarchingCubesOptions& options)
 {
+    // Corner values within this of zero are asked exactly (Field::evaluate_within): two cell
+    // diagonals, beyond which a distance-like field cannot change sign within a cell.
+    const double exact_range = 2.0 * std::sqrt(3.0) * grid.cell;
     if (!(grid.cell > 0.0) || grid.cells[0] < 1 || grid.cells[1] < 1 || grid.cells[2] < 1 ||
         grid.cells[0] > max_cells || grid.cells[1] > max_cells || grid.cells[2] > max_cells)
     {
@@ -579,13 +638,66 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
         {
             points[i] = grid_point(grid, unpack(needed[i]));
         }
-        field.evaluate(points, samples);
+        // Corners only need their sign unless they are near zero: far from the surface a
+        // composite field may answer from bounds (a scan far from where it decides the result).
+        // The corners of cells that the surface crosses, and of the first wave's (whose
+        // `defined` flags decide where the search starts), are then evaluated exactly, so the
+        // mesh is the one that exact values give.
+        evaluate_within(field, exact_range, points, samples);
         stats.field_evaluations += needed.size();
         for (std::size_t i = 0; i < needed.size(); ++i)
         {
             const SparseGrid::Slot s = store.get_or_create(unpack(needed[i]));
-            *s.value = static_cast<float>(samples[i].value);
-            *s.state |= static_cast<std::uint8_t>(evaluated | (samples[i].defined ? defined : 0));
+            store_sample(samples[i], exact_range, s);
+        }
+        {
+            std::vector<std::uint64_t> inexact = parallel_collect<std::uint64_t>(
+                wave.size(), 4096,
+                [&](std::size_t begin, std::size_t end, std::vector<std::uint64_t>& out) {
+                    for (std::size_t w = begin; w < end; ++w)
+                    {
+                        const Coord cell = unpack(wave[w]);
+                        int mask = 0;
+                        bool any_bounded = false;
+                        std::array<std::uint8_t, 8> state{};
+                        for (int c = 0; c < 8; ++c)
+                        {
+                            const SparseGrid::Slot s = store.find(corner_of(cell, c));
+                            if (s.value != nullptr)
+                            {
+                                mask |= (*s.value < 0.0F ? 1 : 0) << c;
+                                state[static_cast<std::size_t>(c)] = *s.state;
+                                any_bounded = any_bounded || (*s.state & bounded) != 0;
+                            }
+                        }
+                        if (!any_bounded || (!first_wave && (mask == 0 || mask == 255)))
+                        {
+                            continue;
+                        }
+                        for (int c = 0; c < 8; ++c)
+                        {
+                            if ((state[static_cast<std::size_t>(c)] & bounded) != 0)
+                            {
+                                out.push_back(pack(corner_of(cell, c)));
+                            }
+                        }
+                    }
+                });
+            sort_unique(inexact);
+            points.resize(inexact.size());
+            samples.resize(inexact.size());
+            for (std::size_t i = 0; i < inexact.size(); ++i)
+            {
+                points[i] = grid_point(grid, unpack(inexact[i]));
+            }
+            field.evaluate(points, samples);
+            stats.field_evaluations += inexact.size();
+            for (std::size_t i = 0; i < inexact.size(); ++i)
+            {
+                const SparseGrid::Slot s = store.get_or_create(unpack(inexact[i]));
+                *s.state = static_cast<std::uint8_t>(*s.state & visited);
+                store_sample(samples[i], std::numeric_limits<double>::infinity(), s);
+            }
         }
         stats.cells_visited += wave.size();
 
@@ -748,7 +860,7 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
         {
             points[v] = a_point[v] + vertex_t[v] * (b_point[v] - a_point[v]);
         }
-        field.evaluate(points, samples);
+        evaluate_near_zero(field, exact_range, points, samples);
         stats.field_evaluations += nv;
         for (std::size_t v = 0; v < nv; ++v)
         {
@@ -799,7 +911,7 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
     if (options.vertex_normals)
     {
         samples.resize(nv);
-        field.evaluate(points, samples);
+        evaluate_near_zero(field, exact_range, points, samples);
         stats.field_evaluations += nv;
         mesh.vertices.normals.resize(nv);
         for (std::size_t v = 0; v < nv; ++v)

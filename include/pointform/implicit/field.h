@@ -46,8 +46,27 @@ public:
 
     /// \brief Value and gradient at many points, in parallel; `out.size()` must equal
     /// `points.size()`. The result is the same as calling evaluate() per point, whatever the
-    /// thread count.
+    /// thread count. By default the batch evaluate_within() over (−∞, ∞).
     virtual void evaluate(std::span<const Vec3d> points, std::span<FieldSample> out) const;
+
+    /// \brief evaluate(p) where its value lies in [lo, hi]; elsewhere only the side is kept: a
+    /// value below `lo` if the exact one is below it, above `hi` if the exact one is above it
+    /// (either, where lo > hi), with any finite gradient and any `defined`.
+    ///
+    /// Operators ask their members this way, so that a costly member answers from a bound where
+    /// another decides the result (a scan along a primitive that wins the min, far from the
+    /// scan). Operators that use it give exactly evaluate()'s result where it lies in [lo, hi],
+    /// the same member chosen on ties. The default evaluates exactly.
+    [[nodiscard]] virtual FieldSample evaluate_within(const Vec3d& p, double lo, double hi) const;
+
+    /// \brief evaluate_within() at many points, point i within [lo[i], hi[i]], in parallel (the
+    /// same results as one by one, whatever the thread count). All spans have the same size.
+    virtual void evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
+                                 std::span<const double> hi, std::span<FieldSample> out) const;
+
+    /// \brief A rough relative cost of one evaluation (1: an analytic primitive). Operators ask
+    /// cheaper members first, so that their values bound what the costlier ones must answer.
+    [[nodiscard]] virtual double cost() const;
 
     /// \brief A box that contains every point where the field is defined and near zero, i.e.
     /// where a surface can be. Polygonization grids are laid over it.

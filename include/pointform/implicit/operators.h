@@ -7,6 +7,7 @@
 
 #include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace pointform {
@@ -33,6 +34,10 @@ namespace pointform {
 ///   surface from every seed that lies on it, so a piece of an intersection or difference that
 ///   holds no member seed (e.g. A ∩ B where no seed of A lies inside B and none of B inside A)
 ///   is missed; with point fields (a seed per sample) and the primitives' seeds this is rare.
+/// - Bounded evaluation (Field::evaluate_within): Booleans, smooth Booleans, offsets and shells
+///   ask each member only for the range of values that can still decide their own result, the
+///   cheaper members first (Field::cost), and give evaluate()'s result wherever it lies in the
+///   range asked of them; the other operators ask their members exactly.
 /// - Bounds: union → union of the boxes, intersection → their intersection (possibly empty),
 ///   difference → the first member's box, offset → grown by d (d > 0), blends → the union grown
 ///   by the blend range.
@@ -74,6 +79,10 @@ public:
 
     [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override;
     using Field::evaluate;
+    [[nodiscard]] FieldSample evaluate_within(const Vec3d& p, double lo, double hi) const override;
+    void evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
+                         std::span<const double> hi, std::span<FieldSample> out) const override;
+    [[nodiscard]] double cost() const override;
     [[nodiscard]] Aabb bounds() const override;
     void append_seeds(std::vector<Vec3d>& seeds) const override;
 
@@ -81,8 +90,11 @@ public:
     [[nodiscard]] std::span<const std::shared_ptr<const Field>> members() const { return members_; }
 
 private:
+    class Minimum;
+
     BooleanOp op_;
     std::vector<std::shared_ptr<const Field>> members_;
+    std::vector<std::size_t> order_; ///< members by cost, then by position
 };
 
 /// \brief Smooth union, intersection or difference of two fields with blend radius k, by the
@@ -103,6 +115,10 @@ public:
 
     [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override;
     using Field::evaluate;
+    [[nodiscard]] FieldSample evaluate_within(const Vec3d& p, double lo, double hi) const override;
+    void evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
+                         std::span<const double> hi, std::span<FieldSample> out) const override;
+    [[nodiscard]] double cost() const override;
     [[nodiscard]] Aabb bounds() const override;
     void append_seeds(std::vector<Vec3d>& seeds) const override;
 
@@ -110,6 +126,14 @@ public:
     [[nodiscard]] double radius() const { return radius_; }
 
 private:
+    /// s with g = s · f for member b (or a): the smooth minimum's orientation of its values.
+    [[nodiscard]] double sign_of(bool b) const;
+    /// The range to ask of member b (or a) for a result within [lo, hi], given the other's
+    /// sample if that was asked first.
+    [[nodiscard]] std::pair<double, double> range_of(bool b, double lo, double hi,
+                                                     const FieldSample* first) const;
+    [[nodiscard]] FieldSample combine(const FieldSample& sa, FieldSample sb) const;
+
     BooleanOp op_;
     std::shared_ptr<const Field> a_;
     std::shared_ptr<const Field> b_;
@@ -163,6 +187,7 @@ public:
 
     [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override;
     using Field::evaluate;
+    [[nodiscard]] double cost() const override;
     [[nodiscard]] Aabb bounds() const override;
     void append_seeds(std::vector<Vec3d>& seeds) const override;
 
@@ -193,6 +218,10 @@ public:
 
     [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override;
     using Field::evaluate;
+    [[nodiscard]] FieldSample evaluate_within(const Vec3d& p, double lo, double hi) const override;
+    void evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
+                         std::span<const double> hi, std::span<FieldSample> out) const override;
+    [[nodiscard]] double cost() const override;
     [[nodiscard]] Aabb bounds() const override;
     void append_seeds(std::vector<Vec3d>& seeds) const override;
 
@@ -215,6 +244,10 @@ public:
 
     [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override;
     using Field::evaluate;
+    [[nodiscard]] FieldSample evaluate_within(const Vec3d& p, double lo, double hi) const override;
+    void evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
+                         std::span<const double> hi, std::span<FieldSample> out) const override;
+    [[nodiscard]] double cost() const override;
     [[nodiscard]] Aabb bounds() const override;
     void append_seeds(std::vector<Vec3d>& seeds) const override;
 
@@ -242,6 +275,7 @@ public:
 
     [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override;
     using Field::evaluate;
+    [[nodiscard]] double cost() const override;
     [[nodiscard]] Aabb bounds() const override;
     void append_seeds(std::vector<Vec3d>& seeds) const override;
 

@@ -87,6 +87,11 @@ struct PointFieldOptions
 ///   answers only where all those representatives' surfaces put p inside and none shares its node
 ///   with a sample facing the other way (a wall thinner than h, whose side the node cannot tell);
 ///   elsewhere the kd-tree search decides, as outside.
+/// - Far outside the same way (no influence ball reaches, every representative's surface puts p
+///   outside, none two-sided; beyond the grid's box, the representatives at the nearest point of
+///   the box): the value is positive, its magnitude from the kd-tree search started at the
+///   nearest representative; evaluate_within() answers with the grid's lower bound on the
+///   distance wherever that is above the range asked, without searching.
 /// The answers do not depend on the order of queries or on threads.
 ///
 /// Queries are answered by a PointGrid over the samples (a kd-tree far from them), and run
@@ -105,6 +110,13 @@ public:
     /// count), faster: the point grid answers each block of consecutive queries together, which
     /// pays where they are coherent (as marching cubes and refinement ask).
     void evaluate(std::span<const Vec3d> points, std::span<FieldSample> out) const override;
+    /// \brief evaluate(), except far outside (see above) where a lower bound on the distance
+    /// to the samples is above `hi`: then the value is that bound.
+    [[nodiscard]] FieldSample evaluate_within(const Vec3d& p, double lo, double hi) const override;
+    /// \brief evaluate_within() per point, as fast as the batch evaluate().
+    void evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
+                         std::span<const double> hi, std::span<FieldSample> out) const override;
+    [[nodiscard]] double cost() const override;
     [[nodiscard]] Aabb bounds() const override;
     void append_seeds(std::vector<Vec3d>& seeds) const override;
 
@@ -117,6 +129,10 @@ public:
     [[nodiscard]] double estimated_area() const;
 
 private:
+    /// The batch evaluate(), each point within (-∞, hi[i]], or exact where `hi` is empty.
+    void evaluate_batch(std::span<const Vec3d> points, std::span<const double> hi,
+                        std::span<FieldSample> out) const;
+
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };

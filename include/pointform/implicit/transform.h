@@ -6,6 +6,7 @@
 #include "pointform/implicit/field.h"
 
 #include <memory>
+#include <utility>
 
 namespace pointform {
 
@@ -29,6 +30,10 @@ public:
 
     [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override;
     using Field::evaluate;
+    [[nodiscard]] FieldSample evaluate_within(const Vec3d& p, double lo, double hi) const override;
+    void evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
+                         std::span<const double> hi, std::span<FieldSample> out) const override;
+    [[nodiscard]] double cost() const override;
     [[nodiscard]] Aabb bounds() const override;
     void append_seeds(std::vector<Vec3d>& seeds) const override;
 
@@ -39,6 +44,11 @@ public:
     [[nodiscard]] double value_scale() const { return value_scale_; }
 
 private:
+    /// The member's range for a result within [lo, hi].
+    [[nodiscard]] std::pair<double, double> member_range(double lo, double hi) const;
+    /// The member's sample mapped to this field.
+    [[nodiscard]] FieldSample transformed(FieldSample s) const;
+
     std::shared_ptr<const Field> member_;
     Mat3d linear_;
     Vec3d translation_;
