@@ -20,6 +20,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pointform {
@@ -327,6 +328,13 @@ struct PointField::Impl
     /// untouched) otherwise.
     bool evaluate_deep_inside(const FarField& far_data, const Vec3d& p, FieldSample& out) const;
 
+    /// The representative of `cell`'s corners nearest to `p` (ties to the smallest index) and
+    /// its squared distance, where every representative's surface puts `p` inside (or outside)
+    /// and none stands for a two-sided site; nullopt otherwise.
+    [[nodiscard]] std::optional<std::pair<std::uint32_t, double>> agreeing_representative(
+        const FarField& far_data, const FeatureGrid::CellQuery& cell, const Vec3d& p,
+        bool inside) const;
+
     /// The value at `p` (relative to the origin) where the far grid proves that no influence
     /// ball reaches and every candidate sample's surface puts `p` outside: the distance to a
     /// nearly nearest sample, or a lower bound on it where that is above `hi`; false (and `out`
@@ -359,28 +367,12 @@ bool PointField::Impl::evaluate_far_outside(const FarField& far_data, const Vec3
         return false;
     }
     // As deep inside (evaluate_deep_inside), the other way round.
-    std::uint32_t best = 0;
-    double best_d2 = std::numeric_limits<double>::infinity();
-    std::uint32_t checked = std::numeric_limits<std::uint32_t>::max();
-    for (const std::uint32_t index : cell->points)
+    const auto agreed = agreeing_representative(far_data, *cell, p, false);
+    if (!agreed)
     {
-        if (index == checked)
-        {
-            continue;
-        }
-        checked = index;
-        const PackedSurfel& sample = packed[grid->slot_of(index)];
-        if (far_data.two_sided[index] != 0 || !(sample.distance(p, nullptr) > 0.0))
-        {
-            return false;
-        }
-        const double d2 = (p - sample.position.cast<double>()).squaredNorm();
-        if (d2 < best_d2 || (d2 == best_d2 && index < best))
-        {
-            best = index;
-            best_d2 = d2;
-        }
+        return false;
     }
+    const std::uint32_t best = agreed->first;
     out.defined = false;
     if (lower > hi)
     {
@@ -438,12 +430,25 @@ bool PointField::Impl::evaluate_deep_inside(const FarField& far_data, const Vec3
     {
         return false;
     }
-    // The corners' representatives: all must say inside, none may stand for a two-sided site;
-    // the nearest one (ties to the smallest index) gives the value.
+    // The corners' representatives: all must say inside; the nearest gives the value.
+    const auto agreed = agreeing_representative(far_data, *cell, p, true);
+    if (!agreed)
+    {
+        return false;
+    }
+    out.defined = false;
+    out.value = -std::sqrt(agreed->second);
+    out.gradient = packed[grid->slot_of(agreed->first)].normal.cast<double>();
+    return true;
+}
+
+std::optional<std::pair<std::uint32_t, double>> PointField::Impl::agreeing_representative(
+    const FarField& far_data, const FeatureGrid::CellQuery& cell, const Vec3d& p, bool inside) const
+{
     std::uint32_t best = 0;
     double best_d2 = std::numeric_limits<double>::infinity();
     std::uint32_t checked = std::numeric_limits<std::uint32_t>::max(); // never a sample index
-    for (const std::uint32_t index : cell->points)
+    for (const std::uint32_t index : cell.points)
     {
         if (index == checked)
         {
@@ -451,9 +456,10 @@ bool PointField::Impl::evaluate_deep_inside(const FarField& far_data, const Vec3
         }
         checked = index;
         const PackedSurfel& sample = packed[grid->slot_of(index)];
-        if (far_data.two_sided[index] != 0 || !(sample.distance(p, nullptr) < 0.0))
+        const double side = sample.distance(p, nullptr);
+        if (far_data.two_sided[index] != 0 || !(inside ? side < 0.0 : side > 0.0))
         {
-            return false;
+            return std::nullopt;
         }
         const double d2 = (p - sample.position.cast<double>()).squaredNorm();
         if (d2 < best_d2 || (d2 == best_d2 && index < best))
@@ -462,10 +468,7 @@ bool PointField::Impl::evaluate_deep_inside(const FarField& far_data, const Vec3
             best_d2 = d2;
         }
     }
-    out.defined = false;
-    out.value = -std::sqrt(best_d2);
-    out.gradient = packed[grid->slot_of(best)].normal.cast<double>();
-    return true;
+    return std::pair{best, best_d2};
 }
 
 PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
