@@ -471,6 +471,10 @@ private:
                 }
                 else
                 {
+                    for (std::size_t j = 0; j < kept; ++j)
+                    {
+                        keys_[j] = key_of(packed_d2_[j], packed_slot_[j]);
+                    }
                     take_smallest(keys_.data(), kept, k, slots, d2);
                 }
                 return Outcome::found;
@@ -534,50 +538,50 @@ private:
                     _mm256_loadu_si256(reinterpret_cast<const __m256i*>(slot_of + i)), order));
             count += static_cast<std::size_t>(std::popcount(mask));
         }
-        for (std::size_t j = 0; j < count; ++j)
-        {
-            keys_[j] = key_of(packed_d2_[j], packed_slot_[j]);
-        }
         return count;
     }
 
-    /// take_smallest() of the first `count` keys (at most max_ranked), by counting for each
-    /// how many are smaller (the keys differ: their slots do).
-    __attribute__((target("avx2"))) void rank_smallest(std::size_t count, std::size_t k,
-                                                       std::uint32_t* slots, float* d2)
+    /// take_smallest() of the first `count` gathered points (at most max_ranked), by counting
+    /// for each how many come before it: nearer, or as near with a smaller slot (the keys'
+    /// order; the keys differ, their slots do).
+    __attribute__((target("avx2,popcnt"))) void rank_smallest(std::size_t count, std::size_t k,
+                                                              std::uint32_t* slots, float* d2)
     {
-        // Keys are below 2^63 (squared distances are not negative), so signed comparisons
-        // order them; the padding is larger than all.
-        constexpr auto padding =
-            static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
-        const std::size_t vectors = (count + 3) / 4;
-        for (std::size_t i = count; i < 4 * vectors; ++i)
+        // Squared distances are not negative and slots are below 2^31, so signed 32-bit
+        // comparisons order both; the padding is farther than all.
+        const std::size_t vectors = (count + 7) / 8;
+        for (std::size_t i = count; i < 8 * vectors; ++i)
         {
-            keys_[i] = padding;
+            packed_d2_[i] = static_cast<std::uint32_t>(std::numeric_limits<std::int32_t>::max());
+            packed_slot_[i] = 0;
         }
-        __m256i keys[max_ranked / 4]; // NOLINT(*-avoid-c-arrays): std::array drops the
+        __m256i dist[max_ranked / 8]; // NOLINT(*-avoid-c-arrays): std::array drops the
                                       // vector type's attributes
+        __m256i slot[max_ranked / 8]; // NOLINT(*-avoid-c-arrays)
         for (std::size_t v = 0; v < vectors; ++v)
         {
-            keys[v] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(keys_.data() + 4 * v));
+            dist[v] =
+                _mm256_loadu_si256(reinterpret_cast<const __m256i*>(packed_d2_.data() + 8 * v));
+            slot[v] =
+                _mm256_loadu_si256(reinterpret_cast<const __m256i*>(packed_slot_.data() + 8 * v));
         }
         for (std::size_t i = 0; i < count; ++i)
         {
-            const std::uint64_t key = keys_[i];
-            const __m256i probe = _mm256_set1_epi64x(static_cast<long long>(key));
-            __m256i smaller = _mm256_setzero_si256();
+            const __m256i probe_dist = _mm256_set1_epi32(static_cast<int>(packed_d2_[i]));
+            const __m256i probe_slot = _mm256_set1_epi32(static_cast<int>(packed_slot_[i]));
+            std::size_t rank = 0;
             for (std::size_t v = 0; v < vectors; ++v)
             {
-                smaller = _mm256_sub_epi64(smaller, _mm256_cmpgt_epi64(probe, keys[v]));
+                const __m256i nearer = _mm256_cmpgt_epi32(probe_dist, dist[v]);
+                const __m256i tied = _mm256_and_si256(_mm256_cmpeq_epi32(probe_dist, dist[v]),
+                                                      _mm256_cmpgt_epi32(probe_slot, slot[v]));
+                rank += static_cast<std::size_t>(std::popcount(static_cast<unsigned>(
+                    _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_or_si256(nearer, tied))))));
             }
-            const __m128i half = _mm_add_epi64(_mm256_castsi256_si128(smaller),
-                                               _mm256_extracti128_si256(smaller, 1));
-            const auto rank = static_cast<std::size_t>(
-                _mm_cvtsi128_si64(_mm_add_epi64(half, _mm_unpackhi_epi64(half, half))));
             if (rank < k)
             {
-                slots[rank] = static_cast<std::uint32_t>(key);
-                d2[rank] = std::bit_cast<float>(static_cast<std::uint32_t>(key >> 32U));
+                slots[rank] = packed_slot_[i];
+                d2[rank] = std::bit_cast<float>(packed_d2_[i]);
             }
         }
     }
@@ -596,7 +600,7 @@ private:
     std::array<std::uint32_t, buffered + 8> slot_;
     std::array<std::uint32_t, capacity + 8> packed_d2_;
     std::array<std::uint32_t, capacity + 8> packed_slot_;
-    std::array<std::uint64_t, capacity + 8> keys_; ///< + 8: rank_smallest() pads them
+    std::array<std::uint64_t, capacity + 8> keys_;
 };
 
 #endif // PF_GRID_AVX2
@@ -877,28 +881,32 @@ void PointGrid::knn_nearby(std::span<const Vec3f> queries, std::size_t k,
     // Each query gets Within's answer for the same passes as knn_nearby() (the octant block
     // with its reach, then the 3 × 3 × 3 block with its), only found faster (Selection), so the
     // answers are the same whatever the order of the queries and the guesses.
-    // Runs of consecutive queries whose cells fit in a small table are looked up once.
+    // The cells that coherent queries look up come back again and again: the last ones looked
+    // up are kept in a small table, direct-mapped by their coordinates modulo 8.
     constexpr std::size_t run = 32;
-    constexpr std::int64_t side = 6;
     std::array<Placement, run> places;
     std::array<bool, run> placed_ok{};
-    std::array<Range, side * side * side> table;
-    std::array<std::uint8_t, side * side * side> known{};
-    std::array<std::int64_t, 3> origin{};
-    bool coherent = false;
+    struct CachedCell
+    {
+        std::uint64_t key = ~std::uint64_t{0}; ///< never a cell's
+        Range range;
+    };
+    auto cell_store = std::make_unique<std::array<CachedCell, 512>>();
+    std::array<CachedCell, 512>& cells = *cell_store;
     const auto range_at = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-        if (!coherent)
+        if (x < 0 || y < 0 || z < 0 || x >= dims_ || y >= dims_ || z >= dims_)
         {
-            return cell_range(x, y, z);
+            return Range{};
         }
-        const auto at = static_cast<std::size_t>(((z - origin[2]) * side + (y - origin[1])) * side +
-                                                 (x - origin[0]));
-        if (known[at] == 0)
+        const std::uint64_t key = packed(x, y, z);
+        CachedCell& cached =
+            cells[static_cast<std::size_t>((x & 7) | ((y & 7) << 3) | ((z & 7) << 6))];
+        if (cached.key != key)
         {
-            table[at] = cell_range(x, y, z);
-            known[at] = 1;
+            cached.key = key;
+            cached.range = cell_range(x, y, z);
         }
-        return table[at];
+        return cached.range;
     };
     auto selection = std::make_unique_for_overwrite<Selection>();
     // Coherent queries come back to a few octant blocks: the last few are kept gathered
@@ -912,35 +920,12 @@ void PointGrid::knn_nearby(std::span<const Vec3f> queries, std::size_t k,
     std::array<Range, 27> ranges;
     // The last query's k-th squared distance minus its nearest's: about the next one's.
     float spread2 = std::numeric_limits<float>::quiet_NaN();
-    for (std::size_t start = 0; start < n; start += run)
+    for (std::size_t start = 0; start < n;)
     {
         const std::size_t end = std::min(n, start + run);
-        std::array<std::int64_t, 3> lo{};
-        std::array<std::int64_t, 3> hi{};
-        lo.fill(std::numeric_limits<std::int64_t>::max());
-        hi.fill(std::numeric_limits<std::int64_t>::min());
         for (std::size_t i = start; i < end; ++i)
         {
-            Placement& place = places[i - start];
-            placed_ok[i - start] = placed(queries[i], place);
-            if (placed_ok[i - start])
-            {
-                for (std::size_t a = 0; a < 3; ++a)
-                {
-                    lo[a] = std::min(lo[a], place.cell[a]);
-                    hi[a] = std::max(hi[a], place.cell[a]);
-                }
-            }
-        }
-        coherent = true;
-        for (std::size_t a = 0; a < 3; ++a)
-        {
-            coherent = coherent && hi[a] >= lo[a] && hi[a] - lo[a] + 3 <= side;
-            origin[a] = lo[a] - 1;
-        }
-        if (coherent)
-        {
-            known.fill(0);
+            placed_ok[i - start] = placed(queries[i], places[i - start]);
         }
         for (std::size_t i = start; i < end; ++i)
         {
@@ -963,16 +948,12 @@ void PointGrid::knn_nearby(std::span<const Vec3f> queries, std::size_t k,
                 return std::span<const Range>(ranges.data(), 8);
             };
             const float octant = place.octant_reach * cell_;
-            Selection::Block* block = nullptr;
-            if (coherent)
+            Selection::Block* block = &blocks[static_cast<std::size_t>(
+                (place.low[0] + 3 * place.low[1] + 5 * place.low[2]) & 7)];
+            if ((!block->valid || block->low != place.low) &&
+                !block->fill(place.low, octant_cells(), xs_.data(), ys_.data(), zs_.data()))
             {
-                block = &blocks[static_cast<std::size_t>(
-                    (place.low[0] + 3 * place.low[1] + 5 * place.low[2]) & 7)];
-                if ((!block->valid || block->low != place.low) &&
-                    !block->fill(place.low, octant_cells(), xs_.data(), ys_.data(), zs_.data()))
-                {
-                    block = nullptr;
-                }
+                block = nullptr;
             }
             auto outcome =
                 block != nullptr
@@ -1010,6 +991,7 @@ void PointGrid::knn_nearby(std::span<const Vec3f> queries, std::size_t k,
                 spread2 = d2[want - 1] - d2[0];
             }
         }
+        start = end;
     }
 #endif
 }
