@@ -13,7 +13,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
+#include <numeric>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -852,23 +854,42 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
         vertex_t[v] = interpolate(v);
     }
     std::vector<int> last_side(nv, 0);
-    for (int step = 0; step < options.refine_steps; ++step)
+    // A vertex whose value is within `settled_value` of zero (far below the float resolution of
+    // its position) stays where it was evaluated, and keeps that sample's gradient as its normal.
+    const double settled_value = 1e-7 * grid.cell;
+    std::vector<std::uint8_t> settled(nv, 0);
+    std::vector<Vec3d> settled_gradient(nv, Vec3d::Zero());
+    std::vector<std::size_t> active(nv);
+    std::iota(active.begin(), active.end(), std::size_t{0});
+    for (int step = 0; step < options.refine_steps && !active.empty(); ++step)
     {
-        points.resize(nv);
-        samples.resize(nv);
-        for (std::size_t v = 0; v < nv; ++v)
+        const std::size_t na = active.size();
+        points.resize(na);
+        samples.resize(na);
+        for (std::size_t i = 0; i < na; ++i)
         {
-            points[v] = a_point[v] + vertex_t[v] * (b_point[v] - a_point[v]);
+            const std::size_t v = active[i];
+            points[i] = a_point[v] + vertex_t[v] * (b_point[v] - a_point[v]);
         }
         evaluate_near_zero(field, exact_range, points, samples);
-        stats.field_evaluations += nv;
-        for (std::size_t v = 0; v < nv; ++v)
+        stats.field_evaluations += na;
+        std::size_t kept = 0;
+        for (std::size_t i = 0; i < na; ++i)
         {
-            const FieldSample& s = samples[v];
+            const std::size_t v = active[i];
+            const FieldSample& s = samples[i];
             if (!s.defined || !std::isfinite(s.value))
             {
+                active[kept++] = v;
                 continue;
             }
+            if (std::abs(s.value) <= settled_value)
+            {
+                settled[v] = 1;
+                settled_gradient[v] = s.gradient;
+                continue;
+            }
+            active[kept++] = v;
             const bool lo_inside = lo_f[v] < 0.0;
             const bool here_inside = s.value < 0.0;
             if (here_inside == lo_inside)
@@ -893,6 +914,7 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
             }
             vertex_t[v] = interpolate(v);
         }
+        active.resize(kept);
     }
 
     // Keep vertices off the grid corners, so that no two vertices coincide.
@@ -910,13 +932,33 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
     }
     if (options.vertex_normals)
     {
-        samples.resize(nv);
-        evaluate_near_zero(field, exact_range, points, samples);
-        stats.field_evaluations += nv;
+        // The gradient where each vertex is: a settled vertex's sample, unless the margin moved
+        // it; the others evaluated here.
+        std::vector<std::size_t> unsettled;
+        for (std::size_t v = 0; v < nv; ++v)
+        {
+            const double s = std::clamp(vertex_t[v], corner_margin, 1.0 - corner_margin);
+            if (settled[v] == 0 || s != vertex_t[v])
+            {
+                unsettled.push_back(v);
+            }
+        }
+        std::vector<Vec3d> at(unsettled.size());
+        samples.resize(unsettled.size());
+        for (std::size_t i = 0; i < unsettled.size(); ++i)
+        {
+            at[i] = points[unsettled[i]];
+        }
+        evaluate_near_zero(field, exact_range, at, samples);
+        stats.field_evaluations += unsettled.size();
+        for (std::size_t i = 0; i < unsettled.size(); ++i)
+        {
+            settled_gradient[unsettled[i]] = samples[i].gradient;
+        }
         mesh.vertices.normals.resize(nv);
         for (std::size_t v = 0; v < nv; ++v)
         {
-            const Vec3d g = samples[v].gradient;
+            const Vec3d g = settled_gradient[v];
             const double norm = g.norm();
             mesh.vertices.normals[v] =
                 norm > 0.0 && std::isfinite(norm) ? Vec3f((g / norm).cast<float>()) : Vec3f::Zero();
