@@ -514,6 +514,9 @@ struct FarField
     }
 };
 
+/// The far grid's answer at a query point (nullopt outside its box).
+using FarCell = std::optional<FeatureGrid::CellQuery>;
+
 struct PointField::Impl
 {
     PointCloud surfels;
@@ -566,8 +569,9 @@ struct PointField::Impl
 
     /// The value at `p` (relative to the origin) where the far grid proves that no influence
     /// ball reaches and every candidate sample's surface puts `p` inside; false (and `out`
-    /// untouched) otherwise.
-    bool evaluate_deep_inside(const FarField& far_data, const Vec3d& p, FieldSample& out) const;
+    /// untouched) otherwise. `cell` is the far grid's query at `p`.
+    bool evaluate_deep_inside(const FarField& far_data, const FarCell& cell, const Vec3d& p,
+                              FieldSample& out) const;
 
     /// The representative of `cell`'s corners nearest to `p` (ties to the smallest index) and
     /// its squared distance, where every representative's surface puts `p` inside (or outside)
@@ -579,23 +583,24 @@ struct PointField::Impl
     /// The value at `p` (relative to the origin) where the far grid proves that no influence
     /// ball reaches and every candidate sample's surface puts `p` outside: the distance to a
     /// nearly nearest sample, or a lower bound on it where that is above `hi`; false (and `out`
-    /// untouched) otherwise.
-    bool evaluate_far_outside(const FarField& far_data, const Vec3d& p, const Vec3f& query,
-                              double hi, FieldSample& out) const;
+    /// untouched) otherwise. `cell` is the far grid's query at `p`.
+    bool evaluate_far_outside(const FarField& far_data, const FarCell& cell, const Vec3d& p,
+                              const Vec3f& query, double hi, FieldSample& out) const;
 
     /// A sample at most far_distance_factor times as far from `p` as the nearest (its squared
-    /// distance to `dist2`), started from the nearest of the far grid's representatives around
-    /// `p` where there is a far grid.
-    [[nodiscard]] std::uint32_t nearly_nearest(const Vec3d& p, const Vec3f& query,
-                                               const FarField* far_data, float& dist2) const;
+    /// distance to `dist2`), started from the nearest of the representatives of `cell` (the far
+    /// grid's query at `p`) where there is one.
+    [[nodiscard]] std::uint32_t nearly_nearest(const FarCell& cell, const Vec3f& query,
+                                               float& dist2) const;
 };
 
-bool PointField::Impl::evaluate_far_outside(const FarField& far_data, const Vec3d& p,
-                                            const Vec3f& query, double hi, FieldSample& out) const
+bool PointField::Impl::evaluate_far_outside(const FarField& far_data, const FarCell& cell_at_p,
+                                            const Vec3d& p, const Vec3f& query, double hi,
+                                            FieldSample& out) const
 {
     // The cell at p, or beyond the grid's box at the nearest point of the box.
     const Vec3d q = p.cwiseMax(local_box.min).cwiseMin(local_box.max);
-    const auto cell = far_data.grid.query(q);
+    const FarCell cell = q == p ? cell_at_p : far_data.grid.query(q);
     if (!cell)
     {
         return false;
@@ -640,10 +645,9 @@ bool PointField::Impl::evaluate_far_outside(const FarField& far_data, const Vec3
     return true;
 }
 
-std::uint32_t PointField::Impl::nearly_nearest(const Vec3d& p, const Vec3f& query,
-                                               const FarField* far_data, float& dist2) const
+std::uint32_t PointField::Impl::nearly_nearest(const FarCell& cell, const Vec3f& query,
+                                               float& dist2) const
 {
-    const auto cell = far_data != nullptr ? far_data->grid.query(p) : std::nullopt;
     if (!cell)
     {
         return tree.nearest_within_factor(query, far_distance_factor, &dist2).value;
@@ -662,10 +666,9 @@ std::uint32_t PointField::Impl::nearly_nearest(const Vec3d& p, const Vec3f& quer
     return tree.nearest_within_factor(query, far_distance_factor, PointId{start}, &dist2).value;
 }
 
-bool PointField::Impl::evaluate_deep_inside(const FarField& far_data, const Vec3d& p,
-                                            FieldSample& out) const
+bool PointField::Impl::evaluate_deep_inside(const FarField& far_data, const FarCell& cell,
+                                            const Vec3d& p, FieldSample& out) const
 {
-    const auto cell = far_data.grid.query(p);
     const double reach = max_radius * static_cast<double>(far_distance_factor);
     if (!cell || !(cell->lower_bound > reach))
     {
@@ -844,17 +847,24 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
     const Impl& m = *this;
     FieldSample out;
     const std::size_t want = wanted();
+    // The far grid's cell at p, looked up once for the far paths below.
+    FarCell cell;
     if (found == 0 && m.options.far_grid)
     {
         if (far_data == nullptr)
         {
             far_data = &m.far_field();
         }
-        if (m.evaluate_deep_inside(*far_data, p, out) ||
-            m.evaluate_far_outside(*far_data, p, query, hi, out))
+        cell = far_data->grid.query(p);
+        if (m.evaluate_deep_inside(*far_data, cell, p, out) ||
+            m.evaluate_far_outside(*far_data, cell, p, query, hi, out))
         {
             return out;
         }
+    }
+    else if (found == 0 && far_data != nullptr)
+    {
+        cell = far_data->grid.query(p);
     }
 
     if (!blends(m.options.fit))
@@ -883,7 +893,7 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
         // The far grid's representatives around p (once built) give a start whose distance
         // bounds the search from the first node, which skips most of the tree.
         float nearest_d2 = 0.0F;
-        const std::uint32_t index = m.nearly_nearest(p, query, far_data, nearest_d2);
+        const std::uint32_t index = m.nearly_nearest(cell, query, nearest_d2);
         const PackedSurfel& nearest = m.packed[m.grid->slot_of(index)];
         const double reach = m.max_radius * static_cast<double>(far_distance_factor);
         if (static_cast<double>(nearest_d2) > reach * reach)
