@@ -127,6 +127,28 @@ BENCHMARK(BM_FieldEvaluateOneByOne)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
+/// The field's construction on the 1M-sample sphere: each sample's local surface from its
+/// neighbours (16 for the centroid planes, 48 for the quadrics) and the point grid.
+void BM_FieldBuild(benchmark::State& state)
+{
+    const auto fit = static_cast<PlaneFit>(state.range(0));
+    const PointCloud& cloud = surfels();
+    for (auto _ : state)
+    {
+        const PointField field(cloud, {.fit = fit});
+        benchmark::DoNotOptimize(field.estimated_area());
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * cloud.size()));
+    state.SetLabel(std::string(to_string(fit)) + ", " + std::to_string(thread_count()) +
+                   " thread(s)");
+}
+BENCHMARK(BM_FieldBuild)
+    ->Arg(static_cast<int>(PlaneFit::Raw))
+    ->Arg(static_cast<int>(PlaneFit::Blend))
+    ->Arg(static_cast<int>(PlaneFit::Quadric))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
 void BM_MarchingCubes512(benchmark::State& state)
 {
     const PointField field(surfels());

@@ -412,11 +412,13 @@ Vec3f tangent_of(const Vec3f& n)
     return n.cross(axis).normalized();
 }
 
-/// The local surface of sample i (see PackedSurfel) from its neighbours (the sample first).
-void fit_local_surface(const PointCloud& cloud, std::span<const std::uint32_t> neighbors,
-                       std::size_t i, PlaneFit fit, PackedSurfel& out)
+/// The local surface of sample i (see PackedSurfel) from its neighbours (the sample first);
+/// `positions` and `normals` are indexed like `neighbors` and i.
+void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
+                       std::span<const std::uint32_t> neighbors, std::size_t i, PlaneFit fit,
+                       PackedSurfel& out)
 {
-    const Vec3d s = cloud.positions[i].cast<double>();
+    const Vec3d s = positions[i].cast<double>();
     const Vec3d n = out.normal.cast<double>();
     const Vec3d t1 = out.tangent.cast<double>();
     const Vec3d t2 = n.cross(t1);
@@ -428,7 +430,7 @@ void fit_local_surface(const PointCloud& cloud, std::span<const std::uint32_t> n
     double mean_height = 0.0;
     for (const std::uint32_t j : neighbors)
     {
-        mean_height += (cloud.positions[j].cast<double>() - s).dot(n);
+        mean_height += (positions[j].cast<double>() - s).dot(n);
     }
     mean_height /= static_cast<double>(neighbors.size());
     out.a = static_cast<float>(mean_height);
@@ -442,9 +444,9 @@ void fit_local_surface(const PointCloud& cloud, std::span<const std::uint32_t> n
     std::size_t used = 0;
     for (const std::uint32_t j : neighbors)
     {
-        if (cloud.normals[j].dot(out.normal) > 0.5F)
+        if (normals[j].dot(out.normal) > 0.5F)
         {
-            scale2 = std::max(scale2, (cloud.positions[j].cast<double>() - s).squaredNorm());
+            scale2 = std::max(scale2, (positions[j].cast<double>() - s).squaredNorm());
             ++used;
         }
     }
@@ -458,11 +460,11 @@ void fit_local_surface(const PointCloud& cloud, std::span<const std::uint32_t> n
     Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
     for (const std::uint32_t j : neighbors)
     {
-        if (!(cloud.normals[j].dot(out.normal) > 0.5F))
+        if (!(normals[j].dot(out.normal) > 0.5F))
         {
             continue;
         }
-        const Vec3d x = (cloud.positions[j].cast<double>() - s) * inv_scale;
+        const Vec3d x = (positions[j].cast<double>() - s) * inv_scale;
         const double u = x.dot(t1);
         const double v = x.dot(t2);
         Eigen::Matrix<double, 6, 1> row;
@@ -745,49 +747,94 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
 
     // Grid cells of about twice a query's farthest neighbour, so that queries near the surface
     // find their neighbours in the 8 cells around them (PointGrid); the median is taken over
-    // a fixed subsample.
+    // a fixed subsample. The same for the fits' k neighbours, which get a grid of their own.
     const std::size_t query_k = std::min(blends(options.fit) ? options.blend_k + 1 : 9, n);
+    const std::size_t reach_k = std::max(query_k, k);
     const std::size_t stride = std::max<std::size_t>(1, n / 20000);
-    std::vector<float> reach((n + stride - 1) / stride);
-    parallel_blocks(reach.size(), 256, [&](std::size_t begin, std::size_t end) {
-        std::vector<std::uint32_t> index(query_k);
-        std::vector<float> d2(query_k);
+    const std::size_t subsample = (n + stride - 1) / stride;
+    std::vector<float> query_reach(subsample);
+    std::vector<float> fit_reach(subsample);
+    parallel_blocks(subsample, 256, [&](std::size_t begin, std::size_t end) {
+        std::vector<std::uint32_t> index(reach_k);
+        std::vector<float> d2(reach_k);
         for (std::size_t r = begin; r < end; ++r)
         {
-            m.tree.knn(m.surfels.positions[r * stride], query_k, index, d2);
-            reach[r] = d2[query_k - 1];
+            m.tree.knn(m.surfels.positions[r * stride], reach_k, index, d2);
+            query_reach[r] = d2[query_k - 1];
+            fit_reach[r] = d2[k - 1];
         }
     });
-    auto reach_middle = reach.begin() + static_cast<std::ptrdiff_t>(reach.size() / 2);
-    std::nth_element(reach.begin(), reach_middle, reach.end());
-    const float cell = grid_cell_scale * std::sqrt(*reach_middle);
-    m.grid = std::make_unique<PointGrid>(m.surfels.positions, cell > 0.0F ? cell : 1.0F, m.tree);
+    const auto grid_cell = [](std::vector<float>& reach) {
+        auto middle = reach.begin() + static_cast<std::ptrdiff_t>(reach.size() / 2);
+        std::nth_element(reach.begin(), middle, reach.end());
+        const float cell = grid_cell_scale * std::sqrt(*middle);
+        return cell > 0.0F ? cell : 1.0F;
+    };
+    m.grid = std::make_unique<PointGrid>(m.surfels.positions, grid_cell(query_reach), m.tree);
 
-    // Each sample's local surface from its k nearest, in grid order (neighbouring queries
-    // after each other), without keeping a table of every sample's neighbours.
+    // Each sample's local surface from its k nearest. The samples are taken in the order of
+    // the fits' grid (neighbouring samples after each other, which its batch queries answer
+    // fastest), and the fits read positions and normals in that order too (a sample's
+    // neighbours are then near it in memory), without keeping a table of every sample's
+    // neighbours.
+    const PointGrid fit_grid(m.surfels.positions, grid_cell(fit_reach), m.tree);
+    std::vector<Vec3f> fit_positions(fit_grid.slot_count(), Vec3f::Zero());
+    std::vector<Vec3f> fit_normals(fit_grid.slot_count(), Vec3f::Zero());
+    for (std::uint32_t slot = 0; slot < fit_grid.slot_count(); ++slot)
+    {
+        const std::uint32_t i = fit_grid.original_index(slot);
+        if (i != PointGrid::padding_slot)
+        {
+            fit_positions[slot] = m.surfels.positions[i];
+            fit_normals[slot] = m.surfels.normals[i];
+        }
+    }
     constexpr std::size_t block = 4096;
     m.packed.assign(m.grid->slot_count(), PackedSurfel{});
-    std::vector<double> block_area((m.packed.size() + block - 1) / block, 0.0);
-    parallel_blocks(m.packed.size(), block, [&](std::size_t begin, std::size_t end) {
-        std::vector<std::uint32_t> index(k);
-        std::vector<float> d2(k);
-        double area = 0.0;
+    std::vector<double> block_area((fit_grid.slot_count() + block - 1) / block, 0.0);
+    parallel_blocks(fit_grid.slot_count(), block, [&](std::size_t begin, std::size_t end) {
+        std::vector<std::uint32_t> samples; // fit-grid slots
+        std::vector<Vec3f> queries;
+        samples.reserve(end - begin);
+        queries.reserve(end - begin);
         for (std::size_t slot = begin; slot < end; ++slot)
         {
-            const std::uint32_t i = m.grid->original_index(static_cast<std::uint32_t>(slot));
-            if (i == PointGrid::padding_slot)
+            if (fit_grid.original_index(static_cast<std::uint32_t>(slot)) !=
+                PointGrid::padding_slot)
             {
-                continue;
+                samples.push_back(static_cast<std::uint32_t>(slot));
+                queries.push_back(fit_positions[slot]);
             }
-            m.tree.knn(m.surfels.positions[i], k, index, d2);
+        }
+        std::vector<std::uint32_t> slots(samples.size() * k);
+        std::vector<float> dist2(samples.size() * k);
+        std::vector<std::uint32_t> found(samples.size());
+        fit_grid.knn_nearby(queries, k, slots, dist2, found);
+        double area = 0.0;
+        for (std::size_t q = 0; q < samples.size(); ++q)
+        {
+            const std::span<std::uint32_t> neighbors(slots.data() + q * k, k);
+            const std::span<float> d2(dist2.data() + q * k, k);
+            if (found[q] != k)
+            {
+                // Too far from its neighbours for the cells around it: the kd-tree.
+                m.tree.knn(queries[q], k, neighbors, d2);
+                for (std::uint32_t& neighbor : neighbors)
+                {
+                    neighbor = fit_grid.slot_of(neighbor);
+                }
+            }
             // The ball to the last neighbour holds k samples: π d² / k of surface per sample.
             area += std::numbers::pi * static_cast<double>(d2[k - 1]) / static_cast<double>(k);
-            PackedSurfel& packed = m.packed[slot];
+            const std::uint32_t i = fit_grid.original_index(samples[q]);
+            PackedSurfel packed;
             packed.position = m.surfels.positions[i];
             packed.radius = m.surfels.radii[i];
             packed.normal = m.surfels.normals[i];
             packed.tangent = tangent_of(packed.normal);
-            fit_local_surface(m.surfels, index, i, options.fit, packed);
+            fit_local_surface(fit_positions, fit_normals, neighbors, samples[q], options.fit,
+                              packed);
+            m.packed[m.grid->slot_of(i)] = packed;
         }
         block_area[begin / block] = area;
     });

@@ -475,6 +475,10 @@ private:
                     {
                         keys_[j] = key_of(packed_d2_[j], packed_slot_[j]);
                     }
+                    // take_smallest() is baseline code: leave the upper halves of the
+                    // vector registers clean for it (GCC 12 does not here), or on some CPUs
+                    // every SSE instruction after this pass runs several times slower.
+                    _mm256_zeroupper();
                     take_smallest(keys_.data(), kept, k, slots, d2);
                 }
                 return Outcome::found;
