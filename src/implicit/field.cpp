@@ -6,7 +6,9 @@
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 
+#include <algorithm>
 #include <limits>
+#include <span>
 #include <vector>
 
 namespace pointform {
@@ -15,11 +17,18 @@ Field::~Field() = default;
 
 void Field::evaluate(std::span<const Vec3d> points, std::span<FieldSample> out) const
 {
-    // Through the batch evaluate_within(), which operators answer member by member.
+    // Through the batch evaluate_within(), which operators answer member by member, in runs
+    // that share one unbounded range (no allocation per call).
     PF_ASSERT(points.size() == out.size());
-    const std::vector<double> lo(points.size(), -std::numeric_limits<double>::infinity());
-    const std::vector<double> hi(points.size(), std::numeric_limits<double>::infinity());
-    evaluate_within(points, lo, hi, out);
+    constexpr std::size_t run = std::size_t{1} << 16;
+    static const std::vector<double> lo(run, -std::numeric_limits<double>::infinity());
+    static const std::vector<double> hi(run, std::numeric_limits<double>::infinity());
+    for (std::size_t begin = 0; begin < points.size(); begin += run)
+    {
+        const std::size_t count = std::min(run, points.size() - begin);
+        evaluate_within(points.subspan(begin, count), std::span(lo).first(count),
+                        std::span(hi).first(count), out.subspan(begin, count));
+    }
 }
 
 FieldSample Field::evaluate_within(const Vec3d& p, double /*lo*/, double /*hi*/) const

@@ -16,8 +16,10 @@
 #include <limits>
 #include <memory>
 #include <numeric>
+#include <span>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace pointform {
@@ -500,6 +502,21 @@ void evaluate_within(const Field& field, double range, std::span<const Vec3d> po
     field.evaluate_within(points, lo, hi, samples);
 }
 
+/// `evaluate` (a batch evaluation) at points[at[i]] for each i: the samples, in the order of at.
+template <class Evaluate>
+std::vector<FieldSample> evaluate_subset(std::span<const Vec3d> points,
+                                         std::span<const std::size_t> at, Evaluate&& evaluate)
+{
+    std::vector<Vec3d> gathered(at.size());
+    for (std::size_t i = 0; i < at.size(); ++i)
+    {
+        gathered[i] = points[at[i]];
+    }
+    std::vector<FieldSample> samples(at.size());
+    std::forward<Evaluate>(evaluate)(std::span<const Vec3d>(gathered), std::span(samples));
+    return samples;
+}
+
 /// The field's samples at `points`, exact where the value is within ±`range` (asked with
 /// Field::evaluate_within) and beyond it (asked again exactly, which a distance-like field
 /// near its surface never needs).
@@ -519,13 +536,9 @@ void evaluate_near_zero(const Field& field, double range, std::span<const Vec3d>
     {
         return;
     }
-    std::vector<Vec3d> again(beyond.size());
-    std::vector<FieldSample> exact(beyond.size());
-    for (std::size_t j = 0; j < beyond.size(); ++j)
-    {
-        again[j] = points[beyond[j]];
-    }
-    field.evaluate(again, exact);
+    const std::vector<FieldSample> exact = evaluate_subset(
+        points, beyond,
+        [&](std::span<const Vec3d> at, std::span<FieldSample> out) { field.evaluate(at, out); });
     for (std::size_t j = 0; j < beyond.size(); ++j)
     {
         samples[beyond[j]] = exact[j];
@@ -858,7 +871,8 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
     // its position) stays where it was evaluated, and keeps that sample's gradient as its normal.
     const double settled_value = 1e-7 * grid.cell;
     std::vector<std::uint8_t> settled(nv, 0);
-    std::vector<Vec3d> settled_gradient(nv, Vec3d::Zero());
+    // Each vertex's normal: a settled vertex's from its last sample, the others' evaluated last.
+    std::vector<Vec3d> vertex_gradient(nv, Vec3d::Zero());
     std::vector<std::size_t> active(nv);
     std::iota(active.begin(), active.end(), std::size_t{0});
     for (int step = 0; step < options.refine_steps && !active.empty(); ++step)
@@ -886,7 +900,7 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
             if (std::abs(s.value) <= settled_value)
             {
                 settled[v] = 1;
-                settled_gradient[v] = s.gradient;
+                vertex_gradient[v] = s.gradient;
                 continue;
             }
             active[kept++] = v;
@@ -943,22 +957,19 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
                 unsettled.push_back(v);
             }
         }
-        std::vector<Vec3d> at(unsettled.size());
-        samples.resize(unsettled.size());
-        for (std::size_t i = 0; i < unsettled.size(); ++i)
-        {
-            at[i] = points[unsettled[i]];
-        }
-        evaluate_near_zero(field, exact_range, at, samples);
+        const std::vector<FieldSample> at_vertices = evaluate_subset(
+            points, unsettled, [&](std::span<const Vec3d> at, std::span<FieldSample> out) {
+                evaluate_near_zero(field, exact_range, at, out);
+            });
         stats.field_evaluations += unsettled.size();
         for (std::size_t i = 0; i < unsettled.size(); ++i)
         {
-            settled_gradient[unsettled[i]] = samples[i].gradient;
+            vertex_gradient[unsettled[i]] = at_vertices[i].gradient;
         }
         mesh.vertices.normals.resize(nv);
         for (std::size_t v = 0; v < nv; ++v)
         {
-            const Vec3d g = settled_gradient[v];
+            const Vec3d g = vertex_gradient[v];
             const double norm = g.norm();
             mesh.vertices.normals[v] =
                 norm > 0.0 && std::isfinite(norm) ? Vec3f((g / norm).cast<float>()) : Vec3f::Zero();
