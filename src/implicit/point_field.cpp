@@ -288,13 +288,14 @@ struct PointField::Impl
     /// point grid to answer (knn_nearby() would find none).
     [[nodiscard]] bool maybe_nearby(const Vec3d& p, const FarField* far_data) const;
     /// The field at `p` (relative to the origin; `query` is it in floats) given what the point
-    /// grid's knn_nearby() found there: `found` (0 if it was not asked) neighbours in `slot`
-    /// and `dist2`, which have room for wanted() and may be overwritten.
-    /// Above `hi`, a far value may be any bound above it (Field::evaluate_within).
-    [[nodiscard]] FieldSample evaluate_with(
-        const Vec3d& p, const Vec3f& query, const FarField* far_data, std::size_t found,
-        std::uint32_t* slot, float* dist2,
-        double hi = std::numeric_limits<double>::infinity()) const;
+    /// grid's knn_nearby() found there: `found` (0 if it was not asked, or found none)
+    /// neighbours in `slot` and `dist2`, which have room for wanted() and may be overwritten.
+    /// `nearby`: whether maybe_nearby() holds at `p`. Above `hi`, a far value may be any bound
+    /// above it (Field::evaluate_within).
+    [[nodiscard]] FieldSample evaluate_with(const Vec3d& p, const Vec3f& query,
+                                            const FarField* far_data, bool nearby,
+                                            std::size_t found, std::uint32_t* slot, float* dist2,
+                                            double hi) const;
 
     /// The value at `p` (relative to the origin) where the far grid proves that no influence
     /// ball reaches and every candidate sample's surface puts `p` inside; false (and `out`
@@ -615,8 +616,9 @@ bool PointField::Impl::maybe_nearby(const Vec3d& p, const FarField* far_data) co
 }
 
 FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
-                                            const FarField* far_data, std::size_t found,
-                                            std::uint32_t* slot, float* dist2, double hi) const
+                                            const FarField* far_data, bool nearby,
+                                            std::size_t found, std::uint32_t* slot, float* dist2,
+                                            double hi) const
 {
     const Impl& m = *this;
     FieldSample out;
@@ -666,9 +668,15 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
         // closed scan the samples are all about equally far, and an exact search visits most.
         // The far grid's representatives around p (once built) give a start whose distance
         // bounds the search from the first node, which skips most of the tree.
+        // Near the samples the point grid finds the nearest exactly, in a few of its cells,
+        // where it could not find all wanted() neighbours.
         float nearest_d2 = 0.0F;
-        const std::uint32_t index = m.nearly_nearest(cell, query, nearest_d2);
-        const PackedSurfel& nearest = m.packed[m.grid->slot_of(index)];
+        std::array<std::uint32_t, 1> nearest_slot{};
+        if (!nearby || m.grid->knn_nearby(query, 1, nearest_slot, std::span(&nearest_d2, 1)) == 0)
+        {
+            nearest_slot[0] = m.grid->slot_of(m.nearly_nearest(cell, query, nearest_d2));
+        }
+        const PackedSurfel& nearest = m.packed[nearest_slot[0]];
         const double reach = m.max_radius * static_cast<double>(far_distance_factor);
         if (static_cast<double>(nearest_d2) > reach * reach)
         {
@@ -740,12 +748,13 @@ FieldSample PointField::evaluate_within(const Vec3d& world_point, double /*lo*/,
     const std::size_t want = m.wanted();
     const FarField* far = m.far_built.load(std::memory_order_acquire);
     std::size_t found = 0;
-    if (m.maybe_nearby(p, far))
+    const bool nearby = m.maybe_nearby(p, far);
+    if (nearby)
     {
         found = m.grid->knn_nearby(query, want, std::span(slot.data(), want),
                                    std::span(dist2.data(), want));
     }
-    return m.evaluate_with(p, query, far, found, slot.data(), dist2.data(), hi);
+    return m.evaluate_with(p, query, far, nearby, found, slot.data(), dist2.data(), hi);
 }
 
 double PointField::cost() const
@@ -815,16 +824,16 @@ void PointField::evaluate_batch(std::span<const Vec3d> points, std::span<const d
                     }
                 }
 #endif
-                out[begin + i] =
-                    m.evaluate_with(local[i], query, far, found[next], slots.data() + next * want,
-                                    dist2.data() + next * want, hi.empty() ? inf : hi[begin + i]);
+                out[begin + i] = m.evaluate_with(
+                    local[i], query, far, true, found[next], slots.data() + next * want,
+                    dist2.data() + next * want, hi.empty() ? inf : hi[begin + i]);
                 ++next;
             }
             else
             {
                 out[begin + i] =
-                    m.evaluate_with(local[i], query, far, 0, none_slot.data(), none_dist2.data(),
-                                    hi.empty() ? inf : hi[begin + i]);
+                    m.evaluate_with(local[i], query, far, false, 0, none_slot.data(),
+                                    none_dist2.data(), hi.empty() ? inf : hi[begin + i]);
             }
         }
     });
