@@ -181,28 +181,32 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
     face_count_ = f_count;
     const std::size_t leaf_size = options.leaf_size == 0 ? 4 : options.leaf_size;
 
-    std::vector<Corners> corners(f_count);
+    // Each triangle's box and centroid (the corners are read again, in leaf order, at the end).
+    const auto corners_of = [&mesh](std::size_t f) {
+        const auto& t = mesh.triangles[f];
+        return Corners{mesh.vertices.positions[t[0]].cast<double>(),
+                       mesh.vertices.positions[t[1]].cast<double>(),
+                       mesh.vertices.positions[t[2]].cast<double>()};
+    };
     std::vector<Aabb> boxes(f_count);
     std::vector<Vec3d> centroids(f_count);
-    for (std::size_t f = 0; f < f_count; ++f)
-    {
-        const auto& t = mesh.triangles[f];
-        Corners& k = corners[f];
-        k.a = mesh.vertices.positions[t[0]].cast<double>();
-        k.b = mesh.vertices.positions[t[1]].cast<double>();
-        k.c = mesh.vertices.positions[t[2]].cast<double>();
-        boxes[f].extend(k.a);
-        boxes[f].extend(k.b);
-        boxes[f].extend(k.c);
-        centroids[f] = (k.a + k.b + k.c) / 3.0;
-    }
+    parallel_blocks(f_count, 16384, [&](std::size_t first, std::size_t last) {
+        for (std::size_t f = first; f < last; ++f)
+        {
+            const Corners k = corners_of(f);
+            boxes[f].extend(k.a);
+            boxes[f].extend(k.b);
+            boxes[f].extend(k.c);
+            centroids[f] = (k.a + k.b + k.c) / 3.0;
+        }
+    });
 
     std::vector<std::uint32_t> order(f_count);
     for (std::size_t f = 0; f < f_count; ++f)
         order[f] = static_cast<std::uint32_t>(f);
     nodes_.reserve(2 * f_count / leaf_size + 1);
 
-    const auto make_node = [&](std::size_t begin, std::size_t end) {
+    const auto make_node = [&](std::size_t begin, std::size_t end, std::vector<Node>& out) {
         Aabb box;
         for (std::size_t i = begin; i < end; ++i)
         {
@@ -216,7 +220,7 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
             node.lo[slot] = round_down(box.min[axis]);
             node.hi[slot] = round_up(box.max[axis]);
         }
-        nodes_.push_back(node);
+        out.push_back(node);
     };
 
     // Returns the split position in [begin, end), or begin if the range should be a leaf.
@@ -316,48 +320,140 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
         return static_cast<std::size_t>(it - order.begin());
     };
 
-    // Depth-first build with an explicit stack of pending right children.
-    struct Pending
+    // Depth-first build of the range's subtree into `out` (a right child's index relative to
+    // out's start), with an explicit stack of pending right children.
+    const auto build_subtree = [&](std::size_t first, std::size_t last, int first_depth,
+                                   std::vector<Node>& out) {
+        struct Pending
+        {
+            std::size_t begin;
+            std::size_t end;
+            int depth;
+            std::size_t parent; ///< node whose right child this range becomes; npos for the root
+        };
+        constexpr std::size_t no_parent = std::numeric_limits<std::size_t>::max();
+        std::vector<Pending> pending;
+        pending.push_back({first, last, first_depth, no_parent});
+        while (!pending.empty())
+        {
+            Pending range = pending.back();
+            pending.pop_back();
+            // Descend the left spine of this range, pushing right halves.
+            for (;;)
+            {
+                const std::size_t node_index = out.size();
+                if (range.parent != no_parent)
+                {
+                    out[range.parent].index = static_cast<std::uint32_t>(node_index);
+                    range.parent = no_parent;
+                }
+                make_node(range.begin, range.end, out);
+                const std::size_t mid = split(range.begin, range.end, range.depth);
+                if (mid == range.begin || mid == range.end)
+                {
+                    out[node_index].index = static_cast<std::uint32_t>(range.begin);
+                    out[node_index].count = static_cast<std::uint32_t>(range.end - range.begin);
+                    break;
+                }
+                out[node_index].count = 0;
+                pending.push_back({mid, range.end, range.depth + 1, node_index});
+                range = {range.begin, mid, range.depth + 1, no_parent};
+            }
+        }
+    };
+
+    // The top levels are split first, one range after another; the subtrees below them are
+    // built in parallel and laid out after their parents in depth-first order. Each range is
+    // split as the sequential build splits it, so the tree is the same whatever the thread count.
+    struct Top
     {
         std::size_t begin;
         std::size_t end;
         int depth;
-        std::size_t parent; ///< node whose right child this range becomes; npos for the root
+        std::size_t left = 0;    ///< index in `tops`, for an inner node
+        std::size_t right = 0;   ///< index in `tops`, for an inner node
+        std::size_t subtree = 0; ///< index in `subtrees` + 1, or 0 for an inner node or a leaf
+        bool leaf = false;
     };
-    constexpr std::size_t no_parent = std::numeric_limits<std::size_t>::max();
-    std::vector<Pending> pending;
-    pending.push_back({0, f_count, 0, no_parent});
-    while (!pending.empty())
-    {
-        Pending range = pending.back();
-        pending.pop_back();
-        // Descend the left spine of this range, pushing right halves.
-        for (;;)
+    std::vector<Top> tops;
+    // Subtrees of at most this many triangles, or below this depth, are built in parallel.
+    constexpr std::size_t subtree_triangles = 16384;
+    constexpr int top_depth = 6;
+    const auto split_top = [&](const auto& self, std::size_t begin, std::size_t end,
+                               int depth) -> std::size_t {
+        const std::size_t at = tops.size();
+        tops.push_back({begin, end, depth});
+        if (end - begin <= subtree_triangles || depth >= top_depth)
         {
-            const std::size_t node_index = nodes_.size();
-            if (range.parent != no_parent)
-            {
-                nodes_[range.parent].index = static_cast<std::uint32_t>(node_index);
-                range.parent = no_parent;
-            }
-            make_node(range.begin, range.end);
-            const std::size_t mid = split(range.begin, range.end, range.depth);
-            if (mid == range.begin || mid == range.end)
-            {
-                nodes_[node_index].index = static_cast<std::uint32_t>(range.begin);
-                nodes_[node_index].count = static_cast<std::uint32_t>(range.end - range.begin);
-                break;
-            }
-            nodes_[node_index].count = 0;
-            pending.push_back({mid, range.end, range.depth + 1, node_index});
-            range = {range.begin, mid, range.depth + 1, no_parent};
+            tops[at].subtree = 1; // numbered below, in depth-first order
+            return at;
+        }
+        const std::size_t mid = split(begin, end, depth);
+        if (mid == begin || mid == end)
+        {
+            tops[at].leaf = true;
+            return at;
+        }
+        const std::size_t left = self(self, begin, mid, depth + 1);
+        const std::size_t right = self(self, mid, end, depth + 1);
+        tops[at].left = left;
+        tops[at].right = right;
+        return at;
+    };
+    split_top(split_top, 0, f_count, 0);
+    std::vector<std::size_t> roots;
+    for (std::size_t t = 0; t < tops.size(); ++t)
+    {
+        if (tops[t].subtree != 0)
+        {
+            roots.push_back(t);
+            tops[t].subtree = roots.size();
         }
     }
+    std::vector<std::vector<Node>> subtrees(roots.size());
+    parallel_blocks(roots.size(), 1, [&](std::size_t first, std::size_t last) {
+        for (std::size_t r = first; r < last; ++r)
+        {
+            const Top& top = tops[roots[r]];
+            build_subtree(top.begin, top.end, top.depth, subtrees[r]);
+        }
+    });
+    const auto emit = [&](const auto& self, std::size_t t) -> void {
+        const Top& top = tops[t];
+        if (top.subtree != 0)
+        {
+            const auto offset = static_cast<std::uint32_t>(nodes_.size());
+            for (Node node : subtrees[top.subtree - 1])
+            {
+                if (node.count == 0)
+                {
+                    node.index += offset;
+                }
+                nodes_.push_back(node);
+            }
+            return;
+        }
+        const std::size_t node_index = nodes_.size();
+        make_node(top.begin, top.end, nodes_);
+        if (top.leaf)
+        {
+            nodes_[node_index].index = static_cast<std::uint32_t>(top.begin);
+            nodes_[node_index].count = static_cast<std::uint32_t>(top.end - top.begin);
+            return;
+        }
+        nodes_[node_index].count = 0;
+        self(self, top.left);
+        nodes_[node_index].index = static_cast<std::uint32_t>(nodes_.size());
+        self(self, top.right);
+    };
+    emit(emit, 0);
 
     corners_.resize(f_count);
     face_ids_ = std::move(order);
-    for (std::size_t i = 0; i < f_count; ++i)
-        corners_[i] = corners[face_ids_[i]];
+    parallel_blocks(f_count, 16384, [&](std::size_t first, std::size_t last) {
+        for (std::size_t i = first; i < last; ++i)
+            corners_[i] = corners_of(face_ids_[i]);
+    });
 }
 
 Aabb TriangleBvh::bounds() const
