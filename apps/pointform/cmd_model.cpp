@@ -6,25 +6,100 @@
 #include "pointform/geometry/mesh_topology.h"
 #include "pointform/implicit/scene.h"
 #include "pointform/io/io.h"
+#include "pointform/polygonize/base_mesh.h"
 #include "pointform/polygonize/marching_cubes.h"
+#include "pointform/polygonize/refine.h"
 
 #include "common.h"
 #include "scene_input.h"
+#include "semi_regular.h"
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
+#include <vector>
 
 namespace pointform::cli {
 namespace {
+
+/// Levels of `model --semi-regular` without --levels (a modeled surface has no samples over all
+/// of it for the §5.2.4 stop), and the base mesh's share of the marching-cubes faces without
+/// --base-faces: two levels give each base face 16, so the output keeps the marching-cubes
+/// resolution. Coarser base meshes lose the sharp edges of Booleans (on the README's bunny cut,
+/// 1/64 of the faces tore the cut face of the head; 1/16 keeps it).
+constexpr long long default_model_levels = 2;
+constexpr std::size_t default_model_base_share = 16;
 
 struct ModelCommandOptions
 {
     std::string input;
     std::string output;
     SceneCommandOptions scene;
+    bool semi_regular = false;
+    SemiRegularOptions refine; ///< with --semi-regular; its --ascii and --json are the scene's
 };
+
+/// The semi-regular polygonization of `model` (§5 on the scene's field): the marching-cubes mesh
+/// simplified to a base mesh, then refined level by level with every new vertex projected onto
+/// the zero set of the whole scene.
+struct ModelSemiRegular
+{
+    MultiresMesh hierarchy;
+    TriMesh finest; ///< the finest level, as written
+    BaseMeshStats base;
+    std::vector<RefineLevelStats> levels;
+    /// |f| at the output's vertices where the field is defined: how near the zero set they lie.
+    double max_residual = 0.0;
+    double mean_residual = 0.0;
+};
+
+ModelSemiRegular semi_regular_model(const TriMesh& intermediate, const Field& field,
+                                    const SemiRegularOptions& options,
+                                    const ProgressCallback& progress, Timings& timings)
+{
+    const auto levels = static_cast<std::size_t>(options.levels.value_or(default_model_levels));
+    const std::size_t target =
+        options.base_faces
+            ? base_face_target(options, intermediate)
+            : std::min(intermediate.face_count(),
+                       std::clamp<std::size_t>(intermediate.face_count() / default_model_base_share,
+                                               200, 20000));
+    check_refinement_memory(target, levels);
+    BaseMeshResult built =
+        build_base_mesh(intermediate, field, {.target_faces = target, .progress = progress});
+    timings.lap("base mesh");
+    ModelSemiRegular out{MultiresMesh(built.mesh), {}, built.stats, {}, 0.0, 0.0};
+    const RefineOptions refine_options = refine_options_of(options, progress);
+    for (std::size_t level = 0; level < levels; ++level)
+    {
+        out.levels.push_back(refine_once(out.hierarchy, field, refine_options));
+    }
+    timings.lap("refinement");
+    out.finest = out.hierarchy.level_mesh(out.hierarchy.finest_level());
+    std::vector<Vec3d> at(out.finest.vertex_count());
+    for (std::size_t v = 0; v < at.size(); ++v)
+    {
+        at[v] = out.finest.vertices.world(v);
+    }
+    std::vector<FieldSample> samples(at.size());
+    field.evaluate(at, samples);
+    std::size_t defined = 0;
+    for (const FieldSample& sample : samples)
+    {
+        if (sample.defined && std::isfinite(sample.value))
+        {
+            out.max_residual = std::max(out.max_residual, std::abs(sample.value));
+            out.mean_residual += std::abs(sample.value);
+            ++defined;
+        }
+    }
+    out.mean_residual = defined > 0 ? out.mean_residual / static_cast<double>(defined) : 0.0;
+    return out;
+}
 
 nlohmann::json box_json(const Aabb& box)
 {
@@ -53,9 +128,21 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
             "polygonized box, or the field is undefined there (check --bounds, try a "
             "smaller --cell or a larger --radius-scale)");
     }
-    write_mesh(options.output, result.mesh, {.ascii = options.scene.ascii});
+    std::optional<ModelSemiRegular> semi;
+    if (options.semi_regular)
+    {
+        SemiRegularOptions refine = options.refine;
+        refine.ascii = options.scene.ascii;
+        semi = semi_regular_model(result.mesh, *scene.field, refine, progress.callback(), timings);
+        write_semi_regular(options.output, refine, semi->hierarchy);
+    }
+    else
+    {
+        write_mesh(options.output, result.mesh, {.ascii = options.scene.ascii});
+    }
     timings.lap("write");
-    const MeshTopology topo = analyze_topology(result.mesh);
+    const TriMesh& written = semi ? semi->finest : result.mesh;
+    const MeshTopology topo = analyze_topology(written);
     progress.clear();
 
     if (options.scene.json)
@@ -77,8 +164,30 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
         out["bounds"] = box_json(grid.box);
         out["cell"] = grid.cell;
         out["grid_cells"] = grid.grid.cells;
-        out["vertices"] = result.mesh.vertex_count();
-        out["faces"] = result.mesh.face_count();
+        out["polygonization"] = semi ? "semi-regular" : "marching cubes";
+        if (semi)
+        {
+            out["marching_cubes_faces"] = result.mesh.face_count();
+            out["base_mesh"] = base_mesh_json(semi->base);
+            nlohmann::json levels = nlohmann::json::array();
+            for (const RefineLevelStats& level : semi->levels)
+            {
+                levels.push_back({{"level", level.level},
+                                  {"faces", level.faces},
+                                  {"unprojected", level.unprojected},
+                                  {"folded_faces", level.folded_faces},
+                                  {"seconds", level.seconds}});
+            }
+            out["levels"] = levels;
+            out["max_abs_field_at_vertices"] = semi->max_residual;
+            out["mean_abs_field_at_vertices"] = semi->mean_residual;
+            if (!options.refine.save_hierarchy.empty())
+            {
+                out["hierarchy"] = options.refine.save_hierarchy;
+            }
+        }
+        out["vertices"] = written.vertex_count();
+        out["faces"] = written.face_count();
         out["components"] = topo.components;
         out["boundary_loops"] = topo.boundary_loops;
         out["euler_characteristic"] = topo.euler_characteristic;
@@ -110,8 +219,28 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
                           std::to_string(grid.grid.cells[2]) + " over a box of " +
                           format_number(size.x()) + " x " + format_number(size.y()) + " x " +
                           format_number(size.z()) + ")");
-    print_row("vertices", std::to_string(result.mesh.vertex_count()));
-    print_row("faces", std::to_string(result.mesh.face_count()));
+    if (semi)
+    {
+        print_row("marching cubes", std::to_string(result.mesh.face_count()) + " faces");
+        print_base_mesh(semi->base);
+        for (const RefineLevelStats& level : semi->levels)
+        {
+            print_row("level " + std::to_string(level.level),
+                      std::to_string(level.faces) + " faces, " + std::to_string(level.unprojected) +
+                          " vertices left unprojected, " + std::to_string(level.folded_faces) +
+                          " folded faces");
+        }
+        print_row("|f| at the vertices", "max " + format_number(semi->max_residual) + ", mean " +
+                                             format_number(semi->mean_residual) +
+                                             " (where the field is defined)");
+        if (!options.refine.save_hierarchy.empty())
+        {
+            print_row("hierarchy", options.refine.save_hierarchy + " (" +
+                                       std::to_string(semi->hierarchy.level_count()) + " levels)");
+        }
+    }
+    print_row("vertices", std::to_string(written.vertex_count()));
+    print_row("faces", std::to_string(written.face_count()));
     print_row("components", std::to_string(topo.components));
     print_row("boundary loops", std::to_string(topo.boundary_loops));
     print_row("Euler characteristic", std::to_string(topo.euler_characteristic));
@@ -130,7 +259,8 @@ void register_model(CLI::App& app, const GlobalOptions& global)
     CLI::App* cmd = app.add_subcommand(
         "model",
         "Level 2 modeling: builds a scene of scans, primitives and operators (Boolean, blend, "
-        "offset, shell, morph, transforms; paper §4.2) and polygonizes it with marching cubes");
+        "offset, shell, morph, transforms; paper §4.2) and polygonizes it with marching cubes, "
+        "or with the semi-regular mesh of §5");
     cmd->add_option("scene", options->input,
                     "A scene expression, e.g. 'difference(scan(\"bunny.ply\"), sphere([0,0.1,0], "
                     "0.03))', or a file: a scene file (any extension but a point format's; "
@@ -138,6 +268,22 @@ void register_model(CLI::App& app, const GlobalOptions& global)
         ->required();
     cmd->add_option("-o,--output", options->output, "Output mesh (.ply, .obj or .off)")->required();
     add_scene_command_options(*cmd, options->scene);
+    CLI::Option* semi = cmd->add_flag(
+        "--semi-regular", options->semi_regular,
+        "Polygonize with the semi-regular multiresolution mesh (§5) instead of marching cubes: "
+        "the marching-cubes mesh simplified to a base mesh, then refined by 1-to-4 splits with "
+        "every new vertex projected onto the scene's surface, to --levels J");
+    std::vector<CLI::Option*> refine = add_level_options(
+        *cmd, options->refine,
+        "With --semi-regular: refine exactly to level J (0 = the base mesh only; default " +
+            std::to_string(default_model_levels) + ")");
+    refine.push_back(add_base_faces_option(*cmd, options->refine)
+                         ->description("With --semi-regular: faces of the base mesh (default: the "
+                                       "marching-cubes mesh's faces / 16, within [200, 20000])"));
+    for (CLI::Option* option : refine)
+    {
+        option->needs(semi);
+    }
     std::string functions;
     const std::string summary = scene_function_summary();
     std::size_t start = 0;

@@ -148,33 +148,53 @@ CLI::Validator levels_range()
 
 void add_refine_options(CLI::App& cmd, SemiRegularOptions& options)
 {
-    cmd.add_option("--levels", options.levels,
-                   "Refine exactly to level J (0 = the base mesh only); default: until the "
-                   "one-sided Hausdorff distance from the samples is below the sampling density "
-                   "(at most level " +
-                       std::to_string(default_max_level) + ")")
-        ->check(levels_range());
-    cmd.add_option("--predictor", options.predictor,
-                   "Where a new edge vertex starts before its projection onto the surface: "
-                   "midpoint, or butterfly (the displaced butterfly subdivision)")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"midpoint", "butterfly"}));
-    cmd.add_option("--relax", options.relax,
-                   "Rounds of tangential relaxation of the new vertices per level (§5.2.3), each "
-                   "followed by their re-projection; 0 keeps the projected predictions")
-        ->capture_default_str()
-        ->check(CLI::Range(0, 10));
-    cmd.add_option("--relaxation", options.relaxation,
-                   "Which part of the umbrella move relaxation makes: across (the part across "
-                   "the parent edge, which keeps the split ratio) or umbrella (all of it, as in "
-                   "the paper)")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"across", "umbrella"}));
-    cmd.add_option("--save-hierarchy", options.save_hierarchy,
-                   "Also write every level as a hierarchy file (.pfh; extract levels with "
-                   "`pointform lod`)");
+    add_level_options(cmd, options,
+                      "Refine exactly to level J (0 = the base mesh only); default: until the "
+                      "one-sided Hausdorff distance from the samples is below the sampling "
+                      "density (at most level " +
+                          std::to_string(default_max_level) + ")");
     cmd.add_flag("--ascii", options.ascii, "Write ascii PLY instead of binary");
     cmd.add_flag("--json", options.json, "Print the report as JSON");
+}
+
+std::vector<CLI::Option*> add_level_options(CLI::App& cmd, SemiRegularOptions& options,
+                                            const std::string& levels_help)
+{
+    std::vector<CLI::Option*> added;
+    added.push_back(cmd.add_option("--levels", options.levels, levels_help)->check(levels_range()));
+    added.push_back(
+        cmd.add_option("--predictor", options.predictor,
+                       "Where a new edge vertex starts before its projection onto the surface: "
+                       "midpoint, or butterfly (the displaced butterfly subdivision)")
+            ->capture_default_str()
+            ->check(CLI::IsMember({"midpoint", "butterfly"})));
+    added.push_back(
+        cmd.add_option("--relax", options.relax,
+                       "Rounds of tangential relaxation of the new vertices per level (§5.2.3), "
+                       "each followed by their re-projection; 0 keeps the projected predictions")
+            ->capture_default_str()
+            ->check(CLI::Range(0, 10)));
+    added.push_back(
+        cmd.add_option("--relaxation", options.relaxation,
+                       "Which part of the umbrella move relaxation makes: across (the part "
+                       "across the parent edge, which keeps the split ratio) or umbrella (all of "
+                       "it, as in the paper)")
+            ->capture_default_str()
+            ->check(CLI::IsMember({"across", "umbrella"})));
+    added.push_back(cmd.add_option("--save-hierarchy", options.save_hierarchy,
+                                   "Also write every level as a hierarchy file (.pfh; extract "
+                                   "levels with `pointform lod`)"));
+    return added;
+}
+
+RefineOptions refine_options_of(const SemiRegularOptions& options, ProgressCallback progress)
+{
+    RefineOptions refine_options;
+    refine_options.predictor = parse_predictor(options.predictor);
+    refine_options.relax_iterations = options.relax;
+    refine_options.relaxation = parse_relaxation(options.relaxation);
+    refine_options.progress = std::move(progress);
+    return refine_options;
 }
 
 CLI::Option* add_base_faces_option(CLI::App& cmd, SemiRegularOptions& options)
@@ -270,11 +290,7 @@ SemiRegularResult refine_semi_regular(const TriMesh& base, const PointField& fie
     r.predictor = options.predictor;
     r.relaxation = options.relaxation;
     r.relax_rounds = options.relax;
-    RefineOptions refine_options;
-    refine_options.predictor = parse_predictor(options.predictor);
-    refine_options.relax_iterations = options.relax;
-    refine_options.relaxation = parse_relaxation(options.relaxation);
-    refine_options.progress = progress;
+    RefineOptions refine_options = refine_options_of(options, progress);
     const std::size_t base_faces = base.face_count();
     if (options.levels)
     {

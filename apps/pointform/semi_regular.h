@@ -19,6 +19,7 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace pointform::cli {
 
@@ -42,6 +43,13 @@ struct SemiRegularOptions
 
 /// Adds --levels, --predictor, --relax, --relaxation, --save-hierarchy, --ascii and --json.
 void add_refine_options(CLI::App& cmd, SemiRegularOptions& options);
+/// Adds --levels (with `levels_help`), --predictor, --relax, --relaxation and --save-hierarchy.
+/// \return the options added
+std::vector<CLI::Option*> add_level_options(CLI::App& cmd, SemiRegularOptions& options,
+                                            const std::string& levels_help);
+/// \brief The refinement options that --predictor, --relax and --relaxation ask for.
+[[nodiscard]] RefineOptions refine_options_of(const SemiRegularOptions& options,
+                                              ProgressCallback progress);
 /// Adds --base-faces. \return the option, for excludes()
 CLI::Option* add_base_faces_option(CLI::App& cmd, SemiRegularOptions& options);
 

@@ -46,12 +46,11 @@ int main(int argc, char** argv)
             std::fprintf(stderr, "mesh_distance: cannot write %s\n", argv[3]);
             return 3;
         }
-        std::printf("{\"points\": %zu, \"triangles\": %zu, \"build_s\": %.6f, \"query_s\": %.6f, "
-                    "\"threads\": %d}\n",
-                    points.size(), mesh.face_count(),
-                    std::chrono::duration<double>(built - start).count(),
-                    std::chrono::duration<double>(done - built).count(),
-                    pointform::thread_count());
+        std::printf(
+            "{\"points\": %zu, \"triangles\": %zu, \"build_s\": %.6f, \"query_s\": %.6f, "
+            "\"threads\": %d}\n",
+            points.size(), mesh.face_count(), std::chrono::duration<double>(built - start).count(),
+            std::chrono::duration<double>(done - built).count(), pointform::thread_count());
     }
     catch (const std::exception& e)
     {

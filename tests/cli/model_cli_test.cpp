@@ -70,6 +70,64 @@ TEST(ModelCli, UnionOfTwoSpheresIsOneClosedSphere)
     }
 }
 
+TEST(ModelCli, SemiRegularUnionOfTwoSpheresLiesOnTheSpheres)
+{
+    test::TempDir dir;
+    const auto output = dir / "spheres.ply";
+    const auto hierarchy = dir / "spheres.pfh";
+    const auto r = run("model 'union(sphere([0,0,0], 1), sphere([1.2,0,0], 0.8))' -o " +
+                       quoted(output) + " --semi-regular --base-faces 500 --levels 2 " +
+                       "--save-hierarchy " + quoted(hierarchy) + " --json");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const auto report = nlohmann::json::parse(r.out);
+    EXPECT_EQ(report["polygonization"].get<std::string>(), "semi-regular");
+    ASSERT_EQ(report["levels"].size(), 2U);
+    // Every level splits every face in four; the base mesh has about the faces asked for.
+    const auto base = report["base_mesh"]["faces"].get<std::size_t>();
+    EXPECT_NEAR(static_cast<double>(base), 500.0, 10.0);
+    EXPECT_EQ(report["faces"].get<std::size_t>(), 16 * base);
+    EXPECT_EQ(report["components"].get<int>(), 1);
+    EXPECT_EQ(report["boundary_loops"].get<int>(), 0);
+    EXPECT_EQ(report["euler_characteristic"].get<int>(), 2);
+    const TriMesh mesh = read_mesh(output);
+    EXPECT_EQ(mesh.face_count(), 16 * base);
+    const MeshTopology topo = analyze_topology(mesh);
+    EXPECT_TRUE(topo.is_oriented_manifold());
+    EXPECT_TRUE(topo.is_closed());
+    // Every new vertex is projected onto the zero set: on the spheres away from the crease
+    // where they meet, within a quarter cell next to it (where the base mesh keeps the
+    // marching-cubes vertices of the kink).
+    const double cell = report["cell"].get<double>();
+    const double worst = max_vertex_distance(mesh, [](const Vec3d& p) {
+        return std::min(p.norm() - 1.0, (p - Vec3d(1.2, 0, 0)).norm() - 0.8);
+    });
+    EXPECT_LT(worst, 0.25 * cell);
+    EXPECT_LT(report["max_abs_field_at_vertices"].get<double>(), 0.25 * cell);
+    EXPECT_LT(report["mean_abs_field_at_vertices"].get<double>(), 1e-3 * cell);
+    // The hierarchy holds the base mesh and both levels.
+    const auto lod = run("lod " + quoted(hierarchy) + " --json");
+    ASSERT_EQ(lod.exit_code, 0) << lod.out;
+    const auto levels = nlohmann::json::parse(lod.out)["levels"];
+    ASSERT_EQ(levels.size(), 3U);
+    EXPECT_EQ(levels[0]["faces"].get<std::size_t>(), base);
+    EXPECT_EQ(levels[2]["faces"].get<std::size_t>(), 16 * base);
+}
+
+TEST(ModelCli, RefinementOptionsNeedSemiRegular)
+{
+    test::TempDir dir;
+    const auto output = dir / "x.ply";
+    const auto r = run("model 'sphere([0,0,0], 1)' -o " + quoted(output) + " --levels 2");
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.out.find("--semi-regular"), std::string::npos) << r.out;
+    EXPECT_FALSE(std::filesystem::exists(output));
+    const auto huge = run("model 'sphere([0,0,0], 1)' -o " + quoted(output) +
+                          " --semi-regular --base-faces 999999999");
+    EXPECT_NE(huge.exit_code, 0);
+    EXPECT_NE(huge.out.find("--base-faces"), std::string::npos) << huge.out;
+    EXPECT_FALSE(std::filesystem::exists(output));
+}
+
 TEST(ModelCli, DrilledRoundedBoxHasGenusOne)
 {
     test::TempDir dir;
