@@ -62,12 +62,7 @@ ModelSemiRegular semi_regular_model(const TriMesh& intermediate, const Field& fi
                                     const ProgressCallback& progress, Timings& timings)
 {
     const auto levels = static_cast<std::size_t>(options.levels.value_or(default_model_levels));
-    const std::size_t target =
-        options.base_faces
-            ? base_face_target(options, intermediate)
-            : std::min(intermediate.face_count(),
-                       std::clamp<std::size_t>(intermediate.face_count() / default_model_base_share,
-                                               200, 20000));
+    const std::size_t target = base_face_target(options, intermediate, default_model_base_share);
     check_refinement_memory(target, levels);
     BaseMeshResult built =
         build_base_mesh(intermediate, field, {.target_faces = target, .progress = progress});
@@ -277,9 +272,11 @@ void register_model(CLI::App& app, const GlobalOptions& global)
         *cmd, options->refine,
         "With --semi-regular: refine exactly to level J (0 = the base mesh only; default " +
             std::to_string(default_model_levels) + ")");
-    refine.push_back(add_base_faces_option(*cmd, options->refine)
-                         ->description("With --semi-regular: faces of the base mesh (default: the "
-                                       "marching-cubes mesh's faces / 16, within [200, 20000])"));
+    refine.push_back(
+        add_base_faces_option(*cmd, options->refine)
+            ->description(
+                "With --semi-regular: faces of the base mesh (default: the "
+                "marching-cubes mesh's faces / 16, within [max(8 per component, 200), 20000])"));
     for (CLI::Option* option : refine)
     {
         option->needs(semi);

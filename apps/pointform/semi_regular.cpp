@@ -221,11 +221,12 @@ CLI::Option* add_base_faces_option(CLI::App& cmd, SemiRegularOptions& options)
             "N >= 1"));
 }
 
-std::size_t base_face_target(const SemiRegularOptions& options, const TriMesh& intermediate)
+std::size_t base_face_target(const SemiRegularOptions& options, const TriMesh& intermediate,
+                             std::size_t share)
 {
     if (!options.base_faces)
     {
-        return default_base_faces(intermediate);
+        return default_base_faces(intermediate, share);
     }
     const long long wanted = *options.base_faces;
     if (wanted < 1)

@@ -54,10 +54,11 @@ std::vector<CLI::Option*> add_level_options(CLI::App& cmd, SemiRegularOptions& o
 CLI::Option* add_base_faces_option(CLI::App& cmd, SemiRegularOptions& options);
 
 /// \brief The automatic base-face target for `intermediate`: --base-faces (checked: at least 1
-/// and at most the intermediate mesh's faces) or default_base_faces().
+/// and at most the intermediate mesh's faces) or default_base_faces() with `share`.
 /// \throw InvalidInput with the option's name
 [[nodiscard]] std::size_t base_face_target(const SemiRegularOptions& options,
-                                           const TriMesh& intermediate);
+                                           const TriMesh& intermediate,
+                                           std::size_t share = default_base_share);
 
 /// \brief Refuses, before anything is allocated, a level whose F0·4^J faces would not fit in
 /// memory (or in 32-bit indices). \throw InvalidInput saying how much it would need

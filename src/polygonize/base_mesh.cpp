@@ -598,10 +598,10 @@ void relax_and_project(const OmMesh& mesh, const Field& field, bool relax, Verte
     state.on_surface = std::move(next_on);
 }
 
-std::size_t default_base_faces(std::size_t faces, std::size_t components)
+std::size_t default_base_faces(std::size_t faces, std::size_t components, std::size_t share)
 {
     const std::size_t lower = std::max<std::size_t>(200, 8 * components);
-    return std::min(std::clamp<std::size_t>(faces / 64, lower, 20000), faces);
+    return std::min(std::clamp<std::size_t>(faces / share, lower, 20000), faces);
 }
 
 std::string describe_topology_change(const MeshTopology& before, const MeshTopology& after)
@@ -626,9 +626,11 @@ std::string describe_topology_change(const MeshTopology& before, const MeshTopol
 
 } // namespace
 
-std::size_t default_base_faces(const TriMesh& intermediate)
+std::size_t default_base_faces(const TriMesh& intermediate, std::size_t share)
 {
-    return default_base_faces(intermediate.face_count(), analyze_topology(intermediate).components);
+    PF_ASSERT(share >= 1);
+    return default_base_faces(intermediate.face_count(), analyze_topology(intermediate).components,
+                              share);
 }
 
 BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
@@ -654,9 +656,10 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
                            " misoriented edges, " + std::to_string(before.degenerate_faces) +
                            " degenerate faces)");
     }
-    stats.target_faces = options.target_faces
-                             ? *options.target_faces
-                             : default_base_faces(stats.input_faces, before.components);
+    stats.target_faces =
+        options.target_faces
+            ? *options.target_faces
+            : default_base_faces(stats.input_faces, before.components, default_base_share);
     if (stats.target_faces == 0)
     {
         throw InvalidInput("base mesh: the target face count must be at least 1, got 0");

@@ -91,14 +91,19 @@ struct BaseMeshResult
     BaseMeshStats stats;
 };
 
-/// \brief The default base-face target for an intermediate mesh: its face count over 4³ (three
-/// 1-to-4 refinement levels bring the semi-regular mesh back to the intermediate mesh's
-/// resolution), clamped to [max(8·components, 200), 20000] and to the mesh's own face count.
+/// Intermediate faces per base face by default (default_base_faces()).
+inline constexpr std::size_t default_base_share = 64;
+
+/// \brief The default base-face target for an intermediate mesh: its face count over `share`
+/// (by default 4³: three 1-to-4 refinement levels bring the semi-regular mesh back to the
+/// intermediate mesh's resolution), clamped to [max(8·components, 200), 20000] and to the mesh's
+/// own face count. \pre share >= 1
 /// Measured on the sampled bunny (121.8k marching-cubes faces), distance from the samples to M⁰
 /// in % of the bounding-box diagonal, mean (max): faces/16 → 0.06 (0.96), faces/64 → 0.18
 /// (2.3), faces/256 → 0.61 (8.8); /64 keeps the shape of the ears and paws, /256 reduces the
 /// ears to a few triangles.
-[[nodiscard]] std::size_t default_base_faces(const TriMesh& intermediate);
+[[nodiscard]] std::size_t default_base_faces(const TriMesh& intermediate,
+                                             std::size_t share = default_base_share);
 
 /// \brief Automatic base mesh M⁰ (§5.1, Fig. 5): the intermediate (marching-cubes) mesh
 /// simplified by topology-safe edge collapses to a target face count, its triangles shaped, and
