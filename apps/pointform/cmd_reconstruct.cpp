@@ -80,7 +80,8 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
         }
         intermediate_faces = mc.mesh.face_count();
         intermediate_vertices = mc.mesh.vertex_count();
-        const std::size_t target = base_face_target(options.refine, mc.mesh);
+        const std::size_t target =
+            base_face_target(options.refine, mc.mesh, default_base_share, input.surfels.size());
         if (options.refine.levels)
         {
             check_refinement_memory(target, static_cast<std::size_t>(*options.refine.levels));

@@ -31,6 +31,8 @@ constexpr double bytes_per_refined_face = 256.0;
 
 constexpr const char* sampling_density_definition =
     "median over the samples of the distance to the nearest other sample";
+constexpr const char* robust_distance_definition =
+    "mean of the smallest 95% of the distances from the samples to the mesh";
 constexpr const char* hausdorff_definition =
     "one-sided Hausdorff distance: the largest distance from a sample to the mesh (exact "
     "closest point on the triangles)";
@@ -68,6 +70,44 @@ std::string stop_reason(const SemiRegularResult& r)
     const std::size_t finest = r.hierarchy.finest_level();
     const double last =
         r.report.levels.empty() ? r.report.initial_hausdorff : *r.report.levels.back().hausdorff;
+    const double robust = r.report.levels.empty() ? r.report.initial_robust_distance
+                                                  : *r.report.levels.back().robust_distance;
+    if (r.report.stop_rule == StopRule::Automatic)
+    {
+        const double detail = r.report.levels.empty()
+                                  ? r.report.initial_next_detail
+                                  : r.report.levels.back().next_detail.value_or(0.0);
+        switch (r.report.stop)
+        {
+            case RefineStop::SmallDetails:
+                return "level " + std::to_string(finest + 1) + " would move its new vertices by " +
+                       format_number(detail) + " on average, not more than the threshold " +
+                       format_number(r.report.detail_threshold) +
+                       " (a tenth of the field's residual at the samples, " +
+                       format_number(r.report.field_residual) +
+                       ", or a thousandth of the sampling density): level " +
+                       std::to_string(finest) +
+                       " is as close as the field allows (robust distance " +
+                       format_number(robust) + ")";
+            case RefineStop::NoisyDetails:
+                return "level " + std::to_string(finest + 1) + " would move its new vertices by " +
+                       format_number(detail) +
+                       " on average, less than the field's residual at the samples (" +
+                       format_number(r.report.field_residual) +
+                       ") and not half as much as the level before: these details follow the "
+                       "noise, so level " +
+                       std::to_string(finest) + " is the output (robust distance " +
+                       format_number(robust) + ")";
+            case RefineStop::VertexBudget:
+                return "level " + std::to_string(finest + 1) +
+                       " would have more vertices than the budget of " +
+                       std::to_string(r.report.vertex_budget) +
+                       " (the number of samples), so level " + std::to_string(finest) +
+                       " is the output (robust distance " + format_number(robust) + ")";
+            default:
+                break;
+        }
+    }
     const std::string distances = "Hausdorff " + format_number(last) + ", sampling density " +
                                   format_number(r.report.sampling_density);
     switch (r.report.stop)
@@ -85,6 +125,9 @@ std::string stop_reason(const SemiRegularResult& r)
                    "): the samples still farther than the density lie where refinement cannot "
                    "reach (outliers, noise, beyond a hole's rim)";
         case RefineStop::LevelCap:
+        case RefineStop::VertexBudget:
+        case RefineStop::SmallDetails:
+        case RefineStop::NoisyDetails:
             break;
     }
     return "reached the level cap " + std::to_string(r.level_cap) +
@@ -103,6 +146,12 @@ nlohmann::json level_json(const RefineLevelStats& s, double diagonal)
     out["hausdorff"] = s.hausdorff.value_or(0.0);
     out["hausdorff_relative"] = diagonal > 0.0 ? s.hausdorff.value_or(0.0) / diagonal : 0.0;
     out["mean_distance"] = s.mean_distance.value_or(0.0);
+    out["robust_distance"] = s.robust_distance.value_or(0.0);
+    out["p90_distance"] = s.p90_distance.value_or(0.0);
+    if (s.next_detail)
+    {
+        out["next_detail"] = *s.next_detail;
+    }
     out["fold_vertices"] = s.fold_vertices;
     out["folds_fixed_by_ven"] = s.folds_fixed_by_ven;
     out["folds_unresolved"] = s.folds_unresolved;
@@ -150,9 +199,16 @@ void add_refine_options(CLI::App& cmd, SemiRegularOptions& options)
 {
     add_level_options(cmd, options,
                       "Refine exactly to level J (0 = the base mesh only); default: until the "
-                      "one-sided Hausdorff distance from the samples is below the sampling "
-                      "density (at most level " +
+                      "--stop rule says so (at most level " +
                           std::to_string(default_max_level) + ")");
+    cmd.add_option("--stop", options.stop,
+                   "When refinement stops without --levels: auto (the default: while the next "
+                   "level would move the mesh by more than a tenth of the field's residual at "
+                   "the samples, and would have no more vertices than there are samples) or "
+                   "paper (§5.2.4: until the largest distance from a sample is below the "
+                   "sampling density)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"auto", "paper"}));
     cmd.add_flag("--ascii", options.ascii, "Write ascii PLY instead of binary");
     cmd.add_flag("--json", options.json, "Print the report as JSON");
 }
@@ -193,6 +249,7 @@ RefineOptions refine_options_of(const SemiRegularOptions& options, ProgressCallb
     refine_options.predictor = parse_predictor(options.predictor);
     refine_options.relax_iterations = options.relax;
     refine_options.relaxation = parse_relaxation(options.relaxation);
+    refine_options.stop_rule = parse_stop_rule(options.stop);
     refine_options.progress = std::move(progress);
     return refine_options;
 }
@@ -222,11 +279,16 @@ CLI::Option* add_base_faces_option(CLI::App& cmd, SemiRegularOptions& options)
 }
 
 std::size_t base_face_target(const SemiRegularOptions& options, const TriMesh& intermediate,
-                             std::size_t share)
+                             std::size_t share, std::size_t samples)
 {
     if (!options.base_faces)
     {
-        return default_base_faces(intermediate, share);
+        const std::size_t target = default_base_faces(intermediate, share);
+        if (samples == 0 || options.levels || parse_stop_rule(options.stop) != StopRule::Automatic)
+        {
+            return target;
+        }
+        return std::min(intermediate.face_count(), fit_base_faces_to_budget(target, samples));
     }
     const long long wanted = *options.base_faces;
     if (wanted < 1)
@@ -299,18 +361,9 @@ SemiRegularResult refine_semi_regular(const TriMesh& base, const PointField& fie
         check_refinement_memory(base_faces, levels);
         r.exact_levels = true;
         r.level_cap = levels;
-        r.report.sampling_density = estimate_sampling_density(samples);
-        const DistanceStats initial =
-            summarize_distances(distances_to_mesh(samples, r.hierarchy.level_mesh(0)));
-        r.report.initial_hausdorff = initial.max;
-        r.report.initial_mean_distance = initial.mean;
-        refine_options.sampling_density = r.report.sampling_density;
-        refine_options.min_improvement = 0.0;
+        refine_options.stop_rule = StopRule::Exact;
         refine_options.max_level = levels;
-        for (std::size_t level = 0; level < levels; ++level)
-        {
-            r.report.levels.push_back(refine_once(r.hierarchy, field, refine_options, &samples));
-        }
+        r.report = refine(r.hierarchy, field, samples, refine_options);
         r.report.stop = RefineStop::LevelCap;
         r.stop_reason = "--levels " + std::to_string(levels) + ": refined exactly to level " +
                         std::to_string(levels);
@@ -320,12 +373,7 @@ SemiRegularResult refine_semi_regular(const TriMesh& base, const PointField& fie
     r.cap_from_memory = r.level_cap < default_max_level;
     refine_options.max_level = r.level_cap;
     r.report = refine(r.hierarchy, field, samples, refine_options);
-    if (r.report.stop == RefineStop::Stalled && !r.report.levels.empty())
-    {
-        r.dropped = r.report.levels.back();
-        r.report.levels.pop_back();
-        r.hierarchy.truncate(r.hierarchy.finest_level() - 1);
-    }
+    r.dropped = r.report.dropped;
     r.stop_reason = stop_reason(r);
     return r;
 }
@@ -451,6 +499,12 @@ nlohmann::json refinement_json(const SemiRegularResult& r)
     base["hausdorff"] = r.report.initial_hausdorff;
     base["hausdorff_relative"] = r.diagonal > 0.0 ? r.report.initial_hausdorff / r.diagonal : 0.0;
     base["mean_distance"] = r.report.initial_mean_distance;
+    base["robust_distance"] = r.report.initial_robust_distance;
+    base["p90_distance"] = r.report.initial_p90_distance;
+    if (r.report.stop_rule == StopRule::Automatic)
+    {
+        base["next_detail"] = r.report.initial_next_detail;
+    }
     base["folds_fixed_by_ven"] = 0;
     base["unprojected"] = r.base_unprojected;
     base["seconds"] = r.base_seconds;
@@ -474,6 +528,19 @@ nlohmann::json refinement_json(const SemiRegularResult& r)
     out["level_cap_from_memory"] = r.cap_from_memory;
     out["stop"] = r.exact_levels ? std::string("levels") : std::string(to_string(r.report.stop));
     out["stop_reason"] = r.stop_reason;
+    out["stop_rule"] =
+        r.exact_levels ? std::string("levels") : std::string(to_string(r.report.stop_rule));
+    out["robust_distance_definition"] = robust_distance_definition;
+    if (!r.exact_levels && r.report.stop_rule == StopRule::Automatic)
+    {
+        out["vertex_budget"] = r.report.vertex_budget;
+        out["field_residual"] = r.report.field_residual;
+        out["detail_threshold"] = r.report.detail_threshold;
+    }
+    // The level the paper's rule (§5.2.4: Hausdorff below the sampling density) picks, counted
+    // from the base, or null when no level made reaches it.
+    out["paper_rule_level"] =
+        r.report.paper_level ? nlohmann::json(*r.report.paper_level) : nlohmann::json(nullptr);
     return out;
 }
 
@@ -483,38 +550,55 @@ void print_refinement(const SemiRegularResult& r)
                                       sampling_density_definition + ", " +
                                       std::to_string(r.sample_count) + " samples)");
     print_row("Hausdorff", hausdorff_definition);
+    print_row("robust", robust_distance_definition);
+    if (!r.exact_levels && r.report.stop_rule == StopRule::Automatic)
+    {
+        print_row("field residual", format_number(r.report.field_residual) +
+                                        " (the same robust mean of |f| at the samples); detail "
+                                        "threshold " +
+                                        format_number(r.report.detail_threshold));
+        print_row("vertex budget", std::to_string(r.report.vertex_budget) + " (the samples)");
+    }
     print_row("VEN fix",
               "fold vertices whose fold the vertex-based edge normal fixed / fold "
               "vertices after projection along the face normal (§5.2.2)");
-    std::printf("  %5s %10s %10s %12s %9s %12s %9s %11s %8s\n", "level", "faces", "vertices",
-                "Hausdorff", "% diag", "mean", "VEN fix", "unprojected", "seconds");
+    std::printf("  %5s %10s %10s %12s %9s %12s %12s %9s %11s %8s\n", "level", "faces", "vertices",
+                "Hausdorff", "% diag", "mean", "robust", "VEN fix", "unprojected", "seconds");
     const auto row = [&](std::size_t level, std::size_t faces, std::size_t vertices, double h,
-                         double mean, const std::string& ven, std::size_t unprojected,
-                         double seconds) {
-        std::printf("  %5zu %10zu %10zu %12s %9s %12s %9s %11zu %8.3f\n", level, faces, vertices,
-                    format_number(h).c_str(), percent_of(h, r.diagonal).c_str(),
-                    format_number(mean).c_str(), ven.c_str(), unprojected, seconds);
+                         double mean, double robust, const std::string& ven,
+                         std::size_t unprojected, double seconds, const char* note) {
+        std::printf("  %5zu %10zu %10zu %12s %9s %12s %12s %9s %11zu %8.3f%s\n", level, faces,
+                    vertices, format_number(h).c_str(), percent_of(h, r.diagonal).c_str(),
+                    format_number(mean).c_str(), format_number(robust).c_str(), ven.c_str(),
+                    unprojected, seconds, note);
+    };
+    const auto level_row = [&](const RefineLevelStats& s, const char* note) {
+        row(s.level, s.faces, s.vertices, s.hausdorff.value_or(0.0), s.mean_distance.value_or(0.0),
+            s.robust_distance.value_or(0.0),
+            std::to_string(s.folds_fixed_by_ven) + "/" + std::to_string(s.fold_vertices),
+            s.unprojected, s.seconds, note);
     };
     row(0, r.hierarchy.face_count(0), r.hierarchy.vertex_count(0), r.report.initial_hausdorff,
-        r.report.initial_mean_distance, "-", r.base_unprojected, r.base_seconds);
+        r.report.initial_mean_distance, r.report.initial_robust_distance, "-", r.base_unprojected,
+        r.base_seconds, "");
     for (const RefineLevelStats& s : r.report.levels)
     {
-        row(s.level, s.faces, s.vertices, s.hausdorff.value_or(0.0), s.mean_distance.value_or(0.0),
-            std::to_string(s.folds_fixed_by_ven) + "/" + std::to_string(s.fold_vertices),
-            s.unprojected, s.seconds);
+        level_row(s, "");
     }
     if (r.dropped)
     {
-        const RefineLevelStats& s = *r.dropped;
-        std::printf(
-            "  %5zu %10zu %10zu %12s %9s %12s %9s %11zu %8.3f  (not kept)\n", s.level, s.faces,
-            s.vertices, format_number(s.hausdorff.value_or(0.0)).c_str(),
-            percent_of(s.hausdorff.value_or(0.0), r.diagonal).c_str(),
-            format_number(s.mean_distance.value_or(0.0)).c_str(),
-            (std::to_string(s.folds_fixed_by_ven) + "/" + std::to_string(s.fold_vertices)).c_str(),
-            s.unprojected, s.seconds);
+        level_row(*r.dropped, "  (not kept)");
     }
     print_row("stopped", r.stop_reason);
+    if (!r.exact_levels && r.report.stop_rule == StopRule::Automatic)
+    {
+        print_row("paper's rule", r.report.paper_level
+                                      ? "§5.2.4 (Hausdorff below the sampling density) is met at "
+                                        "level " +
+                                            std::to_string(*r.report.paper_level)
+                                      : std::string("§5.2.4 (Hausdorff below the sampling "
+                                                    "density) is met at no level made"));
+    }
 }
 
 SemiRegularOutput refine_and_write(const TriMesh& base, const PointField& field,

@@ -36,12 +36,14 @@ struct SemiRegularOptions
     std::string predictor = "midpoint";
     int relax = RefineOptions{}.relax_iterations; ///< --relax N: relaxation rounds per level
     std::string relaxation = "across";            ///< --relaxation across|umbrella
+    std::string stop = "auto";                    ///< --stop auto|paper
     std::string save_hierarchy;
     bool ascii = false;
     bool json = false;
 };
 
-/// Adds --levels, --predictor, --relax, --relaxation, --save-hierarchy, --ascii and --json.
+/// Adds --levels, --stop, --predictor, --relax, --relaxation, --save-hierarchy, --ascii and
+/// --json.
 void add_refine_options(CLI::App& cmd, SemiRegularOptions& options);
 /// Adds --levels (with `levels_help`), --predictor, --relax, --relaxation and --save-hierarchy.
 /// \return the options added
@@ -54,11 +56,14 @@ std::vector<CLI::Option*> add_level_options(CLI::App& cmd, SemiRegularOptions& o
 CLI::Option* add_base_faces_option(CLI::App& cmd, SemiRegularOptions& options);
 
 /// \brief The automatic base-face target for `intermediate`: --base-faces (checked: at least 1
-/// and at most the intermediate mesh's faces) or default_base_faces() with `share`.
+/// and at most the intermediate mesh's faces) or default_base_faces() with `share`; without
+/// --levels and with the automatic stop, that default is fitted to the vertex budget
+/// `samples` (fit_base_faces_to_budget) when `samples` > 0.
 /// \throw InvalidInput with the option's name
 [[nodiscard]] std::size_t base_face_target(const SemiRegularOptions& options,
                                            const TriMesh& intermediate,
-                                           std::size_t share = default_base_share);
+                                           std::size_t share = default_base_share,
+                                           std::size_t samples = 0);
 
 /// \brief Refuses, before anything is allocated, a level whose F0·4^J faces would not fit in
 /// memory (or in 32-bit indices). \throw InvalidInput saying how much it would need
@@ -83,15 +88,14 @@ struct SemiRegularResult
     std::string predictor;
     std::string relaxation; ///< "across" or "umbrella", with the rounds per level
     int relax_rounds = 0;
-    /// A level that stalled (improved the Hausdorff distance by less than 5%) is measured but
-    /// not kept: four times the faces for next to nothing. Its stats, when that happened.
+    /// A level that stalled is measured but not kept: four times the faces for next to nothing.
+    /// Its stats, when that happened.
     std::optional<RefineLevelStats> dropped;
 };
 
-/// \brief Refines `base` on `field` (whose surfels are the samples the Hausdorff distance is
-/// measured from): exactly to --levels J, or until the one-sided Hausdorff distance from the
-/// samples falls below their sampling density (estimate_sampling_density), a level stalls, or the
-/// cap is reached.
+/// \brief Refines `base` on `field` (whose surfels are the samples the distances are measured
+/// from): exactly to --levels J, or until the stop rule of --stop (refine(), StopRule) says so or
+/// the cap is reached.
 [[nodiscard]] SemiRegularResult refine_semi_regular(const TriMesh& base, const PointField& field,
                                                     const SemiRegularOptions& options,
                                                     const ProgressCallback& progress);

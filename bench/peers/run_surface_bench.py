@@ -41,13 +41,80 @@ HERE = Path(__file__).resolve().parent
 VARIANTS = {"clean": [], "noisy+holes": ["--noise", "0.002", "--holes", "8", "--hole-radius", "0.04"]}
 
 
+# Shape::Blobby and Shape::Part of src/geometry/shapes.cpp (keep in sync).
+BLOBBY = [((0.0, 0.0, 0.0), 0.8), ((0.95, 0.1, 0.0), 0.5), ((-0.8, 0.45, 0.15), 0.55),
+          ((0.1, 0.9, -0.35), 0.45), ((0.05, -0.35, 0.9), 0.45), ((-0.35, -0.85, -0.3), 0.5)]
+PART_ADDED = [("box", (-1.0, -0.6, -0.3), (1.0, 0.6, 0.3)), ("cylinder", (0.5, 0.0, 0.1), (0.35, 0.0, 0.7))]
+PART_REMOVED = [("cylinder", (-0.5, 0.0, -1.0), (0.25, 0.0, 1.0))]
+
+
+def _box_sdf(p, lo, hi):
+    c = 0.5 * (np.array(lo) + np.array(hi))
+    e = np.abs(p - c) - 0.5 * (np.array(hi) - np.array(lo))
+    return np.linalg.norm(np.maximum(e, 0.0), axis=1) + np.minimum(e.max(1), 0.0)
+
+
+def _cylinder_sdf(p, lo, hi):
+    d = np.stack([np.hypot(p[:, 0] - lo[0], p[:, 1] - lo[1]) - hi[0],
+                  np.abs(p[:, 2] - 0.5 * (lo[2] + hi[2])) - 0.5 * (hi[2] - lo[2])], 1)
+    return np.linalg.norm(np.maximum(d, 0.0), axis=1) + np.minimum(d.max(1), 0.0)
+
+
+def _primitive_sdf(q, p):
+    return _box_sdf(p, q[1], q[2]) if q[0] == "box" else _cylinder_sdf(p, q[1], q[2])
+
+
+def _blobby_distance(p: np.ndarray) -> np.ndarray:
+    """Exact distance to the boundary of the union of balls, whose pairwise intersection circles
+    meet no third ball: the nearest boundary point is a radial projection onto a sphere that no
+    other ball covers, or a point of an intersection circle."""
+    centers = np.array([c for c, _ in BLOBBY])
+    radii = np.array([r for _, r in BLOBBY])
+    best = np.full(len(p), np.inf)
+    for i, (c, r) in enumerate(zip(centers, radii)):
+        v = p - c
+        norm = np.maximum(np.linalg.norm(v, axis=1), 1e-300)
+        q = c + r * v / norm[:, None]
+        covered = np.zeros(len(p), bool)
+        for j, (cj, rj) in enumerate(zip(centers, radii)):
+            if j != i:
+                covered |= np.linalg.norm(q - cj, axis=1) < rj
+        best = np.where(covered, best, np.minimum(best, np.abs(norm - r)))
+        for j in range(i + 1, len(radii)):
+            axis = centers[j] - c
+            d = np.linalg.norm(axis)
+            if d >= r + radii[j] or d <= abs(r - radii[j]):
+                continue
+            axis /= d
+            t = (d * d + r * r - radii[j] ** 2) / (2 * d)
+            ring = np.sqrt(r * r - t * t)
+            w = p - (c + t * axis)
+            h = w @ axis
+            rho = np.linalg.norm(w - h[:, None] * axis, axis=1)
+            best = np.minimum(best, np.hypot(rho - ring, h))
+    return best
+
+
 def true_distance(shape: str, p: np.ndarray) -> np.ndarray:
-    """Unsigned distance to the analytic surface `pointform sample` draws from."""
+    """Unsigned distance to the analytic surface `pointform sample` draws from (exact; for the
+    part, the distance bound of its CSG of exact primitive distances, exact but within its
+    concave creases and the hole's rims, where it may be lower)."""
     if shape == "sphere":
         return np.abs(np.linalg.norm(p, axis=1) - 1.0)
     if shape == "torus":
         rho = np.hypot(p[:, 0], p[:, 1])
         return np.abs(np.hypot(rho - 1.0, p[:, 2]) - 0.35)
+    if shape == "two-spheres":
+        c = np.where(p[:, :1] > 0, 1.6, -1.6)
+        return np.abs(np.linalg.norm(p - np.concatenate([c, np.zeros((len(p), 2))], 1), axis=1) - 1.0)
+    if shape == "plate":
+        return np.abs(_box_sdf(p, (-1.0, -1.0, -0.025), (1.0, 1.0, 0.025)))
+    if shape == "blobby":
+        return _blobby_distance(p)
+    if shape == "part":
+        value = np.min([_primitive_sdf(q, p) for q in PART_ADDED], axis=0)
+        value = np.maximum(value, -np.min([_primitive_sdf(q, p) for q in PART_REMOVED], axis=0))
+        return np.abs(value)
     raise ValueError(shape)
 
 

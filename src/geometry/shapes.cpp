@@ -6,6 +6,7 @@
 #include "pointform/core/error.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -81,6 +82,170 @@ Sample sample_plate(std::mt19937_64& rng, double thickness)
     return {p, n};
 }
 
+// A large ball with five smaller ones sunk into it: five concave creases where the normals turn
+// by 82° to 95°, the small balls at least 0.12 apart from each other.
+const std::array<Ball, 6> blobby = {{
+    {Vec3d(0.0, 0.0, 0.0), 0.8},
+    {Vec3d(0.95, 0.1, 0.0), 0.5},
+    {Vec3d(-0.8, 0.45, 0.15), 0.55},
+    {Vec3d(0.1, 0.9, -0.35), 0.45},
+    {Vec3d(0.05, -0.35, 0.9), 0.45},
+    {Vec3d(-0.35, -0.85, -0.3), 0.5},
+}};
+
+bool inside_ball(const Ball& b, const Vec3d& p)
+{
+    return (p - b.center).squaredNorm() < b.radius * b.radius;
+}
+
+/// Area-uniform sample of the union of balls: a ball picked by area, a point on it, kept unless
+/// it lies inside another ball.
+Sample sample_blobby(std::mt19937_64& rng)
+{
+    double total = 0.0;
+    for (const Ball& b : blobby)
+        total += b.radius * b.radius;
+    std::uniform_real_distribution<double> uni(0.0, total);
+    for (;;)
+    {
+        double pick = uni(rng);
+        std::size_t i = 0;
+        while (i + 1 < blobby.size() && pick >= blobby[i].radius * blobby[i].radius)
+        {
+            pick -= blobby[i].radius * blobby[i].radius;
+            ++i;
+        }
+        const Vec3d n = random_unit(rng);
+        const Vec3d p = blobby[i].center + blobby[i].radius * n;
+        bool covered = false;
+        for (std::size_t j = 0; j < blobby.size() && !covered; ++j)
+            covered = j != i && inside_ball(blobby[j], p);
+        if (!covered)
+            return {p, n};
+    }
+}
+
+PartSolid make_part()
+{
+    using Kind = PartPrimitive::Kind;
+    PartSolid solid;
+    solid.added.push_back({Kind::Box, Vec3d(-1.0, -0.6, -0.3), Vec3d(1.0, 0.6, 0.3)});
+    // A boss of radius 0.35 rising 0.4 above the top face (its foot inside the block).
+    solid.added.push_back({Kind::Cylinder, Vec3d(0.5, 0.0, 0.1), Vec3d(0.35, 0.0, 0.7)});
+    // A hole of radius 0.25 through the block.
+    solid.removed.push_back({Kind::Cylinder, Vec3d(-0.5, 0.0, -1.0), Vec3d(0.25, 0.0, 1.0)});
+    return solid;
+}
+
+bool inside_primitive(const PartPrimitive& q, const Vec3d& p)
+{
+    if (q.kind == PartPrimitive::Kind::Box)
+        return (p.array() > q.min.array()).all() && (p.array() < q.max.array()).all();
+    const double dx = p.x() - q.min.x();
+    const double dy = p.y() - q.min.y();
+    return p.z() > q.min.z() && p.z() < q.max.z() && dx * dx + dy * dy < q.max.x() * q.max.x();
+}
+
+double primitive_area(const PartPrimitive& q)
+{
+    if (q.kind == PartPrimitive::Kind::Box)
+    {
+        const Vec3d e = q.max - q.min;
+        return 2.0 * (e.x() * e.y() + e.y() * e.z() + e.z() * e.x());
+    }
+    const double r = q.max.x();
+    return 2.0 * std::numbers::pi * r * (q.max.z() - q.min.z()) + 2.0 * std::numbers::pi * r * r;
+}
+
+Sample sample_primitive(const PartPrimitive& q, std::mt19937_64& rng)
+{
+    std::uniform_real_distribution<double> uni(0.0, 1.0);
+    if (q.kind == PartPrimitive::Kind::Box)
+    {
+        const Vec3d e = q.max - q.min;
+        const double areas[3] = {e.y() * e.z(), e.z() * e.x(), e.x() * e.y()};
+        double pick = uni(rng) * 2.0 * (areas[0] + areas[1] + areas[2]);
+        int axis = 0;
+        while (axis < 2 && pick >= 2.0 * areas[axis])
+        {
+            pick -= 2.0 * areas[axis];
+            ++axis;
+        }
+        const bool upper = pick >= areas[axis];
+        Vec3d p(q.min.x() + e.x() * uni(rng), q.min.y() + e.y() * uni(rng),
+                q.min.z() + e.z() * uni(rng));
+        p[axis] = upper ? q.max[axis] : q.min[axis];
+        Vec3d n = Vec3d::Zero();
+        n[axis] = upper ? 1.0 : -1.0;
+        return {p, n};
+    }
+    const double r = q.max.x();
+    const double height = q.max.z() - q.min.z();
+    const double side = 2.0 * std::numbers::pi * r * height;
+    const double cap = std::numbers::pi * r * r;
+    const double pick = uni(rng) * (side + 2.0 * cap);
+    if (pick < side)
+    {
+        const double a = 2.0 * std::numbers::pi * uni(rng);
+        const Vec3d n(std::cos(a), std::sin(a), 0.0);
+        return {Vec3d(q.min.x() + r * n.x(), q.min.y() + r * n.y(), q.min.z() + height * uni(rng)),
+                n};
+    }
+    const bool top = pick >= side + cap;
+    const double a = 2.0 * std::numbers::pi * uni(rng);
+    const double rho = r * std::sqrt(uni(rng));
+    return {Vec3d(q.min.x() + rho * std::cos(a), q.min.y() + rho * std::sin(a),
+                  top ? q.max.z() : q.min.z()),
+            Vec3d(0.0, 0.0, top ? 1.0 : -1.0)};
+}
+
+/// Area-uniform sample of the part's surface: a primitive picked by area, a point on it, kept
+/// where it bounds the solid (an added primitive's point outside every other primitive; a
+/// removed one's inside an added one and outside the other removed ones, its normal reversed).
+Sample sample_part(std::mt19937_64& rng)
+{
+    const PartSolid& solid = part_solid();
+    std::vector<const PartPrimitive*> all;
+    double total = 0.0;
+    for (const auto& q : solid.added)
+    {
+        all.push_back(&q);
+        total += primitive_area(q);
+    }
+    for (const auto& q : solid.removed)
+    {
+        all.push_back(&q);
+        total += primitive_area(q);
+    }
+    std::uniform_real_distribution<double> uni(0.0, total);
+    for (;;)
+    {
+        double pick = uni(rng);
+        std::size_t i = 0;
+        while (i + 1 < all.size() && pick >= primitive_area(*all[i]))
+        {
+            pick -= primitive_area(*all[i]);
+            ++i;
+        }
+        Sample s = sample_primitive(*all[i], rng);
+        const bool removed = i >= solid.added.size();
+        bool keep = true;
+        bool in_added = false;
+        for (std::size_t j = 0; j < solid.added.size(); ++j)
+            if (j != i && inside_primitive(solid.added[j], s.position))
+                in_added = true;
+        for (std::size_t j = 0; j < solid.removed.size(); ++j)
+            if (j + solid.added.size() != i && inside_primitive(solid.removed[j], s.position))
+                keep = false;
+        keep = keep && (removed ? in_added : !in_added);
+        if (!keep)
+            continue;
+        if (removed)
+            s.normal = -s.normal;
+        return s;
+    }
+}
+
 Sample sample_one(Shape shape, std::mt19937_64& rng, const SampleOptions& options)
 {
     switch (shape)
@@ -100,11 +265,26 @@ Sample sample_one(Shape shape, std::mt19937_64& rng, const SampleOptions& option
         }
         case Shape::Plate:
             return sample_plate(rng, options.thickness);
+        case Shape::Blobby:
+            return sample_blobby(rng);
+        case Shape::Part:
+            return sample_part(rng);
     }
     throw InvalidInput("unknown shape");
 }
 
 } // namespace
+
+std::span<const Ball> blobby_spheres()
+{
+    return blobby;
+}
+
+const PartSolid& part_solid()
+{
+    static const PartSolid solid = make_part();
+    return solid;
+}
 
 PointCloud sample_shape(Shape shape, const SampleOptions& options)
 {
@@ -164,8 +344,12 @@ Shape parse_shape(const std::string& name)
         return Shape::TwoSpheres;
     if (name == "plate")
         return Shape::Plate;
+    if (name == "blobby")
+        return Shape::Blobby;
+    if (name == "part")
+        return Shape::Part;
     throw InvalidInput("unknown shape '" + name +
-                       "' (expected sphere, torus, two-spheres or plate)");
+                       "' (expected sphere, torus, two-spheres, plate, blobby or part)");
 }
 
 } // namespace pointform

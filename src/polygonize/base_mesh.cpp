@@ -626,6 +626,18 @@ std::string describe_topology_change(const MeshTopology& before, const MeshTopol
 
 } // namespace
 
+std::size_t fit_base_faces_to_budget(std::size_t target, std::size_t vertex_budget, double fill)
+{
+    PF_ASSERT(fill > 0.0 && fill <= 1.0);
+    const double faces_wanted = 2.0 * fill * static_cast<double>(vertex_budget);
+    if (target == 0 || static_cast<double>(target) >= faces_wanted)
+        return target;
+    const double levels =
+        std::round(std::log(faces_wanted / static_cast<double>(target)) / std::log(4.0));
+    const double fitted = faces_wanted / std::pow(4.0, levels);
+    return std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(fitted)));
+}
+
 std::size_t default_base_faces(const TriMesh& intermediate, std::size_t share)
 {
     PF_ASSERT(share >= 1);

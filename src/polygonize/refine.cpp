@@ -13,6 +13,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <utility>
@@ -306,12 +307,50 @@ void check_options(const RefineOptions& options)
         throw InvalidInput("refine: sampling_density must be 0 (estimate) or positive");
     if (!(options.min_improvement >= 0.0 && options.min_improvement < 1.0))
         throw InvalidInput("refine: min_improvement must lie in [0, 1)");
+    if (!(options.detail_factor > 0.0 && options.detail_factor <= 1.0))
+        throw InvalidInput("refine: detail_factor must lie in (0, 1]");
+    if (!(options.noise_decay > 0.0 && options.noise_decay < 1.0))
+        throw InvalidInput("refine: noise_decay must lie in (0, 1)");
+}
+
+/// Share of the distances, the smallest first, that the robust distance averages.
+constexpr double robust_share = 0.95;
+
+struct RobustStats
+{
+    double robust = 0.0; ///< mean of the smallest robust_share of the values
+    double p90 = 0.0;
+};
+
+/// The robust statistics of `values` (reordered: nth_element).
+RobustStats robust_stats(std::vector<double>& values)
+{
+    RobustStats out;
+    if (values.empty())
+        return out;
+    const std::size_t n = values.size();
+    const std::size_t kept = std::max<std::size_t>(
+        1, static_cast<std::size_t>(std::ceil(robust_share * static_cast<double>(n))));
+    if (kept < n)
+        std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(kept),
+                         values.end());
+    double sum = 0.0;
+    for (std::size_t i = 0; i < kept; ++i)
+        sum += values[i];
+    out.robust = sum / static_cast<double>(kept);
+    const auto p90 = std::min(n - 1, static_cast<std::size_t>(0.9 * static_cast<double>(n)));
+    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(p90),
+                     values.begin() + static_cast<std::ptrdiff_t>(std::max(kept, p90 + 1)));
+    out.p90 = values[p90];
+    return out;
 }
 
 struct Distances
 {
     double hausdorff = 0.0;
     double mean = 0.0;
+    double robust = 0.0;
+    double p90 = 0.0;
 };
 
 Distances distances_from(const PointCloud& samples, const MultiresMesh& mesh,
@@ -326,7 +365,7 @@ Distances distances_from(const PointCloud& samples, const MultiresMesh& mesh,
         surface.vertices.positions[v] = mesh.positions()[v].cast<float>();
     surface.triangles.assign(faces.begin(), faces.end());
     const TriangleBvh bvh(surface);
-    const std::vector<double> d = distances_to_mesh(bvh, samples, {.progress = progress});
+    std::vector<double> d = distances_to_mesh(bvh, samples, {.progress = progress});
     Distances out;
     double sum = 0.0;
     for (const double value : d)
@@ -335,6 +374,9 @@ Distances distances_from(const PointCloud& samples, const MultiresMesh& mesh,
         sum += value;
     }
     out.mean = d.empty() ? 0.0 : sum / static_cast<double>(d.size());
+    const RobustStats robust = robust_stats(d);
+    out.robust = robust.robust;
+    out.p90 = robust.p90;
     return out;
 }
 
@@ -642,8 +684,40 @@ std::string_view to_string(RefineStop stop)
             return "level cap";
         case RefineStop::Stalled:
             return "stalled";
+        case RefineStop::VertexBudget:
+            return "vertex budget";
+        case RefineStop::SmallDetails:
+            return "small details";
+        case RefineStop::NoisyDetails:
+            return "noisy details";
     }
     return "unknown";
+}
+
+StopRule parse_stop_rule(std::string_view text)
+{
+    if (text == "auto")
+        return StopRule::Automatic;
+    if (text == "paper")
+        return StopRule::Paper;
+    if (text == "exact")
+        return StopRule::Exact;
+    throw InvalidInput("unknown stop rule '" + std::string(text) +
+                       "' (expected auto, paper or exact)");
+}
+
+std::string_view to_string(StopRule rule)
+{
+    switch (rule)
+    {
+        case StopRule::Paper:
+            return "paper";
+        case StopRule::Exact:
+            return "exact";
+        case StopRule::Automatic:
+            break;
+    }
+    return "auto";
 }
 
 double estimate_sampling_density(const PointCloud& samples)
@@ -702,6 +776,8 @@ RefineLevelStats refine_once(MultiresMesh& mesh, const Field& field, const Refin
                 });
             stats.hausdorff = d.hausdorff;
             stats.mean_distance = d.mean;
+            stats.robust_distance = d.robust;
+            stats.p90_distance = d.p90;
         }
     }
     catch (...)
@@ -716,6 +792,75 @@ RefineLevelStats refine_once(MultiresMesh& mesh, const Field& field, const Refin
     return stats;
 }
 
+namespace {
+
+/// The field's own robust distance from the samples: the robust statistic of |f(s)|.
+double field_residual(const Field& field, const PointCloud& samples)
+{
+    std::vector<Vec3d> points(samples.size());
+    for (std::size_t i = 0; i < samples.size(); ++i)
+        points[i] = samples.world(i);
+    std::vector<FieldSample> values(points.size());
+    field.evaluate(points, values);
+    std::vector<double> residual;
+    residual.reserve(values.size());
+    for (const FieldSample& v : values)
+        if (v.defined)
+            residual.push_back(std::abs(v.value));
+    return robust_stats(residual).robust;
+}
+
+/// The unique edges of `faces` as sorted (low, high) vertex pairs.
+std::vector<std::uint64_t> unique_edges(std::span<const Triangle> faces)
+{
+    std::vector<std::uint64_t> edges;
+    edges.reserve(3 * faces.size());
+    for (const Triangle& t : faces)
+        for (int k = 0; k < 3; ++k)
+        {
+            const std::uint64_t a = std::min(t[k], t[(k + 1) % 3]);
+            const std::uint64_t b = std::max(t[k], t[(k + 1) % 3]);
+            edges.push_back(a << 32U | b);
+        }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    return edges;
+}
+
+/// Vertices of the level after the finest: V + E, with E = V + F − χ and χ from the base mesh,
+/// which every level keeps.
+std::size_t next_level_vertices(const MultiresMesh& mesh)
+{
+    const auto base_edges = static_cast<long long>(unique_edges(mesh.base_faces()).size());
+    const long long chi = static_cast<long long>(mesh.vertex_count(0)) - base_edges +
+                          static_cast<long long>(mesh.base_faces().size());
+    const std::size_t level = mesh.finest_level();
+    const auto v = static_cast<long long>(mesh.vertex_count(level));
+    const auto f = static_cast<long long>(mesh.face_count(level));
+    return static_cast<std::size_t>(v + (v + f - chi));
+}
+
+/// The expected detail of the next level: the robust statistic of |f| at the midpoints of the
+/// finest level's edges. Where f is undefined (beyond every influence radius) the detail is
+/// unknown and counts as infinite: more than 5% of such midpoints make the next level needed.
+double next_detail(const MultiresMesh& mesh, const Field& field)
+{
+    const std::vector<std::uint64_t> edges = unique_edges(mesh.faces(mesh.finest_level()));
+    std::vector<Vec3d> midpoints(edges.size());
+    for (std::size_t e = 0; e < edges.size(); ++e)
+        midpoints[e] = 0.5 * (mesh.world(static_cast<std::uint32_t>(edges[e] >> 32U)) +
+                              mesh.world(static_cast<std::uint32_t>(edges[e] & 0xffffffffU)));
+    std::vector<FieldSample> values(midpoints.size());
+    field.evaluate(midpoints, values);
+    std::vector<double> detail(values.size());
+    for (std::size_t e = 0; e < values.size(); ++e)
+        detail[e] =
+            values[e].defined ? std::abs(values[e].value) : std::numeric_limits<double>::infinity();
+    return robust_stats(detail).robust;
+}
+
+} // namespace
+
 RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& samples,
                     const RefineOptions& options)
 {
@@ -725,6 +870,7 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
     if (samples.empty())
         throw InvalidInput("refine: no samples to measure the Hausdorff distance from");
     RefineReport report;
+    report.stop_rule = options.stop_rule;
     report.sampling_density = options.sampling_density > 0.0 ? options.sampling_density
                                                              : estimate_sampling_density(samples);
     const Distances initial = distances_from(
@@ -734,10 +880,23 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
         });
     report.initial_hausdorff = initial.hausdorff;
     report.initial_mean_distance = initial.mean;
+    report.initial_robust_distance = initial.robust;
+    report.initial_p90_distance = initial.p90;
+    const bool automatic = options.stop_rule == StopRule::Automatic;
+    if (automatic)
+    {
+        report.vertex_budget = options.vertex_budget > 0 ? options.vertex_budget : samples.size();
+        report.field_residual = field_residual(field, samples);
+        report.detail_threshold =
+            std::max(options.detail_factor * report.field_residual, 1e-3 * report.sampling_density);
+    }
+    const std::size_t start_level = mesh.finest_level();
+    if (initial.hausdorff < report.sampling_density)
+        report.paper_level = 0;
     double hausdorff = initial.hausdorff;
     while (true)
     {
-        if (hausdorff < report.sampling_density)
+        if (options.stop_rule == StopRule::Paper && hausdorff < report.sampling_density)
         {
             report.stop = RefineStop::BelowSamplingDensity;
             break;
@@ -747,15 +906,47 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
             report.stop = RefineStop::LevelCap;
             break;
         }
-        report.levels.push_back(refine_once(mesh, field, options, &samples));
-        const double previous = hausdorff;
-        hausdorff = *report.levels.back().hausdorff;
-        if (hausdorff >= report.sampling_density &&
-            hausdorff > (1.0 - options.min_improvement) * previous)
+        if (automatic)
         {
+            if (next_level_vertices(mesh) > report.vertex_budget)
+            {
+                report.stop = RefineStop::VertexBudget;
+                break;
+            }
+            const double detail = next_detail(mesh, field);
+            const double previous = report.levels.empty() ? std::numeric_limits<double>::infinity()
+                                    : report.levels.size() == 1
+                                        ? report.initial_next_detail
+                                        : *report.levels[report.levels.size() - 2].next_detail;
+            if (report.levels.empty())
+                report.initial_next_detail = detail;
+            else
+                report.levels.back().next_detail = detail;
+            if (detail <= report.detail_threshold)
+            {
+                report.stop = RefineStop::SmallDetails;
+                break;
+            }
+            if (detail < report.field_residual && detail > options.noise_decay * previous)
+            {
+                report.stop = RefineStop::NoisyDetails;
+                break;
+            }
+        }
+        RefineLevelStats stats = refine_once(mesh, field, options, &samples);
+        const double previous_hausdorff = hausdorff;
+        hausdorff = *stats.hausdorff;
+        if (!report.paper_level && hausdorff < report.sampling_density)
+            report.paper_level = stats.level - start_level;
+        if (options.stop_rule == StopRule::Paper && hausdorff >= report.sampling_density &&
+            hausdorff > (1.0 - options.min_improvement) * previous_hausdorff)
+        {
+            mesh.truncate(mesh.finest_level() - 1);
+            report.dropped = stats;
             report.stop = RefineStop::Stalled;
             break;
         }
+        report.levels.push_back(stats);
     }
     return report;
 }

@@ -49,10 +49,11 @@ TEST(ReconstructCli, SampledSphereBecomesAClosedSemiRegularMeshOnTheSphere)
 {
     test::TempDir dir;
     const auto output = dir / "out.ply";
-    const auto r =
-        run("reconstruct " + quoted(write_sphere(dir)) + " -o " + quoted(output) + " --json");
+    const auto r = run("reconstruct " + quoted(write_sphere(dir)) + " -o " + quoted(output) +
+                       " --stop paper --json");
     ASSERT_EQ(r.exit_code, 0) << r.out;
     const auto report = nlohmann::json::parse(r.out);
+    EXPECT_EQ(report["stop_rule"].get<std::string>(), "paper");
     const TriMesh mesh = read_mesh(output);
     const MeshTopology topo = analyze_topology(mesh);
     EXPECT_TRUE(topo.is_oriented_manifold());
@@ -81,6 +82,50 @@ TEST(ReconstructCli, SampledSphereBecomesAClosedSemiRegularMeshOnTheSphere)
     EXPECT_EQ(report["stop"].get<std::string>(), "below sampling density");
     EXPECT_LT(levels.back()["hausdorff"].get<double>(), density);
     EXPECT_FALSE(report["stop_reason"].get<std::string>().empty());
+}
+
+TEST(ReconstructCli, DefaultStopStaysWithinTheSamplesAndReportsThePaperRule)
+{
+    test::TempDir dir;
+    const auto output = dir / "out.ply";
+    const std::size_t count = 20000;
+    const auto r = run("reconstruct " + quoted(write_sphere(dir, count)) + " -o " + quoted(output) +
+                       " --json");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const auto report = nlohmann::json::parse(r.out);
+    EXPECT_EQ(report["stop_rule"].get<std::string>(), "auto");
+    const std::string stop = report["stop"].get<std::string>();
+    EXPECT_TRUE(stop == "vertex budget" || stop == "small details") << stop;
+    EXPECT_EQ(report["vertex_budget"].get<std::size_t>(), count);
+    const TriMesh mesh = read_mesh(output);
+    EXPECT_LE(mesh.vertex_count(), count);
+    // The base mesh is fitted to the budget: the output has between 0.6 / 4 and all of it
+    // (a closed mesh of F faces has F / 2 + 2 vertices).
+    EXPECT_GT(mesh.vertex_count(), count / 8);
+    const MeshTopology topo = analyze_topology(mesh);
+    EXPECT_TRUE(topo.is_closed());
+    EXPECT_EQ(topo.euler_characteristic, 2);
+    // Within a small part of the sampling density of the true sphere.
+    EXPECT_LT(sphere_error(mesh), 0.25 * report["sampling_density"].get<double>());
+    for (const auto& level : report["levels"])
+    {
+        EXPECT_LE(level["robust_distance"].get<double>(), level["hausdorff"].get<double>());
+        EXPECT_LE(level["p90_distance"].get<double>(), level["hausdorff"].get<double>());
+    }
+    EXPECT_GE(report["field_residual"].get<double>(), 0.0);
+    EXPECT_GT(report["detail_threshold"].get<double>(), 0.0);
+    EXPECT_TRUE(report.contains("paper_rule_level"));
+
+    // The human report says why it stopped and what the paper's rule gives.
+    const auto text =
+        run("reconstruct " + quoted(dir / "sphere.ply") + " -o " + quoted(dir / "out2.ply"));
+    ASSERT_EQ(text.exit_code, 0) << text.out;
+    for (const char* expected : {"robust", "field residual", "vertex budget", "paper's rule"})
+        EXPECT_NE(text.out.find(expected), std::string::npos) << expected << "\n" << text.out;
+    EXPECT_NE(run("reconstruct " + quoted(dir / "sphere.ply") + " -o " + quoted(dir / "x.ply") +
+                  " --stop max")
+                  .exit_code,
+              0);
 }
 
 TEST(ReconstructCli, LevelsRefinesExactlyAndTheHierarchyGivesTheSameMesh)

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 
 namespace pointform {
 namespace {
@@ -71,8 +72,88 @@ double surface_distance(Shape shape, const Vec3d& p, double thickness)
             const Vec3d q = p.cwiseAbs() - half;
             return std::abs(q.maxCoeff());
         }
+        case Shape::Blobby:
+        case Shape::Part:
+            break;
     }
     return 1e9;
+}
+
+/// Exact signed distance of a box or capped z-cylinder of Shape::Part (negative inside).
+double primitive_distance(const PartPrimitive& q, const Vec3d& p)
+{
+    Eigen::Vector2d d;
+    if (q.kind == PartPrimitive::Kind::Box)
+    {
+        const Vec3d c = 0.5 * (q.min + q.max);
+        const Vec3d e = (p - c).cwiseAbs() - 0.5 * (q.max - q.min);
+        return e.cwiseMax(0.0).norm() + std::min(e.maxCoeff(), 0.0);
+    }
+    d.x() = std::hypot(p.x() - q.min.x(), p.y() - q.min.y()) - q.max.x();
+    d.y() = std::abs(p.z() - 0.5 * (q.min.z() + q.max.z())) - 0.5 * (q.max.z() - q.min.z());
+    return d.cwiseMax(0.0).norm() + std::min(d.maxCoeff(), 0.0);
+}
+
+/// A signed function of the Blobby and Part solids, zero exactly on their surface, negative
+/// inside (min and max of exact signed distances: a bound away from the surface).
+double solid_value(Shape shape, const Vec3d& p)
+{
+    double value = 1e9;
+    if (shape == Shape::Blobby)
+    {
+        for (const Ball& b : blobby_spheres())
+            value = std::min(value, (p - b.center).norm() - b.radius);
+        return value;
+    }
+    const PartSolid& solid = part_solid();
+    for (const PartPrimitive& q : solid.added)
+        value = std::min(value, primitive_distance(q, p));
+    for (const PartPrimitive& q : solid.removed)
+        value = std::max(value, -primitive_distance(q, p));
+    return value;
+}
+
+TEST(Shapes, BlobbyAndPartSamplesLieOnTheSolidsSurfaceWithOutwardNormals)
+{
+    for (const Shape shape : {Shape::Blobby, Shape::Part})
+    {
+        const PointCloud cloud = sample_shape(shape, {.count = 20000, .seed = 3});
+        ASSERT_EQ(cloud.size(), 20000U);
+        std::size_t outward = 0;
+        for (std::size_t i = 0; i < cloud.size(); ++i)
+        {
+            const Vec3d p = cloud.positions[i].cast<double>();
+            const Vec3d n = cloud.normals[i].cast<double>();
+            ASSERT_LT(std::abs(solid_value(shape, p)), 1e-6);
+            EXPECT_NEAR(n.norm(), 1.0, 1e-6);
+            // A small step along the normal leaves the solid and one against it enters it
+            // (but for samples within the step of a crease).
+            outward +=
+                solid_value(shape, p + 1e-3 * n) > 0.0 && solid_value(shape, p - 1e-3 * n) < 0.0
+                    ? 1
+                    : 0;
+        }
+        EXPECT_GT(static_cast<double>(outward), 0.995 * static_cast<double>(cloud.size()));
+    }
+}
+
+TEST(Shapes, PartSamplingIsAreaUniform)
+{
+    // The part's top face, z = 0.3, is the block's top (2 × 1.2) less the boss's and the hole's
+    // discs; its share of the samples is its share of the whole area, computed piece by piece.
+    const double pi = std::numbers::pi;
+    const double block = 2.0 * (2.0 * 1.2 + 1.2 * 0.6 + 0.6 * 2.0);
+    const double boss_r = 0.35;
+    const double hole_r = 0.25;
+    const double top = 2.0 * 1.2 - pi * boss_r * boss_r - pi * hole_r * hole_r;
+    const double total = block - pi * boss_r * boss_r - 2.0 * pi * hole_r * hole_r // faces cut
+                         + 2.0 * pi * boss_r * 0.4 + pi * boss_r * boss_r          // boss
+                         + 2.0 * pi * hole_r * 0.6;                                // hole wall
+    const PointCloud part = sample_shape(Shape::Part, {.count = 200000, .seed = 4});
+    std::size_t on_top = 0;
+    for (std::size_t i = 0; i < part.size(); ++i)
+        on_top += std::abs(part.positions[i].z() - 0.3F) < 1e-6F && part.normals[i].z() > 0.5F;
+    EXPECT_NEAR(static_cast<double>(on_top) / static_cast<double>(part.size()), top / total, 0.004);
 }
 
 TEST(Shapes, SamplesLieOnTheSurfaceWithUnitOutwardNormals)

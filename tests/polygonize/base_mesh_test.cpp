@@ -155,6 +155,30 @@ TEST(BaseMesh, SampledSphereReachesTheTargetOnTheSurface)
     }
 }
 
+TEST(BaseMesh, TargetFittedToAVertexBudget)
+{
+    // F0 moves by at most a factor of two, to a value whose level J has 2·0.6·budget faces.
+    for (const std::size_t budget : {1000UL, 35947UL, 100000UL, 1000000UL, 10000000UL})
+        for (const std::size_t target : {200UL, 850UL, 3000UL, 20000UL})
+        {
+            const std::size_t fitted = fit_base_faces_to_budget(target, budget);
+            if (static_cast<double>(target) >= 1.2 * static_cast<double>(budget))
+            {
+                EXPECT_EQ(fitted, target);
+                continue;
+            }
+            EXPECT_GE(2.0 * static_cast<double>(fitted), static_cast<double>(target));
+            EXPECT_LE(static_cast<double>(fitted), 2.0 * static_cast<double>(target));
+            const double levels =
+                std::log(1.2 * static_cast<double>(budget) / static_cast<double>(fitted)) /
+                std::log(4.0);
+            // F0 is rounded to whole faces: log₄ moves by at most 0.5 / (F0 ln 4).
+            EXPECT_NEAR(levels, std::round(levels), 0.5 / static_cast<double>(fitted))
+                << budget << " " << target;
+        }
+    EXPECT_EQ(fit_base_faces_to_budget(0, 1000), 0U);
+}
+
 TEST(BaseMesh, DefaultTargetFollowsTheIntermediateMesh)
 {
     const Scene scene = sampled(Shape::Sphere, 3000, sphere_area);

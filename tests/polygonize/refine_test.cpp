@@ -286,7 +286,8 @@ TEST(Refine, SampledSphereStopsBelowTheSamplingDensity)
     const PointCloud samples = sampled_sphere(8000);
     const PointField field(samples);
     MultiresMesh mesh(test::icosphere(0));
-    const RefineReport report = refine(mesh, field, samples, {.max_level = 6});
+    const RefineReport report =
+        refine(mesh, field, samples, {.max_level = 6, .stop_rule = StopRule::Paper});
     const double density = report.sampling_density;
     // 8000 area-uniform samples on the unit sphere are about sqrt(4π/8000) ≈ 0.04 apart; the
     // median nearest-neighbour distance is a fraction of that.
@@ -405,6 +406,156 @@ TEST(Refine, ButterflyPredictsBetterThanTheMidpoint)
             EXPECT_LE(p.cwiseAbs().maxCoeff(), 1.0 + 1e-12);
         }
     }
+}
+
+/// `count` samples of the unit sphere with isotropic Gaussian noise of `sigma` (absolute), with
+/// the true normals.
+PointCloud noisy_sphere(std::size_t count, double sigma)
+{
+    // sample_shape's noise is relative to the diagonal of the samples' box (2√3 for the sphere).
+    PointCloud cloud = sample_shape(
+        Shape::Sphere, {.count = count, .seed = 9, .noise = sigma / (2.0 * std::sqrt(3.0))});
+    const KdTree tree(cloud.positions);
+    cloud.radii = influence_radii(knn_batch(tree, cloud.positions, 17), 1.5);
+    return cloud;
+}
+
+/// Largest |‖p‖ − 1| over the vertices of the finest level.
+double sphere_error(const MultiresMesh& mesh)
+{
+    double error = 0.0;
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+        error = std::max(error, std::abs(mesh.world(static_cast<std::uint32_t>(v)).norm() - 1.0));
+    return error;
+}
+
+TEST(RefineAutomaticStop, CleanSphereRefinesToTheVertexBudget)
+{
+    // A clean sphere: every level brings the mesh about four times closer to the samples, so the
+    // budget (the number of samples) is what stops it, at the deepest level that fits.
+    const PointCloud samples = sampled_sphere(20000);
+    const PointField field(samples);
+    MultiresMesh mesh(test::icosphere(0));
+    const RefineReport report = refine(mesh, field, samples);
+    EXPECT_EQ(report.stop_rule, StopRule::Automatic);
+    EXPECT_EQ(report.vertex_budget, samples.size());
+    ASSERT_EQ(report.stop, RefineStop::VertexBudget);
+    EXPECT_LE(mesh.vertex_count(), samples.size());
+    // The next level (V + E = 4V − 6 on a closed genus-0 mesh) would not fit.
+    EXPECT_GT(4 * mesh.vertex_count() - 6, samples.size());
+    ASSERT_FALSE(report.levels.empty());
+    double previous = report.initial_robust_distance;
+    for (const RefineLevelStats& s : report.levels)
+    {
+        ASSERT_TRUE(s.robust_distance && s.p90_distance);
+        EXPECT_LT(*s.robust_distance, 0.8 * previous) << "level " << s.level;
+        EXPECT_LE(*s.robust_distance, *s.mean_distance + 1e-15);
+        EXPECT_LE(*s.p90_distance, *s.hausdorff);
+        previous = *s.robust_distance;
+    }
+    // Level J of an icosahedron has 10·4^J + 2 vertices: J = 5 (10242; 40962 is over 20000),
+    // and it lies on the sphere to within its chord error.
+    EXPECT_EQ(mesh.finest_level(), 5U);
+    EXPECT_LT(sphere_error(mesh), 0.2 * report.sampling_density);
+    EXPECT_FALSE(report.dropped);
+}
+
+/// Mean distance from the true unit sphere over the centroids of the finest level's faces: the
+/// chord error and the field's error together.
+double centroid_error(const MultiresMesh& mesh)
+{
+    const std::vector<Triangle> faces = mesh.faces(mesh.finest_level());
+    double sum = 0.0;
+    for (const Triangle& t : faces)
+        sum +=
+            std::abs((mesh.world(t[0]) + mesh.world(t[1]) + mesh.world(t[2])).norm() / 3.0 - 1.0);
+    return sum / static_cast<double>(faces.size());
+}
+
+TEST(RefineAutomaticStop, NoiseStopsRefinementAtTheNoiseFloor)
+{
+    // With noise the field's residual at the samples is the noise, and once a level's details
+    // shrink by half or less (not fourfold, as a smooth surface's do) they follow the noise in
+    // the field: refinement stops there, before the budget (made ample here), and a further
+    // level would not bring the mesh closer to the true sphere.
+    const double sigma = 0.01;
+    const PointCloud samples = noisy_sphere(20000, sigma);
+    const PointField field(samples);
+    MultiresMesh mesh(test::icosphere(0));
+    const RefineReport report =
+        refine(mesh, field, samples, {.vertex_budget = 100 * samples.size()});
+    EXPECT_TRUE(report.stop == RefineStop::NoisyDetails || report.stop == RefineStop::SmallDetails)
+        << to_string(report.stop);
+    EXPECT_LT(mesh.finest_level(), 6U);
+    EXPECT_NEAR(report.detail_threshold, 0.1 * report.field_residual, 1e-15);
+    ASSERT_FALSE(report.levels.empty());
+    const double last = *report.levels.back().next_detail;
+    const double before = report.levels.size() == 1
+                              ? report.initial_next_detail
+                              : *report.levels[report.levels.size() - 2].next_detail;
+    if (report.stop == RefineStop::NoisyDetails)
+    {
+        EXPECT_LT(last, report.field_residual);
+        EXPECT_GT(last, 0.5 * before);
+    }
+    else
+        EXPECT_LE(last, report.detail_threshold);
+    // The field's residual is the noise's: E|N(0, σ²)| = σ·√(2/π) ≈ 0.8σ, trimmed a little.
+    EXPECT_GT(report.field_residual, 0.5 * sigma);
+    EXPECT_LT(report.field_residual, 0.9 * sigma);
+    // One more level gains less than a tenth against the true sphere.
+    MultiresMesh finer = mesh;
+    (void)refine_once(finer, field);
+    EXPECT_GT(centroid_error(finer), 0.9 * centroid_error(mesh));
+    // The mesh follows the true sphere, not the noise.
+    EXPECT_LT(sphere_error(mesh), 4.0 * sigma);
+}
+
+TEST(RefineAutomaticStop, OutliersDoNotStopRefinement)
+{
+    // 1% of the measured samples are strays far off the surface: the largest distance stays at
+    // their distance at every level, so the paper's rule stalls at once, while the robust
+    // distance ignores them and refinement goes on to the budget.
+    const PointCloud clean = sampled_sphere(20000);
+    const PointField field(clean);
+    PointCloud measured = clean;
+    for (std::size_t i = 0; i < measured.size(); i += 100)
+        measured.positions[i] *= 1.4F;
+    MultiresMesh automatic(test::icosphere(0));
+    const RefineReport a = refine(automatic, field, measured);
+    EXPECT_EQ(a.stop, RefineStop::VertexBudget);
+    EXPECT_EQ(automatic.finest_level(), 5U);
+    EXPECT_FALSE(a.paper_level);
+    MultiresMesh paper(test::icosphere(0));
+    const RefineReport p = refine(paper, field, measured, {.stop_rule = StopRule::Paper});
+    EXPECT_EQ(p.stop, RefineStop::Stalled);
+    EXPECT_LT(paper.finest_level(), automatic.finest_level());
+    ASSERT_TRUE(p.dropped);
+    EXPECT_EQ(p.dropped->level, paper.finest_level() + 1);
+}
+
+TEST(RefineAutomaticStop, VertexBudgetOptionAndChecks)
+{
+    const PointCloud samples = sampled_sphere(20000);
+    const PointField field(samples);
+    MultiresMesh mesh(test::icosphere(0));
+    const RefineReport report = refine(mesh, field, samples, {.vertex_budget = 700});
+    EXPECT_EQ(report.stop, RefineStop::VertexBudget);
+    EXPECT_EQ(report.vertex_budget, 700U);
+    EXPECT_EQ(mesh.vertex_count(), 642U); // level 3; level 4 has 2562
+    MultiresMesh other(test::icosphere(0));
+    EXPECT_THROW((void)refine(other, field, samples, {.detail_factor = 0.0}), InvalidInput);
+    EXPECT_THROW((void)refine(other, field, samples, {.detail_factor = 1.5}), InvalidInput);
+    EXPECT_EQ(parse_stop_rule("auto"), StopRule::Automatic);
+    EXPECT_EQ(parse_stop_rule("paper"), StopRule::Paper);
+    EXPECT_EQ(parse_stop_rule("exact"), StopRule::Exact);
+    EXPECT_THROW((void)parse_stop_rule("max"), InvalidInput);
+    // Exact: to max_level whatever the distances.
+    MultiresMesh exact(test::icosphere(0));
+    const RefineReport r =
+        refine(exact, field, samples, {.max_level = 2, .stop_rule = StopRule::Exact});
+    EXPECT_EQ(exact.finest_level(), 2U);
+    EXPECT_EQ(r.stop, RefineStop::LevelCap);
 }
 
 TEST(Refine, ButterflyOnSampledSphere)

@@ -7,7 +7,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
+#include <vector>
 
 namespace pointform {
 
@@ -19,7 +21,43 @@ enum class Shape
     Torus,      ///< major radius 1, minor radius 0.35, axis z
     TwoSpheres, ///< two disjoint unit spheres centred at (±1.6, 0, 0)
     Plate,      ///< closed thin box 2 × 2 × thickness, centred at 0
+    /// The union of six overlapping spheres (a "blobby" shape): smooth parts meeting along
+    /// concave creases, where sharp features test a reconstruction (blobby_spheres()).
+    Blobby,
+    /// A machined part: a block 2 × 1.2 × 0.6 with a cylindrical boss on top and a round hole
+    /// through it: flat faces, convex and concave 90° creases and a genus-1 surface (part_solid()).
+    Part,
 };
+
+/// \brief A ball of the Blobby shape.
+struct Ball
+{
+    Vec3d center;
+    double radius = 0.0;
+};
+
+/// \brief The six balls whose union is Shape::Blobby.
+[[nodiscard]] std::span<const Ball> blobby_spheres();
+
+/// \brief Shape::Part as constructive solid geometry: the union of `added` minus the union of
+/// `removed`, each an axis-aligned box or a capped cylinder along z.
+struct PartPrimitive
+{
+    enum class Kind
+    {
+        Box,      ///< [min, max]
+        Cylinder, ///< axis along z through (min.x, min.y), radius max.x, z in [min.z, max.z]
+    };
+    Kind kind = Kind::Box;
+    Vec3d min = Vec3d::Zero();
+    Vec3d max = Vec3d::Zero();
+};
+struct PartSolid
+{
+    std::vector<PartPrimitive> added;
+    std::vector<PartPrimitive> removed;
+};
+[[nodiscard]] const PartSolid& part_solid();
 
 /// \brief Options for sample_shape.
 struct SampleOptions
@@ -43,7 +81,8 @@ struct SampleOptions
 /// \throw InvalidInput for count == 0 or negative noise, hole radius or thickness.
 [[nodiscard]] PointCloud sample_shape(Shape shape, const SampleOptions& options = {});
 
-/// \brief Parses "sphere", "torus", "two-spheres", "plate". \throw InvalidInput otherwise.
+/// \brief Parses "sphere", "torus", "two-spheres", "plate", "blobby", "part".
+/// \throw InvalidInput otherwise.
 [[nodiscard]] Shape parse_shape(const std::string& name);
 
 } // namespace pointform

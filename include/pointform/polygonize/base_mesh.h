@@ -105,6 +105,16 @@ inline constexpr std::size_t default_base_share = 64;
 [[nodiscard]] std::size_t default_base_faces(const TriMesh& intermediate,
                                              std::size_t share = default_base_share);
 
+/// \brief Moves a base-face target by at most a factor of two so that some refinement level of
+/// it has about `fill` of a vertex budget: the level J nearest to log₄(2·fill·budget / target),
+/// and F0 = 2·fill·budget / 4^J (a closed mesh of F faces has about F / 2 vertices). With a
+/// budget on the finest level's vertices (StopRule::Automatic), the deepest level that fits
+/// then has between fill and 4·fill of the budget, whatever the base mesh's own estimate; a
+/// target that alone would exceed the budget is returned as it is.
+/// \pre 0 < fill <= 1
+[[nodiscard]] std::size_t fit_base_faces_to_budget(std::size_t target, std::size_t vertex_budget,
+                                                   double fill = 0.6);
+
 /// \brief Automatic base mesh M⁰ (§5.1, Fig. 5): the intermediate (marching-cubes) mesh
 /// simplified by topology-safe edge collapses to a target face count, its triangles shaped, and
 /// every vertex moved onto f = 0.
