@@ -599,8 +599,7 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
     //    Each sample's own normal takes the sign of its oriented guide.
     if (guided)
         for (std::size_t i = 0; i < n; ++i)
-            result.normals[i] =
-                fine_normals[i].dot(result.normals[i]) < 0.0F ? -fine_normals[i] : fine_normals[i];
+            result.normals[i] = usable(fine_normals[i]) ? result.normals[i] : fine_normals[i];
 
     // 4. Samples without a normal of their own take their tree parent's; each component's root
     //    then faces +z.

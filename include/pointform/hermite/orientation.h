@@ -49,14 +49,18 @@ struct OrientationOptions
     double patch_cost = 0.3;
     /// Noisy clouds (Hoppe rule only): orientation follows guide normals, PCA normals of each
     /// sample's neighbourhood grown by up to this many rings of the neighbour table (each ring
-    /// one pass over all k columns), at the ring where the neighbourhood is flattest; each normal
-    /// then takes its guide's sign. Noise of twice the sampling step leaves PCA normals 40° off
-    /// and their signs to chance, while the guide's averages it out: on 1M noisy samples with
-    /// holes, 88.3% → 98.2% oriented on a torus, 94.1% → 98.5% on a sphere (2 rings: 97.7% and
-    /// 98.0%). A cloud whose neighbourhoods are mostly flat (median surface variation about that
-    /// of noise of 1/17 of the neighbourhood radius; clean scans are flatter) is oriented by its
-    /// own normals, so thin walls and sharp features of clean data keep their fine scale.
-    /// 0 = never guide.
+    /// one pass over all k columns), at the ring where the neighbourhood is flattest; the oriented
+    /// guides are then the output normals (where the input normal is usable): the neighbourhood
+    /// scale follows the noise. On a 100k-sample sphere with noise of 0.2% of its diagonal the
+    /// mean angle to the true normals went from 12.9° (each PCA normal given its guide's sign,
+    /// 10 of them inside out) to 1.8° (none), and its marching-cubes mesh from 9 components
+    /// and 9 boundary loops to one closed sphere. Noise of twice the sampling step leaves PCA
+    /// normals 40° off and their signs to chance, while the guide's averages it out: on 1M noisy
+    /// samples with holes, 88.3% → 98.2% oriented on a torus, 94.1% → 98.5% on a sphere (2
+    /// rings: 97.7% and 98.0%). A cloud whose neighbourhoods are mostly flat (median surface
+    /// variation about that of noise of 1/17 of the neighbourhood radius; clean scans are flatter)
+    /// is oriented by its own normals, so thin walls and sharp features of clean data keep their
+    /// fine scale. 0 = never guide.
     std::size_t guide_rings = 4;
     /// Sweeps in which every sample takes the sign of its neighbourhood's weighted mean normal,
     /// after propagation (each sweep reads all k columns of the table), when not guided (guided
@@ -125,7 +129,7 @@ struct OrientedNormals
 /// into patches, which are flipped against each other by the summed agreement of every graph
 /// edge between them. Then `options.smoothing_sweeps` times, every sample takes the sign of its
 /// neighbours' weighted mean normal. On noisy clouds (Hoppe rule) all this runs on coarser-scale
-/// guide normals (`options.guide_rings`), whose signs the input normals then take. Finally, so that
+/// guide normals (`options.guide_rings`), which are then the output normals. Finally, so that
 /// closed surfaces come out with outward normals whatever their shape, the component's normals are
 /// flipped if the area-weighted flux Σ a_i n_i·(p_i − c) (3 × the enclosed volume for a closed
 /// surface, by the divergence theorem) is clearly negative; for open, flat components the flux says
