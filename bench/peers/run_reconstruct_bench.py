@@ -32,7 +32,8 @@ import open3d as o3d
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from run_normals_bench import run_measured  # noqa: E402
-from run_surface_bench import VARIANTS, evaluate_isolated, load_points  # noqa: E402
+from plyio import write_ply  # noqa: E402
+from run_surface_bench import BUNNY_MESH, VARIANTS, evaluate_isolated, load_points  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 
@@ -70,11 +71,47 @@ def mesh_quality(path: Path) -> dict:
     }
 
 
+def write_points(path: Path, points: np.ndarray) -> None:
+    """Positions only, as binary float32 PLY."""
+    write_ply(str(path), {"x": points[:, 0].astype(np.float32), "y": points[:, 1].astype(np.float32),
+                          "z": points[:, 2].astype(np.float32)})
+
+
+def thread_scaling(args) -> int:
+    """Normals and reconstruct of one clean blobby at 1, 2, ... threads: wall time and peak."""
+    env = os.environ.copy()
+    cores = os.cpu_count() or 1
+    counts = sorted({t for t in (1, 2, 4, 8, 16, cores) if t <= cores})
+    with tempfile.TemporaryDirectory(prefix="pf-scaling-") as tmp:
+        work = Path(tmp)
+        run_measured([args.pointform, "sample", "blobby", "-n", str(args.scaling), "-o",
+                      work / "with_normals.ply"], env, args.timeout, work / "sample")
+        raw = work / "raw.ply"
+        write_points(raw, load_points(work / "with_normals.ply"))
+        print(f"| command | samples | threads | wall s | peak MiB | bytes per sample | result |")
+        print("|---|---|---|---|---|---|---|")
+        for command in ("normals", "reconstruct"):
+            for threads in counts:
+                out = work / f"{command}_{threads}.ply"
+                status, wall, peak, report = run_measured(
+                    [args.pointform, "-j", str(threads), command, raw, "-o", out, "--json"], env,
+                    args.timeout, work / "run")
+                result = ""
+                if report and command == "reconstruct":
+                    result = f"level {report.get('finest_level')}, {report.get('vertices')} vertices"
+                per_sample = peak * 1048576 / args.scaling if peak else float("nan")
+                print(f"| {command} | {args.scaling} | {threads} | {wall:.1f} | {peak or 0:.0f} | "
+                      f"{per_sample:.0f} | {status if status != 'ok' else result} |", flush=True)
+    return 0
+
+
 def main(argv=None) -> int:
     faulthandler.enable()
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--pointform", default="build/release/apps/pointform/pointform")
-    ap.add_argument("--shapes", default="sphere,torus")
+    ap.add_argument("--shapes", default="sphere,torus,blobby,part,plate,bunny",
+                    help="analytic shapes of `pointform sample`, and bunny (the shipped scan, "
+                         "clean only, against the Stanford reconstruction bun_zipper)")
     ap.add_argument("--variants", default="clean,noisy+holes")
     ap.add_argument("--size", type=int, default=100000)
     ap.add_argument("--bpa", action="store_true", help="also ball pivoting (slow)")
@@ -84,20 +121,38 @@ def main(argv=None) -> int:
                          "(the automatic stop can end at a mesh coarser than any marching cubes "
                          "of the field: its cells would be larger than the influence radii)")
     ap.add_argument("--timeout", type=float, default=1800)
+    ap.add_argument("--no-poisson", action="store_true", help="skip Open3D Poisson (slow)")
+    ap.add_argument("--scaling", type=int, default=0, metavar="N",
+                    help="only the thread-scaling table: normals and reconstruct of a clean "
+                         "blobby of N samples at 1, 2, ... threads (up to the cores)")
     args = ap.parse_args(argv)
+    if args.scaling:
+        return thread_scaling(args)
     env = os.environ.copy()
     rows = []
     with tempfile.TemporaryDirectory(prefix="pf-reconstruct-") as tmp:
         work = Path(tmp)
         for shape in args.shapes.split(","):
             truth_path = work / "truth.ply"
-            run_measured([args.pointform, "sample", shape, "-n", "200000", "--seed", "99", "-o",
-                          truth_path], env, 600, work / "truth")
+            if shape == "bunny":
+                # The truth is the Stanford reconstruction; the samples are its own vertices.
+                write_points(truth_path, load_points(BUNNY_MESH))
+            else:
+                run_measured([args.pointform, "sample", shape, "-n", "200000", "--seed", "99",
+                              "-o", truth_path], env, 600, work / "truth")
             truth = load_points(truth_path)
             for variant in args.variants.split(","):
                 raw = work / "raw.ply"
-                run_measured([args.pointform, "sample", shape, "-n", str(args.size), "-o", raw,
-                              *VARIANTS[variant]], env, 600, work / "sample")
+                if shape == "bunny":
+                    if variant != "clean":
+                        continue
+                    write_points(raw, load_points(BUNNY_MESH))
+                else:
+                    run_measured([args.pointform, "sample", shape, "-n", str(args.size), "-o",
+                                  work / "with_normals.ply", *VARIANTS[variant]], env, 600,
+                                 work / "sample")
+                    # Raw points: no tool may see the true normals.
+                    write_points(raw, load_points(work / "with_normals.ply"))
                 samples = load_points(raw)
                 diag = float(np.linalg.norm(samples.max(0) - samples.min(0)))
 
@@ -137,6 +192,8 @@ def main(argv=None) -> int:
                 measure("pointform mc (default cell)",
                         [args.pointform, "mc", raw, "-o", work / "mc_default.ply", "--json"],
                         work / "mc_default.ply")
+                if args.no_poisson:
+                    continue
                 measure("Open3D Poisson 9",
                         ["/usr/bin/python3", HERE / "open3d_surface.py", raw, work / "poisson9.ply",
                          "poisson", "9", "--estimate-normals", "16"], work / "poisson9.ply")

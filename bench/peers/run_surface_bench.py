@@ -95,6 +95,19 @@ def _blobby_distance(p: np.ndarray) -> np.ndarray:
     return best
 
 
+# The Stanford bunny's own reconstruction: the truth of the shipped scan (its vertices).
+BUNNY_MESH = HERE.parent.parent / "data" / "bunny" / "bun_zipper.ply"
+
+
+def _mesh_distance(mesh_path: Path, p: np.ndarray) -> np.ndarray:
+    """Exact point-to-triangle distance to a mesh (Open3D's RaycastingScene)."""
+    loaded = o3d.io.read_triangle_mesh(str(mesh_path))
+    scene = o3d.t.geometry.RaycastingScene()
+    scene.add_triangles(o3d.t.geometry.TriangleMesh.from_legacy(
+        o3d.geometry.TriangleMesh(loaded.vertices, loaded.triangles)))
+    return scene.compute_distance(o3d.core.Tensor(p.astype(np.float32))).numpy().astype(np.float64)
+
+
 def true_distance(shape: str, p: np.ndarray) -> np.ndarray:
     """Unsigned distance to the analytic surface `pointform sample` draws from (exact; for the
     part, the distance bound of its CSG of exact primitive distances, exact but within its
@@ -111,6 +124,8 @@ def true_distance(shape: str, p: np.ndarray) -> np.ndarray:
         return np.abs(_box_sdf(p, (-1.0, -1.0, -0.025), (1.0, 1.0, 0.025)))
     if shape == "blobby":
         return _blobby_distance(p)
+    if shape == "bunny":
+        return _mesh_distance(BUNNY_MESH, p)
     if shape == "part":
         value = np.min([_primitive_sdf(q, p) for q in PART_ADDED], axis=0)
         value = np.maximum(value, -np.min([_primitive_sdf(q, p) for q in PART_REMOVED], axis=0))
