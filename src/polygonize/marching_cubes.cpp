@@ -1037,8 +1037,9 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
         active.resize(kept);
     }
 
-    // Positions are stored as float32 relative to a grid point at the middle of the surface
-    // (not of the grid, which may be far larger), so their rounding is as small as it can be.
+    // Positions are stored as float32 relative to an origin at the middle of the surface (not
+    // of the grid, which may be far larger; rounded as choose_origin() does, so a surface about
+    // the world origin keeps origin 0 and float32 files), so their rounding stays small.
     // Vertices are kept off the grid corners by a margin well above that rounding (32 ulps of
     // the largest coordinate, at least 10⁻⁴ of a cell, at most 5%), so that no two vertices
     // coincide and the tiny triangles around a corner keep their shape once rounded.
@@ -1059,12 +1060,10 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
     {
         const Coord middle = {(low[0] + high[0]) / 2, (low[1] + high[1]) / 2,
                               (low[2] + high[2]) / 2};
-        mesh.vertices.origin = grid_point(grid, middle);
-        for (std::size_t a = 0; a < 3; ++a)
-        {
-            reach = std::max({reach, static_cast<double>(high[a] - middle[a]),
-                              static_cast<double>(middle[a] - low[a])});
-        }
+        mesh.vertices.origin = choose_origin(grid_point(grid, middle));
+        const Vec3d lo = grid_point(grid, low) - mesh.vertices.origin;
+        const Vec3d hi = grid_point(grid, high) - mesh.vertices.origin;
+        reach = std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff()) / grid.cell;
     }
     const double float_ulp_cells = reach * std::ldexp(1.0, -23);
     const double corner_margin = std::clamp(32.0 * float_ulp_cells, 1e-4, 0.05);
