@@ -53,6 +53,7 @@ TEST(ReconstructCli, SampledSphereBecomesAClosedSemiRegularMeshOnTheSphere)
         run("reconstruct " + quoted(write_sphere(dir)) + " -o " + quoted(output) + " --json");
     ASSERT_EQ(r.exit_code, 0) << r.out;
     const auto report = nlohmann::json::parse(r.out);
+    EXPECT_EQ(report["degenerate_kept"].get<std::size_t>(), 0U);
     const TriMesh mesh = read_mesh(output);
     const MeshTopology topo = analyze_topology(mesh);
     EXPECT_TRUE(topo.is_oriented_manifold());
