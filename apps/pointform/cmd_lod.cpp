@@ -7,6 +7,7 @@
 #include "pointform/io/io.h"
 
 #include "common.h"
+#include "output_transaction.h"
 
 #include <nlohmann/json.hpp>
 
@@ -56,7 +57,9 @@ void run_lod(const LodOptions& options, const GlobalOptions& global)
         extracted = mesh.level_mesh(level);
         topo = analyze_topology(*extracted);
         timings.lap("extract");
-        write_mesh(options.output, *extracted, {.ascii = options.ascii});
+        write_output(options.output, [&](const std::filesystem::path& path) {
+            write_mesh(path, *extracted, {.ascii = options.ascii});
+        });
         timings.lap("write");
     }
 

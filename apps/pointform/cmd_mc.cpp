@@ -10,6 +10,7 @@
 #include "pointform/polygonize/marching_cubes.h"
 
 #include "common.h"
+#include "output_transaction.h"
 #include "surfel_input.h"
 
 #include <nlohmann/json.hpp>
@@ -62,7 +63,9 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
             "marching cubes made no triangles: the field has no defined zero crossing "
             "at this cell size (try a smaller --cell or a larger --radius-scale)");
     }
-    write_mesh(options.output, result.mesh, {.ascii = options.ascii});
+    write_output(options.output, [&](const std::filesystem::path& path) {
+        write_mesh(path, result.mesh, {.ascii = options.ascii});
+    });
     timings.lap("write");
 
     const MeshTopology topo = analyze_topology(result.mesh);
@@ -90,6 +93,8 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
         out["cells_visited"] = result.stats.cells_visited;
         out["surface_cells"] = result.stats.surface_cells;
         out["undefined_cells"] = result.stats.undefined_cells;
+        out["degenerate_triangles"] = result.stats.degenerate_triangles;
+        out["degenerate_kept"] = result.stats.degenerate_kept;
         out["field_evaluations"] = result.stats.field_evaluations;
         out["hausdorff_samples_to_mesh"] = distance.max;
         out["mean_samples_to_mesh"] = distance.mean;
@@ -112,6 +117,8 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
     print_row("components", std::to_string(topo.components));
     print_row("boundary loops", std::to_string(topo.boundary_loops));
     print_row("Euler characteristic", std::to_string(topo.euler_characteristic));
+    print_row("degenerate triangles",
+              describe_degenerate(result.stats.degenerate_triangles, result.stats.degenerate_kept));
     print_row("Hausdorff samples->mesh",
               format_number(distance.max) + " (" + format_number(100.0 * distance.max / diagonal) +
                   "% of the diagonal; mean " + format_number(distance.mean) + ")");

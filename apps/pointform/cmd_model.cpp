@@ -11,6 +11,7 @@
 #include "pointform/polygonize/refine.h"
 
 #include "common.h"
+#include "output_transaction.h"
 #include "scene_input.h"
 #include "semi_regular.h"
 
@@ -133,7 +134,9 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
     }
     else
     {
-        write_mesh(options.output, result.mesh, {.ascii = options.scene.ascii});
+        write_output(options.output, [&](const std::filesystem::path& path) {
+            write_mesh(path, result.mesh, {.ascii = options.scene.ascii});
+        });
     }
     timings.lap("write");
     const TriMesh& written = semi ? semi->finest : result.mesh;
@@ -191,6 +194,8 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
         out["cells_visited"] = result.stats.cells_visited;
         out["surface_cells"] = result.stats.surface_cells;
         out["undefined_cells"] = result.stats.undefined_cells;
+        out["degenerate_triangles"] = result.stats.degenerate_triangles;
+        out["degenerate_kept"] = result.stats.degenerate_kept;
         out["field_evaluations"] = result.stats.field_evaluations;
         out["dense"] = result.stats.dense;
         add_run_report(out, timings);
@@ -239,6 +244,9 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
     print_row("components", std::to_string(topo.components));
     print_row("boundary loops", std::to_string(topo.boundary_loops));
     print_row("Euler characteristic", std::to_string(topo.euler_characteristic));
+    print_row("degenerate triangles",
+              describe_degenerate(result.stats.degenerate_triangles, result.stats.degenerate_kept) +
+                  " in marching cubes");
     print_timings(timings);
     for (const LoadedScan& scan : arguments.scans())
     {

@@ -9,6 +9,7 @@
 #include "pointform/polygonize/marching_cubes.h"
 
 #include "common.h"
+#include "output_transaction.h"
 #include "scene_input.h"
 
 #include <nlohmann/json.hpp>
@@ -50,33 +51,6 @@ std::string step_path(const std::string& prefix, int step, int steps)
     return prefix + "_" + number + ".ply";
 }
 
-/// Removes the files a failed run wrote, so that a failure leaves no partial sequence.
-class WrittenFiles
-{
-public:
-    WrittenFiles() = default;
-    WrittenFiles(const WrittenFiles&) = delete;
-    WrittenFiles& operator=(const WrittenFiles&) = delete;
-    ~WrittenFiles()
-    {
-        if (committed_)
-        {
-            return;
-        }
-        for (const std::string& path : paths_)
-        {
-            std::error_code error;
-            std::filesystem::remove(path, error);
-        }
-    }
-    void add(const std::string& path) { paths_.push_back(path); }
-    void commit() { committed_ = true; }
-
-private:
-    std::vector<std::string> paths_;
-    bool committed_ = false;
-};
-
 void run_morph(const MorphCommandOptions& options, const GlobalOptions& global)
 {
     set_thread_count(global.threads);
@@ -98,7 +72,7 @@ void run_morph(const MorphCommandOptions& options, const GlobalOptions& global)
     const SceneGrid grid = choose_scene_grid(box, options.scene, arguments.scans());
 
     std::vector<MorphStep> steps;
-    WrittenFiles written;
+    OutputTransaction written;
     for (int i = 0; i <= options.steps; ++i)
     {
         const auto start = std::chrono::steady_clock::now();
@@ -113,8 +87,9 @@ void run_morph(const MorphCommandOptions& options, const GlobalOptions& global)
             throw Error("marching cubes made no triangles at t = " + format_number(step.t) +
                         " (check --bounds, try a smaller --cell or a larger --radius-scale)");
         }
-        written.add(step.path);
-        write_mesh(step.path, result.mesh, {.ascii = options.scene.ascii});
+        written.stage(step.path, [&](const std::filesystem::path& path) {
+            write_mesh(path, result.mesh, {.ascii = options.scene.ascii});
+        });
         step.vertices = result.mesh.vertex_count();
         step.faces = result.mesh.face_count();
         step.topology = analyze_topology(result.mesh);
@@ -122,7 +97,7 @@ void run_morph(const MorphCommandOptions& options, const GlobalOptions& global)
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         steps.push_back(std::move(step));
     }
-    written.commit();
+    written.commit(); // every step, or none
     timings.lap("marching cubes + write");
     progress.clear();
 

@@ -7,6 +7,7 @@
 #include "pointform/io/io.h"
 
 #include "common.h"
+#include "output_transaction.h"
 
 #include <nlohmann/json.hpp>
 
@@ -87,7 +88,9 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
     const SurfelResult result = compute_surfels(cloud, surfel_options);
     for (const auto& [stage, seconds] : result.stage_seconds)
         timings.add(stage, seconds);
-    write_point_cloud(options.output, result.surfels, {.ascii = options.ascii});
+    write_output(options.output, [&](const std::filesystem::path& path) {
+        write_point_cloud(path, result.surfels, {.ascii = options.ascii});
+    });
     timings.lap("write");
     progress.clear();
 

@@ -51,6 +51,8 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
     double cell = 0.0;
     std::size_t intermediate_faces = 0;
     std::size_t intermediate_vertices = 0;
+    std::size_t degenerate_triangles = 0;
+    std::size_t degenerate_kept = 0;
     if (!options.base_mesh.empty())
     {
         picked = read_picked_base_mesh(options.base_mesh, field.surfels(), field);
@@ -80,6 +82,8 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
         }
         intermediate_faces = mc.mesh.face_count();
         intermediate_vertices = mc.mesh.vertex_count();
+        degenerate_triangles = mc.stats.degenerate_triangles;
+        degenerate_kept = mc.stats.degenerate_kept;
         const std::size_t target =
             base_face_target(options.refine, mc.mesh, default_base_share, input.surfels.size());
         if (options.refine.levels)
@@ -107,6 +111,8 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
             out["cell"] = cell;
             out["intermediate_faces"] = intermediate_faces;
             out["intermediate_vertices"] = intermediate_vertices;
+            out["degenerate_triangles"] = degenerate_triangles;
+            out["degenerate_kept"] = degenerate_kept;
             out["base_mesh"] = base_mesh_json(*base_stats);
             out["base_mesh"]["source"] = "automatic";
         }
@@ -139,9 +145,10 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
                              (input.estimated_normals ? " (normals estimated)" : " (surfels)"));
     if (base_stats)
     {
-        print_row("intermediate mesh", std::to_string(intermediate_faces) +
-                                           " faces (marching cubes, cell " + format_number(cell) +
-                                           ", " + options.fit + " field)");
+        print_row("intermediate mesh",
+                  std::to_string(intermediate_faces) + " faces (marching cubes, cell " +
+                      format_number(cell) + ", " + options.fit + " field; degenerate " +
+                      describe_degenerate(degenerate_triangles, degenerate_kept) + ")");
         print_base_mesh(*base_stats);
     }
     else

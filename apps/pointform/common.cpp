@@ -100,6 +100,12 @@ std::string format_number(double value)
     return buffer;
 }
 
+std::string describe_degenerate(std::size_t degenerate, std::size_t kept)
+{
+    return std::to_string(degenerate) + " (" + std::to_string(degenerate - kept) + " flipped, " +
+           std::to_string(kept) + " kept; none dropped)";
+}
+
 void print_row(const std::string& label, const std::string& value)
 {
     std::printf("  %-22s %s\n", (label + ":").c_str(), value.c_str());

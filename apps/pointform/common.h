@@ -82,6 +82,10 @@ void print_timings(const Timings& timings);
 /// \brief Prints a one-line JSON-free summary row "label: value" aligned for humans.
 void print_row(const std::string& label, const std::string& value);
 
+/// \brief The marching-cubes triangles of next to zero area and what became of them, for
+/// reports: "N (F flipped, K kept; none dropped)".
+[[nodiscard]] std::string describe_degenerate(std::size_t degenerate, std::size_t kept);
+
 /// \brief Registers the subcommands; each is defined in its own cmd_<verb>.cpp.
 void register_info(CLI::App& app, const GlobalOptions& global);
 void register_normals(CLI::App& app, const GlobalOptions& global);

@@ -8,9 +8,12 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <new>
+#include <string>
+#include <thread>
 
 namespace {
 
@@ -20,19 +23,49 @@ constexpr int exit_invalid_input = 2; // data or option values that cannot be pr
 constexpr int exit_io = 3;            // a file could not be read or written
 constexpr int exit_failure = 4;       // any other failure
 
+/// The largest -j accepted: four threads per core, and at least 8 (determinism tests
+/// oversubscribe small machines on purpose).
+int max_thread_option()
+{
+    const unsigned cores = std::thread::hardware_concurrency();
+    return std::max(8, 4 * static_cast<int>(std::min(cores, 1024U)));
+}
+
 int run(int argc, char** argv)
 {
     CLI::App app{
         "pointform: multiresolution free-form modeling from point-sampled geometry.\n"
-        "Exit codes: 0 success, 2 invalid input, 3 file error, 4 other failure; "
-        "usage errors as CLI11 reports them (non-zero)."};
+        "Exit codes: 0 success, 2 invalid input or usage (bad option values, unknown options, "
+        "missing arguments), 3 file error, 4 other failure."};
     app.set_version_flag("--version", "pointform 0.1.0");
     app.require_subcommand(1);
     app.fallthrough();
 
     pointform::cli::GlobalOptions global;
-    app.add_option("-j,--threads", global.threads, "Threads to use (0 = all cores)")
-        ->check(CLI::NonNegativeNumber);
+    // More threads than this only costs memory and time: a typo, not a wish.
+    const int max_threads = max_thread_option();
+    app.add_option("-j,--threads", global.threads,
+                   "Threads to use (0 = all cores; at most " + std::to_string(max_threads) + ")")
+        ->check(CLI::Validator(
+            [max_threads](const std::string& text) -> std::string {
+                long long n = -1;
+                try
+                {
+                    std::size_t used = 0;
+                    n = std::stoll(text, &used);
+                    if (used != text.size())
+                        n = -1;
+                }
+                catch (const std::exception&)
+                {
+                    n = -1;
+                }
+                if (n < 0 || n > max_threads)
+                    return "-j " + text + ": expected 0 (all cores) to " +
+                           std::to_string(max_threads) + " (4 per core on this machine)";
+                return {};
+            },
+            "0.." + std::to_string(max_threads)));
     app.add_flag("-q,--quiet", global.quiet, "No progress and no summary");
 
     pointform::cli::register_info(app, global);
@@ -53,7 +86,9 @@ int run(int argc, char** argv)
     }
     catch (const CLI::ParseError& e)
     {
-        return app.exit(e);
+        // --help and --version exit 0; every usage error (a bad option value, an unknown
+        // option, a missing argument) is invalid input.
+        return app.exit(e) == exit_ok ? exit_ok : exit_invalid_input;
     }
     catch (const pointform::IoError& e)
     {

@@ -4,9 +4,11 @@
 #include "scene_input.h"
 
 #include "pointform/core/error.h"
+#include "pointform/core/memory.h"
 #include "pointform/io/io.h"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <sstream>
 #include <system_error>
@@ -205,6 +207,17 @@ SceneGrid choose_scene_grid(const Aabb& field_bounds, const SceneCommandOptions&
     for (const LoadedScan& scan : scans)
     {
         check_marching_cubes_memory(*scan.field, out.cell);
+    }
+    if (scans.empty())
+    {
+        // Primitives alone: a convex surface inside the box has at most the box's area, so
+        // take that as the surface the grid follows.
+        const Vec3d size = out.box.size();
+        const double area = 2.0 * (size.x() * size.y() + size.y() * size.z() + size.z() * size.x());
+        char what[96];
+        std::snprintf(what, sizeof what, "marching cubes of the scene at a cell of %g", out.cell);
+        check_memory(estimate_marching_cubes_bytes(area, out.cell), what,
+                     "use a larger --cell or a lower --resolution");
     }
     return out;
 }

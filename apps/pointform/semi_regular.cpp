@@ -4,15 +4,15 @@
 #include "semi_regular.h"
 
 #include "pointform/core/error.h"
+#include "pointform/core/memory.h"
 #include "pointform/io/hierarchy.h"
 #include "pointform/io/io.h"
 #include "pointform/metrics/hausdorff.h"
 
 #include "common.h"
+#include "output_transaction.h"
 
 #include <nlohmann/json.hpp>
-
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -37,17 +37,6 @@ constexpr const char* hausdorff_definition =
     "one-sided Hausdorff distance: the largest distance from a sample to the mesh (exact "
     "closest point on the triangles)";
 
-double physical_memory_bytes()
-{
-    const long pages = ::sysconf(_SC_PHYS_PAGES);
-    const long page_size = ::sysconf(_SC_PAGE_SIZE);
-    if (pages <= 0 || page_size <= 0)
-    {
-        return std::numeric_limits<double>::infinity();
-    }
-    return static_cast<double>(pages) * static_cast<double>(page_size);
-}
-
 double faces_at_level(std::size_t base_faces, std::size_t level)
 {
     return static_cast<double>(base_faces) * std::pow(4.0, static_cast<double>(level));
@@ -57,7 +46,8 @@ bool fits(std::size_t base_faces, std::size_t level)
 {
     const double faces = faces_at_level(base_faces, level);
     return faces <= static_cast<double>(std::numeric_limits<std::uint32_t>::max()) &&
-           bytes_per_refined_face * faces <= 0.8 * physical_memory_bytes();
+           estimate_refinement_bytes(base_faces, level) <=
+               0.8 * static_cast<double>(memory_limit_bytes());
 }
 
 std::string percent_of(double value, double diagonal)
@@ -316,19 +306,17 @@ void check_refinement_memory(std::size_t base_faces, std::size_t level)
                            " faces, more than 32-bit indices allow; use fewer --levels or "
                            "--base-faces");
     }
-    const double need = bytes_per_refined_face * faces;
-    const double have = physical_memory_bytes();
-    if (need > 0.8 * have)
-    {
-        constexpr double gib = 1024.0 * 1024.0 * 1024.0;
-        char text[300];
-        std::snprintf(text, sizeof text,
-                      "level %zu of a base mesh of %zu faces would have %.4g faces and need about "
-                      "%.1f GiB, more than the %.1f GiB of memory this machine has; use fewer "
-                      "--levels or --base-faces",
-                      level, base_faces, faces, need / gib, have / gib);
-        throw InvalidInput(text);
-    }
+    char what[160];
+    std::snprintf(what, sizeof what,
+                  "level %zu of a base mesh of %zu faces (%.4g faces at that level)", level,
+                  base_faces, faces);
+    check_memory(estimate_refinement_bytes(base_faces, level), what,
+                 "use fewer --levels or --base-faces");
+}
+
+double estimate_refinement_bytes(std::size_t base_faces, std::size_t level)
+{
+    return bytes_per_refined_face * faces_at_level(base_faces, level);
 }
 
 std::size_t affordable_level(std::size_t base_faces, std::size_t cap)
@@ -381,21 +369,17 @@ SemiRegularResult refine_semi_regular(const TriMesh& base, const PointField& fie
 void write_semi_regular(const std::string& output, const SemiRegularOptions& options,
                         const MultiresMesh& hierarchy)
 {
-    write_mesh(output, hierarchy.level_mesh(hierarchy.finest_level()), {.ascii = options.ascii});
-    if (options.save_hierarchy.empty())
+    OutputTransaction transaction;
+    transaction.stage(output, [&](const std::filesystem::path& path) {
+        write_mesh(path, hierarchy.level_mesh(hierarchy.finest_level()), {.ascii = options.ascii});
+    });
+    if (!options.save_hierarchy.empty())
     {
-        return;
+        transaction.stage(options.save_hierarchy, [&](const std::filesystem::path& path) {
+            write_hierarchy(path, hierarchy);
+        });
     }
-    try
-    {
-        write_hierarchy(options.save_hierarchy, hierarchy);
-    }
-    catch (...)
-    {
-        std::error_code ignored;
-        std::filesystem::remove(output, ignored);
-        throw;
-    }
+    transaction.commit(); // the mesh and the hierarchy, or neither
 }
 
 AngleStats angle_stats(const TriMesh& mesh)

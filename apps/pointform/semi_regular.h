@@ -66,8 +66,13 @@ CLI::Option* add_base_faces_option(CLI::App& cmd, SemiRegularOptions& options);
                                            std::size_t samples = 0);
 
 /// \brief Refuses, before anything is allocated, a level whose F0·4^J faces would not fit in
-/// memory (or in 32-bit indices). \throw InvalidInput saying how much it would need
+/// memory (check_memory(): the cgroup limit or MemAvailable) or in 32-bit indices.
+/// \throw InvalidInput saying how much it would need
 void check_refinement_memory(std::size_t base_faces, std::size_t level);
+
+/// \brief About how many bytes refining `base_faces` faces to `level` needs (256 per face of
+/// that level).
+[[nodiscard]] double estimate_refinement_bytes(std::size_t base_faces, std::size_t level);
 
 /// \brief The deepest level ≤ `cap` whose faces fit in memory (at least 0).
 [[nodiscard]] std::size_t affordable_level(std::size_t base_faces, std::size_t cap);
@@ -100,8 +105,9 @@ struct SemiRegularResult
                                                     const SemiRegularOptions& options,
                                                     const ProgressCallback& progress);
 
-/// \brief Writes the finest level to `output` (format by extension, atomically) and, if asked,
-/// the hierarchy; if the second write fails the first file is removed.
+/// \brief Writes the finest level to `output` (format by extension) and, if asked, the
+/// hierarchy, as one OutputTransaction: both files or neither, and pre-existing files keep
+/// their bytes when a write fails.
 void write_semi_regular(const std::string& output, const SemiRegularOptions& options,
                         const MultiresMesh& hierarchy);
 

@@ -4,11 +4,10 @@
 #include "pointform/polygonize/marching_cubes.h"
 
 #include "pointform/core/error.h"
+#include "pointform/core/memory.h"
 #include "pointform/core/parallel.h"
 #include "pointform/geometry/mesh_topology.h"
 #include "pointform/implicit/point_field.h"
-
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -451,36 +450,26 @@ double default_cell_size(const PointField& field)
     return 0.4 * field.median_radius();
 }
 
-double estimate_marching_cubes_bytes(const PointField& field, double cell)
+double estimate_marching_cubes_bytes(double surface_area, double cell)
 {
     // A surface of area A cuts about 1.5 A / h² cells (the mean of |nx| + |ny| + |nz|); each
     // costs about 400 bytes: its share of the 8³ corner blocks (~120), wave keys (~40), two
     // triangles as edge keys (~50), 1.5 vertices with their refinement state (~190).
     constexpr double bytes_per_cell = 400.0;
-    return bytes_per_cell * 1.5 * field.estimated_area() / (cell * cell);
+    return bytes_per_cell * 1.5 * surface_area / (cell * cell);
+}
+
+double estimate_marching_cubes_bytes(const PointField& field, double cell)
+{
+    return estimate_marching_cubes_bytes(field.estimated_area(), cell);
 }
 
 void check_marching_cubes_memory(const PointField& field, double cell)
 {
-    const double need = estimate_marching_cubes_bytes(field, cell);
-    const long pages = ::sysconf(_SC_PHYS_PAGES);
-    const long page_size = ::sysconf(_SC_PAGE_SIZE);
-    if (pages <= 0 || page_size <= 0)
-    {
-        return;
-    }
-    const double have = static_cast<double>(pages) * static_cast<double>(page_size);
-    if (need > 0.8 * have)
-    {
-        constexpr double gib = 1024.0 * 1024.0 * 1024.0;
-        char text[200];
-        std::snprintf(text, sizeof text,
-                      "marching cubes at a cell of %g would need about %.1f GiB, more than the "
-                      "%.1f GiB of memory this machine has; use a larger cell or a lower "
-                      "resolution",
-                      cell, need / gib, have / gib);
-        throw InvalidInput(text);
-    }
+    char what[96];
+    std::snprintf(what, sizeof what, "marching cubes at a cell of %g", cell);
+    check_memory(estimate_marching_cubes_bytes(field, cell), what,
+                 "use a larger cell or a lower resolution");
 }
 
 namespace {
@@ -542,6 +531,123 @@ void evaluate_near_zero(const Field& field, double range, std::span<const Vec3d>
     for (std::size_t j = 0; j < beyond.size(); ++j)
     {
         samples[beyond[j]] = exact[j];
+    }
+}
+
+/// Twice the area of face f on the stored (float32) positions, in the mesh's units².
+double double_area(const TriMesh& mesh, const Triangle& t)
+{
+    const Vec3d a = mesh.vertices.positions[t[0]].cast<double>();
+    const Vec3d b = mesh.vertices.positions[t[1]].cast<double>();
+    const Vec3d c = mesh.vertices.positions[t[2]].cast<double>();
+    return (b - a).cross(c - a).norm();
+}
+
+std::uint64_t edge_key(std::uint32_t from, std::uint32_t to)
+{
+    return static_cast<std::uint64_t>(from) << 32 | to;
+}
+
+/// Makes every triangle whose stored positions have (next to) zero area whole again, keeping the
+/// surface closed: its corner w lies on its opposite edge (u, v), so flipping (u, v) in the
+/// quad it forms with the neighbour (v, u, d) gives (u, d, w) and (d, v, w), which tile that
+/// neighbour exactly (the same surface, no new overlap). A flip that would duplicate an edge
+/// or leave a zero-area triangle is not made, and the triangle is kept.
+void repair_degenerate_triangles(TriMesh& mesh, double cell, MarchingCubesStats& stats)
+{
+    const double min_double_area = 1e-12 * cell * cell;
+    std::vector<std::uint32_t> degenerate;
+    for (std::size_t f = 0; f < mesh.triangles.size(); ++f)
+    {
+        if (!(double_area(mesh, mesh.triangles[f]) > min_double_area))
+        {
+            degenerate.push_back(static_cast<std::uint32_t>(f));
+        }
+    }
+    stats.degenerate_triangles = degenerate.size();
+    if (degenerate.empty())
+    {
+        return;
+    }
+    // Directed edge -> face, for the faces near the degenerate ones.
+    std::unordered_map<std::uint64_t, std::uint32_t> face_of;
+    face_of.reserve(3 * mesh.triangles.size());
+    for (std::size_t f = 0; f < mesh.triangles.size(); ++f)
+    {
+        const Triangle& t = mesh.triangles[f];
+        for (std::size_t j = 0; j < 3; ++j)
+        {
+            face_of[edge_key(t[j], t[(j + 1) % 3])] = static_cast<std::uint32_t>(f);
+        }
+    }
+    auto position = [&](std::uint32_t v) {
+        return mesh.vertices.positions[v].cast<double>();
+    };
+    for (const std::uint32_t f : degenerate)
+    {
+        const Triangle t = mesh.triangles[f];
+        if (double_area(mesh, t) > min_double_area)
+        {
+            continue; // an earlier flip already made it whole
+        }
+        // w: the corner between the other two.
+        std::size_t mid = 0;
+        double best = std::numeric_limits<double>::infinity();
+        for (std::size_t j = 0; j < 3; ++j)
+        {
+            const Vec3d m = position(t[j]);
+            const double d = (position(t[(j + 1) % 3]) - m).dot(position(t[(j + 2) % 3]) - m);
+            if (d < best)
+            {
+                best = d;
+                mid = j;
+            }
+        }
+        const std::uint32_t w = t[mid];
+        const std::uint32_t u = t[(mid + 1) % 3];
+        const std::uint32_t v = t[(mid + 2) % 3];
+        const auto across = face_of.find(edge_key(v, u));
+        if (across == face_of.end())
+        {
+            ++stats.degenerate_kept;
+            continue;
+        }
+        const std::uint32_t g = across->second;
+        const Triangle& n = mesh.triangles[g];
+        std::uint32_t d = n[0];
+        for (const std::uint32_t c : n)
+        {
+            if (c != u && c != v)
+            {
+                d = c;
+            }
+        }
+        const Triangle first = {u, d, w};
+        const Triangle second = {d, v, w};
+        if (d == w || face_of.contains(edge_key(w, d)) || face_of.contains(edge_key(d, w)) ||
+            !(double_area(mesh, first) > min_double_area) ||
+            !(double_area(mesh, second) > min_double_area))
+        {
+            ++stats.degenerate_kept;
+            continue;
+        }
+        for (const Triangle& old : {t, n})
+        {
+            for (std::size_t j = 0; j < 3; ++j)
+            {
+                face_of.erase(edge_key(old[j], old[(j + 1) % 3]));
+            }
+        }
+        mesh.triangles[f] = first;
+        mesh.triangles[g] = second;
+        for (const std::uint32_t h : {f, g})
+        {
+            const Triangle& now = mesh.triangles[h];
+            for (std::size_t j = 0; j < 3; ++j)
+            {
+                face_of[edge_key(now[j], now[(j + 1) % 3])] = h;
+            }
+        }
     }
 }
 
@@ -931,11 +1037,36 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
         active.resize(kept);
     }
 
-    // Keep vertices off the grid corners, so that no two vertices coincide.
-    constexpr double corner_margin = 1e-4;
+    // Positions are stored as float32 relative to an origin at the middle of the surface (not
+    // of the grid, which may be far larger; rounded as choose_origin() does, so a surface about
+    // the world origin keeps origin 0 and float32 files), so their rounding stays small.
+    // Vertices are kept off the grid corners by a margin well above that rounding (32 ulps of
+    // the largest coordinate, at least 10⁻⁴ of a cell, at most 5%), so that no two vertices
+    // coincide and the tiny triangles around a corner keep their shape once rounded.
     TriMesh& mesh = result.mesh;
-    mesh.vertices.origin =
-        choose_origin(grid_point(grid, {grid.cells[0] / 2, grid.cells[1] / 2, grid.cells[2] / 2}));
+    Coord low = {max_cells, max_cells, max_cells};
+    Coord high = {0, 0, 0};
+    for (std::size_t v = 0; v < nv; ++v)
+    {
+        const Coord base = unpack(edges[v] >> 2);
+        for (std::size_t a = 0; a < 3; ++a)
+        {
+            low[a] = std::min(low[a], base[a]);
+            high[a] = std::max(high[a], base[a] + 1);
+        }
+    }
+    double reach = 0.0; // the largest |coordinate| in cells, relative to the origin
+    if (nv > 0)
+    {
+        const Coord middle = {(low[0] + high[0]) / 2, (low[1] + high[1]) / 2,
+                              (low[2] + high[2]) / 2};
+        mesh.vertices.origin = choose_origin(grid_point(grid, middle));
+        const Vec3d lo = grid_point(grid, low) - mesh.vertices.origin;
+        const Vec3d hi = grid_point(grid, high) - mesh.vertices.origin;
+        reach = std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff()) / grid.cell;
+    }
+    const double float_ulp_cells = reach * std::ldexp(1.0, -23);
+    const double corner_margin = std::clamp(32.0 * float_ulp_cells, 1e-4, 0.05);
     mesh.vertices.positions.resize(nv);
     points.resize(nv);
     for (std::size_t v = 0; v < nv; ++v)
@@ -976,26 +1107,18 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
         }
     }
 
-    // Triangles, without the zero-area ones.
-    const double min_double_area = 1e-12 * grid.cell * grid.cell;
-    mesh.triangles.reserve(corners_of_triangles.size() / 3);
-    for (std::size_t i = 0; i + 2 < corners_of_triangles.size(); i += 3)
+    // Triangles, all of them: dropping one would open a hole.
+    mesh.triangles.resize(corners_of_triangles.size() / 3);
+    for (std::size_t f = 0; f < mesh.triangles.size(); ++f)
     {
-        Triangle tri{};
         for (std::size_t j = 0; j < 3; ++j)
         {
             const auto it =
-                std::lower_bound(edges.begin(), edges.end(), corners_of_triangles[i + j]);
-            tri[j] = static_cast<std::uint32_t>(it - edges.begin());
+                std::lower_bound(edges.begin(), edges.end(), corners_of_triangles[3 * f + j]);
+            mesh.triangles[f][j] = static_cast<std::uint32_t>(it - edges.begin());
         }
-        const Vec3d n = (points[tri[1]] - points[tri[0]]).cross(points[tri[2]] - points[tri[0]]);
-        if (!(n.norm() > min_double_area))
-        {
-            ++stats.dropped_degenerate;
-            continue;
-        }
-        mesh.triangles.push_back(tri);
     }
+    repair_degenerate_triangles(mesh, grid.cell, stats);
     // Where undefined cells meet diagonally, two sheets touch at one vertex; give each its own.
     stats.split_vertices = split_nonmanifold_vertices(mesh);
     progress.finish();

@@ -32,6 +32,8 @@ TEST(McCli, BunnyScanToAMesh)
     const TriMesh mesh = read_mesh(output);
     EXPECT_EQ(report["faces"].get<std::size_t>(), mesh.face_count());
     EXPECT_EQ(report["vertices"].get<std::size_t>(), mesh.vertex_count());
+    EXPECT_EQ(report["degenerate_kept"].get<std::size_t>(), 0U);
+    EXPECT_LE(report["degenerate_triangles"].get<std::size_t>(), mesh.face_count());
     const MeshTopology topo = analyze_topology(mesh);
     EXPECT_TRUE(topo.is_oriented_manifold());
     EXPECT_EQ(report["boundary_loops"].get<std::size_t>(), topo.boundary_loops);

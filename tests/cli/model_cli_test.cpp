@@ -47,6 +47,9 @@ TEST(ModelCli, UnionOfTwoSpheresIsOneClosedSphere)
     EXPECT_EQ(report["components"].get<int>(), 1);
     EXPECT_EQ(report["boundary_loops"].get<int>(), 0);
     EXPECT_EQ(report["euler_characteristic"].get<int>(), 2);
+    // Marching cubes keeps every triangle; none had to be mended here.
+    EXPECT_EQ(report["degenerate_triangles"].get<std::size_t>(), 0U);
+    EXPECT_EQ(report["degenerate_kept"].get<std::size_t>(), 0U);
     const TriMesh mesh = read_mesh(output);
     EXPECT_EQ(mesh.face_count(), report["faces"].get<std::size_t>());
     const MeshTopology topo = analyze_topology(mesh);

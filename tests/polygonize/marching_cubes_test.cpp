@@ -9,8 +9,12 @@
 #include "pointform/geometry/shapes.h"
 #include "pointform/hermite/radius.h"
 #include "pointform/hermite/surfels.h"
+#include "pointform/implicit/operators.h"
 #include "pointform/implicit/point_field.h"
+#include "pointform/implicit/primitives.h"
 #include "pointform/spatial/kd_tree.h"
+
+#include "support/self_intersection.h"
 
 #include <gtest/gtest.h>
 
@@ -153,7 +157,7 @@ TEST(MarchingCubes, SphereIsClosedOutwardAndOnTheSurface)
     EXPECT_TRUE(topo.is_closed());
     EXPECT_EQ(topo.components, 1U);
     EXPECT_EQ(topo.euler_characteristic, 2);
-    EXPECT_EQ(result.stats.dropped_degenerate, 0U);
+    EXPECT_EQ(result.stats.degenerate_triangles, 0U);
     // Vertices on the sphere (the field is exact, so regula falsi converges).
     for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
     {
@@ -269,7 +273,7 @@ TEST(MarchingCubes, SampledSphereThroughThePointField)
     EXPECT_TRUE(topo.is_closed());
     EXPECT_EQ(topo.components, 1U);
     EXPECT_EQ(topo.euler_characteristic, 2);
-    EXPECT_EQ(result.stats.dropped_degenerate, 0U);
+    EXPECT_EQ(result.stats.degenerate_triangles, 0U);
     const double spacing = std::sqrt(4.0 * std::numbers::pi / 20000.0);
     double worst = 0.0;
     for (std::size_t v = 0; v < result.mesh.vertex_count(); ++v)
@@ -339,6 +343,168 @@ TEST(MarchingCubes, SameMeshWhateverTheThreadCount)
     ASSERT_EQ(one.triangles, two.triangles);
     ASSERT_EQ(one.vertices.positions, two.vertices.positions);
     EXPECT_EQ(analyze_topology(one).euler_characteristic, 0);
+}
+
+/// A mesh from world positions and triangles (origin 0, so the floats are the positions).
+TriMesh mesh_of(const std::vector<Vec3d>& points, const std::vector<Triangle>& triangles)
+{
+    TriMesh mesh;
+    for (const Vec3d& p : points)
+    {
+        mesh.vertices.positions.push_back(p.cast<float>());
+    }
+    mesh.triangles = triangles;
+    return mesh;
+}
+
+TEST(SelfIntersectionCheck, FindsCrossingTouchingAndOverlappingTriangles)
+{
+    using test::find_self_intersections;
+    // Two triangles piercing each other; then one only touching the other's interior with a
+    // corner (closed triangles: a touch counts); then one just clear of it.
+    const std::vector<Vec3d> base = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}};
+    const auto with = [&](const std::vector<Vec3d>& more) {
+        std::vector<Vec3d> points = base;
+        points.insert(points.end(), more.begin(), more.end());
+        return mesh_of(points, {{0, 1, 2}, {3, 4, 5}});
+    };
+    EXPECT_EQ(find_self_intersections(with({{1, 1, -1}, {1, 1, 1}, {2, 2, 1}})).pairs.size(), 1U);
+    EXPECT_EQ(find_self_intersections(with({{1, 1, 0}, {1, 1, 1}, {2, 2, 1}})).pairs.size(), 1U);
+    EXPECT_EQ(find_self_intersections(with({{1, 1, 0x1p-20}, {1, 1, 1}, {2, 2, 1}})).pairs.size(),
+              0U);
+    // Coplanar: overlapping, and disjoint.
+    EXPECT_EQ(find_self_intersections(with({{1, 1, 0}, {5, 1, 0}, {1, 5, 0}})).pairs.size(), 1U);
+    EXPECT_EQ(find_self_intersections(with({{3, 3, 0}, {5, 3, 0}, {3, 5, 0}})).pairs.size(), 0U);
+    // An edge of one crossing the other where it does not reach a corner (no vertex inside).
+    EXPECT_EQ(find_self_intersections(with({{-1, 1, 0.5}, {5, 1, 0.5}, {2, 1, -3}})).pairs.size(),
+              1U);
+}
+
+TEST(SelfIntersectionCheck, NeighboursMeetOnlyWhereTheyShareUnlessTheyFoldOver)
+{
+    using test::find_self_intersections;
+    // A shared edge: a proper hinge is fine, a coplanar fold-over is an overlap.
+    const std::vector<Vec3d> hinge = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 1}};
+    EXPECT_TRUE(find_self_intersections(mesh_of(hinge, {{0, 1, 2}, {1, 0, 3}})).pairs.empty());
+    const std::vector<Vec3d> fold = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.5, 2, 0}};
+    EXPECT_EQ(find_self_intersections(mesh_of(fold, {{0, 1, 2}, {1, 0, 3}})).pairs.size(), 1U);
+    // A shared corner: a fan is fine; a face whose edge from the corner runs inside the other,
+    // or whose far edge pierces it, is not.
+    const std::vector<Vec3d> fan = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0.2}, {0, -1, 0.3}};
+    EXPECT_TRUE(find_self_intersections(mesh_of(fan, {{0, 1, 2}, {0, 3, 4}})).pairs.empty());
+    const std::vector<Vec3d> inside = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.3, 0.3, 0}, {0, 0, 1}};
+    EXPECT_EQ(find_self_intersections(mesh_of(inside, {{0, 1, 2}, {0, 3, 4}})).pairs.size(), 1U);
+    const std::vector<Vec3d> pierce = {
+        {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.4, 0.2, -1}, {0.2, 0.4, 1}};
+    EXPECT_EQ(find_self_intersections(mesh_of(pierce, {{0, 1, 2}, {0, 3, 4}})).pairs.size(), 1U);
+    // Copies of a vertex at one position count as the same corner; a repeated face overlaps.
+    const std::vector<Vec3d> copies = {{0, 0, 0}, {1, 0, 0},    {0, 1, 0},
+                                       {0, 0, 0}, {-1, 0, 0.2}, {0, -1, 0.3}};
+    EXPECT_TRUE(find_self_intersections(mesh_of(copies, {{0, 1, 2}, {3, 4, 5}})).pairs.empty());
+    EXPECT_EQ(find_self_intersections(mesh_of(hinge, {{0, 1, 2}, {1, 2, 0}})).pairs.size(), 1U);
+    // Collinear corners are reported as degenerate, not tested.
+    const std::vector<Vec3d> line = {{0, 0, 0}, {1, 1, 1}, {2, 2, 2}, {0, 1, 0}};
+    EXPECT_EQ(find_self_intersections(mesh_of(line, {{0, 1, 2}, {0, 1, 3}})).degenerate.size(), 1U);
+}
+
+TEST(SelfIntersectionCheck, OrientationIsExactWhereDoublesRoundToZero)
+{
+    // d is 2⁻⁶⁰ off the plane through a, b, c at a scale of 1: the naive double determinant
+    // rounds, the exact sign does not.
+    const double a[3] = {0.0, 0.0, 0.0};
+    const double b[3] = {1.0, 0.1, 0.0};
+    const double c[3] = {0.1, 1.0, 0.0};
+    const double above[3] = {0.3, 0.7, 0x1p-60};
+    const double below[3] = {0.3, 0.7, -0x1p-60};
+    const double on[3] = {0.3, 0.7, 0.0};
+    EXPECT_EQ(test::orient3d_exact(a, b, c, above), 1);
+    EXPECT_EQ(test::orient3d_exact(a, b, c, below), -1);
+    EXPECT_EQ(test::orient3d_exact(a, b, c, on), 0);
+    // Nearly collinear points far from the origin (a case where the filter must defer).
+    const double p[3] = {1e8 + 1.0, 1e8 + 2.0, 1e8 + 3.0};
+    const double q[3] = {1e8 + 2.0, 1e8 + 4.0, 1e8 + 6.0};
+    const double r[3] = {1e8 + 3.0, 1e8 + 6.0, 1e8 + 9.0};
+    const double s[3] = {1e8, 1e8 + 0x1p-20, 1e8};
+    EXPECT_EQ(test::orient3d_exact(p, q, r, s), 0);
+}
+
+/// Closed, manifold, with `components` spheres' Euler characteristic, no degenerate triangle
+/// and no two triangles intersecting (exactly, on the stored float positions).
+void expect_closed_and_embedded(const MarchingCubesResult& result, std::size_t components,
+                                const std::string& what)
+{
+    const MeshTopology topo = analyze_topology(result.mesh);
+    EXPECT_TRUE(topo.is_oriented_manifold()) << what;
+    EXPECT_EQ(topo.boundary_edges, 0U) << what;
+    EXPECT_EQ(topo.components, components) << what;
+    EXPECT_EQ(topo.euler_characteristic, 2 * static_cast<std::int64_t>(components)) << what;
+    const test::SelfIntersections found = test::find_self_intersections(result.mesh);
+    EXPECT_TRUE(found.degenerate.empty()) << what << ": " << found.degenerate.size();
+    EXPECT_TRUE(found.pairs.empty()) << what << ": " << found.pairs.size() << " pairs, e.g. "
+                                     << (found.pairs.empty() ? 0 : found.pairs[0].first) << ", "
+                                     << (found.pairs.empty() ? 0 : found.pairs[0].second);
+}
+
+TEST(MarchingCubes, SurfacesThroughGridCornersStayClosedAndEmbedded)
+{
+    // Corners exactly on the surface (f = 0) put vertices at the ends of their edges: boxes
+    // whose faces lie on grid planes, spheres centred on a grid corner with a radius of whole
+    // cells, and their unions, where the sheets meet along grid lines.
+    const double h = 0.125;
+    const CellGrid grid{.origin = Vec3d(-2.0, -2.0, -2.0), .cell = h, .cells = {32, 32, 32}};
+    const auto box = make_box(Vec3d(-1.0, -0.75, -0.5), Vec3d(0.5, 0.75, 1.0));
+    const auto sphere = make_sphere(Vec3d(0.5, 0.0, 0.0), 0.75);
+    const auto small = make_sphere(Vec3d(-1.0, -0.75, 1.0), 0.5);
+    struct Case
+    {
+        std::shared_ptr<const Field> field;
+        std::size_t components;
+        const char* what;
+    };
+    const std::vector<Case> cases = {
+        {box, 1, "box on grid planes"},
+        {sphere, 1, "sphere through grid corners"},
+        {make_union({box, sphere}), 1, "box and sphere"},
+        {make_union({box, sphere, small}), 1, "box and two spheres"},
+        {make_difference(box, sphere), 1, "box minus sphere"},
+        {make_intersection({box, sphere}), 1, "box and sphere intersected"},
+    };
+    for (const Case& c : cases)
+    {
+        const MarchingCubesResult result = marching_cubes(*c.field, grid);
+        ASSERT_GT(result.mesh.face_count(), 0U) << c.what;
+        EXPECT_EQ(result.stats.degenerate_kept, 0U) << c.what;
+        expect_closed_and_embedded(result, c.components, c.what);
+    }
+}
+
+TEST(MarchingCubes, SurfacesFarApartOnAHugeGridStayClosedAndEmbedded)
+{
+    // Two small spheres 500000 cells apart: float32 positions then resolve about 1/30 of a
+    // cell, so tiny corner triangles are crushed by rounding unless the corner margin grows with
+    // it, and any triangle left with zero area is flipped away rather than dropped.
+    const double h = 1.0 / 64.0;
+    const CellGrid grid{.origin = Vec3d::Zero(), .cell = h, .cells = {1 << 19, 8, 8}};
+    // Both pass through grid corners (centred on one, a radius of whole cells), which puts
+    // vertices at the corner margin.
+    const auto near = make_sphere(Vec3d(4.0 * h, 4.0 * h, 4.0 * h), 3.0 * h);
+    const auto far = make_union(
+        {make_sphere(Vec3d(500000.0 * h, 4.0 * h, 4.0 * h), 3.0 * h),
+         make_box(Vec3d(499998.0 * h, 2.0 * h, 2.0 * h), Vec3d(500000.0 * h, 6.0 * h, 5.0 * h))});
+    const MarchingCubesResult result = marching_cubes(*make_union({near, far}), grid);
+    expect_closed_and_embedded(result, 2, "two spheres far apart");
+    EXPECT_EQ(result.stats.degenerate_kept, 0U);
+}
+
+TEST(MarchingCubes, SampledTwoSpheresAreClosedAndEmbedded)
+{
+    const PointCloud samples = sample_shape(Shape::TwoSpheres, {.count = 100000, .seed = 1});
+    const PointField field(
+        compute_surfels(samples, {.radius_scale = default_field_radius_scale}).surfels);
+    const MarchingCubesResult result =
+        marching_cubes(field, grid_over(field.bounds(), default_cell_size(field)));
+    EXPECT_GT(result.mesh.face_count(), 100000U);
+    expect_closed_and_embedded(result, 2, "two sampled spheres");
 }
 
 TEST(MarchingCubes, RejectsBadGrids)

@@ -42,8 +42,12 @@ class PointField;
 /// vertices).
 [[nodiscard]] double estimate_marching_cubes_bytes(const PointField& field, double cell);
 
+/// \brief About how many bytes marching cubes needs on a surface of `surface_area` (units²) at
+/// this cell size (about 600 bytes per cell of side `cell` per cell² of area).
+[[nodiscard]] double estimate_marching_cubes_bytes(double surface_area, double cell);
+
 /// \brief Refuses, before anything is allocated, a cell size whose marching cubes would need
-/// more memory than this machine has.
+/// more memory than this process may use (check_memory(): the cgroup limit or MemAvailable).
 /// \throw InvalidInput saying how much it would need and how much there is
 void check_marching_cubes_memory(const PointField& field, double cell);
 
@@ -59,12 +63,17 @@ struct MarchingCubesOptions
 
 struct MarchingCubesStats
 {
-    std::size_t cells_visited = 0;      ///< cells whose corners were evaluated
-    std::size_t surface_cells = 0;      ///< cells that made triangles
-    std::size_t undefined_cells = 0;    ///< cells with a sign change but an undefined corner
-    std::size_t field_evaluations = 0;  ///< corners plus vertex refinement
-    std::size_t dropped_degenerate = 0; ///< zero-area triangles removed
-    std::size_t split_vertices = 0;     ///< copies made where two sheets touched at a vertex
+    std::size_t cells_visited = 0;     ///< cells whose corners were evaluated
+    std::size_t surface_cells = 0;     ///< cells that made triangles
+    std::size_t undefined_cells = 0;   ///< cells with a sign change but an undefined corner
+    std::size_t field_evaluations = 0; ///< corners plus vertex refinement
+    /// Triangles of (next to) zero area on the stored float32 positions (possible only where
+    /// rounding crushes a tiny triangle at a corner). Each is made whole by flipping its long
+    /// edge with the neighbour across it, which keeps the surface closed and unchanged.
+    std::size_t degenerate_triangles = 0;
+    /// Those of degenerate_triangles that no flip could mend; kept, so the surface stays closed.
+    std::size_t degenerate_kept = 0;
+    std::size_t split_vertices = 0; ///< copies made where two sheets touched at a vertex
     bool dense = false; ///< the field gave no seeds, so every cell of the grid was visited
 };
 
@@ -87,7 +96,8 @@ struct MarchingCubesResult
 /// resolved by the asymptotic decider, which depends only on that face's four values, so the two
 /// cells sharing the face always agree and the mesh is a 2-manifold (with boundary where the
 /// field is undefined). Vertices are shared between cells; triangles are oriented with normals
-/// towards f > 0 (outwards); the result is the same whatever the thread count.
+/// towards f > 0 (outwards); the result is the same whatever the thread count. No triangle is
+/// dropped (see MarchingCubesStats::degenerate_triangles).
 [[nodiscard]] MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
                                                  const MarchingCubesOptions& options = {});
 

@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+namespace pointform {
+
+/// \brief How much memory this process may use, and where that figure comes from.
+struct MemoryLimit
+{
+    /// Bytes; UINT64_MAX when nothing could be read.
+    std::uint64_t bytes = UINT64_MAX;
+    /// "cgroup v2 memory.max", "cgroup v1 memory.limit_in_bytes", "MemAvailable" or "unknown".
+    std::string source = "unknown";
+};
+
+/// \brief Where memory_limit() reads from (the defaults are the live system; tests point these
+/// at a fake tree).
+struct MemoryLimitFiles
+{
+    std::filesystem::path proc_self_cgroup = "/proc/self/cgroup";
+    std::filesystem::path cgroup_root = "/sys/fs/cgroup";
+    std::filesystem::path meminfo = "/proc/meminfo";
+};
+
+/// \brief The memory limit that applies to this process: the smallest of the cgroup limits on
+/// its cgroup and the cgroup's ancestors (v2 `memory.max`, read under `cgroup_root` and
+/// `cgroup_root`/unified; v1 `memory.limit_in_bytes` under `cgroup_root`/memory) and the
+/// system's MemAvailable from /proc/meminfo. Unreadable files are skipped; v1's "no limit"
+/// (a value near 2⁶³) and v2's "max" count as unset.
+[[nodiscard]] MemoryLimit memory_limit(const MemoryLimitFiles& files = {});
+
+/// \brief memory_limit().bytes.
+[[nodiscard]] std::uint64_t memory_limit_bytes();
+
+/// \brief Refuses, before anything is allocated, work estimated to need more than 80% of
+/// memory_limit().
+/// \param need_bytes  the estimate, in bytes (may be infinite)
+/// \param what        what would need it, e.g. "marching cubes at a cell of 0.001"
+/// \param advice      how to ask for less, e.g. "use a larger --cell"
+/// \throw InvalidInput "<what> would need about N GiB, more than the M GiB this process may use
+///        (<source>); <advice>"
+void check_memory(double need_bytes, const std::string& what, const std::string& advice);
+
+} // namespace pointform
