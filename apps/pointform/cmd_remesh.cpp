@@ -53,6 +53,14 @@ void check_input_mesh(const std::string& path, const TriMesh& mesh)
             " misoriented edges, " + std::to_string(topo.degenerate_faces) +
             " degenerate triangles); remesh needs a manifold mesh");
     }
+    try // what the base mesh cannot take (a vertex of too high valence), before the surfels
+    {
+        (void)check_intermediate_mesh(mesh);
+    }
+    catch (const InvalidInput& e)
+    {
+        throw InvalidInput(path + ": " + e.what());
+    }
 }
 
 /// Level 2 from an irregular mesh (§6): every used vertex with its area-weighted vertex normal,
