@@ -17,24 +17,25 @@ namespace {
 
 constexpr std::uint32_t unset = std::numeric_limits<std::uint32_t>::max();
 
-/// Halfedge `slot` of triangle `face`, from corner slot to corner slot + 1, keyed by its
-/// undirected edge (lo, hi).
+/// Halfedge 3f + j (of triangle f, from corner j to corner j + 1), keyed by its undirected edge
+/// (lo, hi) packed as lo · 2³² + hi, so that sorting compares two integers.
 struct HalfEdge
 {
-    std::uint32_t lo;
-    std::uint32_t hi;
-    std::uint32_t face;
-    std::uint8_t slot;
-    bool forward; ///< traversed lo → hi
+    std::uint64_t key;
+    std::uint32_t index; ///< 3 · face + slot
+    bool forward;        ///< traversed lo → hi
 
+    [[nodiscard]] std::uint32_t lo() const { return static_cast<std::uint32_t>(key >> 32U); }
+    [[nodiscard]] std::uint32_t hi() const { return static_cast<std::uint32_t>(key); }
+    [[nodiscard]] std::uint32_t face() const { return index / 3; }
     /// The corner (3 · face + slot) of the triangle at the edge's lower end, and at its upper.
     [[nodiscard]] std::size_t lo_corner() const
     {
-        return 3 * std::size_t{face} + (forward ? slot : (slot + 1) % 3);
+        return forward ? index : index - index % 3 + (index % 3 + 1) % 3;
     }
     [[nodiscard]] std::size_t hi_corner() const
     {
-        return 3 * std::size_t{face} + (forward ? (slot + 1) % 3 : slot);
+        return forward ? index - index % 3 + (index % 3 + 1) % 3 : index;
     }
 };
 
@@ -71,16 +72,12 @@ std::vector<HalfEdge> sorted_halfedges(std::span<const Triangle> triangles)
         {
             const std::uint32_t a = t[j];
             const std::uint32_t b = t[(j + 1) % 3];
-            half.push_back({std::min(a, b), std::max(a, b), static_cast<std::uint32_t>(f),
-                            static_cast<std::uint8_t>(j), a < b});
+            half.push_back({(std::uint64_t{std::min(a, b)} << 32U) | std::max(a, b),
+                            static_cast<std::uint32_t>(3 * f + j), a < b});
         }
     }
     std::sort(half.begin(), half.end(), [](const HalfEdge& x, const HalfEdge& y) {
-        if (x.lo != y.lo)
-            return x.lo < y.lo;
-        if (x.hi != y.hi)
-            return x.hi < y.hi;
-        return x.face != y.face ? x.face < y.face : x.slot < y.slot;
+        return x.key != y.key ? x.key < y.key : x.index < y.index;
     });
     return half;
 }
@@ -92,7 +89,7 @@ void for_each_edge(const std::vector<HalfEdge>& half, Visit&& visit)
     for (std::size_t i = 0; i < half.size();)
     {
         std::size_t j = i + 1;
-        while (j < half.size() && half[j].lo == half[i].lo && half[j].hi == half[i].hi)
+        while (j < half.size() && half[j].key == half[i].key)
             ++j;
         visit(i, j);
         i = j;
@@ -195,21 +192,21 @@ MeshTopology analyze_topology(const TriMesh& mesh)
         if (count == 1)
         {
             ++topo.boundary_edges;
-            boundary.unite(half[i].lo, half[i].hi);
-            ++boundary_degree[half[i].lo];
-            ++boundary_degree[half[i].hi];
+            boundary.unite(half[i].lo(), half[i].hi());
+            ++boundary_degree[half[i].lo()];
+            ++boundary_degree[half[i].hi()];
         }
         else if (count == 2)
         {
             if (half[i].forward == half[i + 1].forward)
                 ++topo.misoriented_edges;
-            faces.unite(half[i].face, half[i + 1].face);
+            faces.unite(half[i].face(), half[i + 1].face());
         }
         else
         {
             ++topo.non_manifold_edges;
             for (std::size_t k = i + 1; k < j; ++k)
-                faces.unite(half[i].face, half[k].face);
+                faces.unite(half[i].face(), half[k].face());
         }
     });
 

@@ -96,7 +96,6 @@ TEST(MeshTopology, TwoDisjointTetrahedra)
     EXPECT_EQ(t.euler_characteristic, 4);
 }
 
-
 /// The plain definitions, pair by pair (quadratic), to check analyze_topology, vertex_fans and
 /// split_nonmanifold_vertices against.
 struct Reference
@@ -197,8 +196,9 @@ Reference reference_topology(const TriMesh& mesh)
             ++t.misoriented_edges;
     }
     t.boundary_edges = boundary.size();
-    const auto component = flood(
-        live.size(), [&](std::size_t i, std::size_t j) { return share_edge(tris[live[i]], tris[live[j]]); });
+    const auto component = flood(live.size(), [&](std::size_t i, std::size_t j) {
+        return share_edge(tris[live[i]], tris[live[j]]);
+    });
     t.components = classes(component);
     std::vector<std::uint32_t> rim;
     for (const auto& [a, b] : boundary)

@@ -5,13 +5,14 @@
 // 999,998 triangles around vertex 0 once triangulated), and a hierarchy file whose base mesh is
 // such a fan. Each is read, validated and its topology computed, with the true values.
 
+#include "support/polygon_fan.h"
+
 #include "pointform/core/error.h"
 #include "pointform/geometry/mesh_topology.h"
 #include "pointform/geometry/multires_mesh.h"
 #include "pointform/io/hierarchy.h"
 #include "pointform/io/io.h"
 
-#include "support/polygon_fan.h"
 #include "support/test_support.h"
 
 #include <gtest/gtest.h>

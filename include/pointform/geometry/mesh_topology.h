@@ -75,8 +75,7 @@ struct VertexFans
 
 /// \brief The fans of every vertex of `vertex_count` (see VertexFans). O(F log F) whatever the
 /// valences. \throw InvalidInput as analyze_topology()
-[[nodiscard]] VertexFans vertex_fans(std::span<const Triangle> triangles,
-                                     std::size_t vertex_count);
+[[nodiscard]] VertexFans vertex_fans(std::span<const Triangle> triangles, std::size_t vertex_count);
 
 /// \brief Gives every vertex whose triangles form several fans (two sheets touching at one
 /// point, e.g. where two holes meet) one copy per extra fan, so that every vertex is a manifold

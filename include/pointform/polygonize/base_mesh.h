@@ -146,7 +146,8 @@ MeshTopology check_intermediate_mesh(const TriMesh& intermediate);
 /// never thrown. Deterministic: the same input gives the same mesh whatever the thread count.
 /// \param intermediate  an oriented 2-manifold mesh (with or without boundary), e.g.
 ///                      marching_cubes(field, ...).mesh
-/// \throw InvalidInput if check_intermediate_mesh() refuses the intermediate mesh, if the target is 0 or larger than its face count, or if an option is
+/// \throw InvalidInput if check_intermediate_mesh() refuses the intermediate mesh, if the target is
+/// 0 or larger than its face count, or if an option is
 ///        out of range
 /// \throw Cancelled if the progress callback asks to stop
 [[nodiscard]] BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
