@@ -54,6 +54,14 @@ void check_input_mesh(const std::string& path, const TriMesh& mesh)
             " misoriented edges, " + std::to_string(topo.degenerate_faces) +
             " degenerate triangles); remesh needs a manifold mesh");
     }
+    try // what the base mesh cannot take (a vertex of too high valence), before the surfels
+    {
+        (void)check_intermediate_mesh(mesh);
+    }
+    catch (const InvalidInput& e)
+    {
+        throw InvalidInput(path + ": " + e.what());
+    }
 }
 
 /// Bytes per surfel of the surfels and their point field (positions, normals, radii, k-d tree,

@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <limits>
-#include <numeric>
 #include <string>
 #include <vector>
 
@@ -16,21 +15,28 @@ namespace pointform {
 
 namespace {
 
+constexpr std::uint32_t unset = std::numeric_limits<std::uint32_t>::max();
+
+/// Halfedge 3f + j (of triangle f, from corner j to corner j + 1), keyed by its undirected edge
+/// (lo, hi) packed as lo · 2³² + hi, so that sorting compares two integers.
 struct HalfEdge
 {
-    std::uint32_t lo;
-    std::uint32_t hi;
-    bool forward; ///< traversed lo → hi
-    std::uint32_t face;
-};
+    std::uint64_t key;
+    std::uint32_t index; ///< 3 · face + slot
+    bool forward;        ///< traversed lo → hi
 
-/// The triangles around one vertex grouped into fans: two triangles are in one fan when a chain
-/// of triangles sharing edges through the vertex joins them.
-struct VertexFans
-{
-    std::vector<std::uint32_t> faces; ///< triangles using the vertex
-    std::vector<std::uint32_t> fan;   ///< fan of each, numbered from 0 in order of appearance
-    std::uint32_t count = 0;
+    [[nodiscard]] std::uint32_t lo() const { return static_cast<std::uint32_t>(key >> 32U); }
+    [[nodiscard]] std::uint32_t hi() const { return static_cast<std::uint32_t>(key); }
+    [[nodiscard]] std::uint32_t face() const { return index / 3; }
+    /// The corner (3 · face + slot) of the triangle at the edge's lower end, and at its upper.
+    [[nodiscard]] std::size_t lo_corner() const
+    {
+        return forward ? index : index - index % 3 + (index % 3 + 1) % 3;
+    }
+    [[nodiscard]] std::size_t hi_corner() const
+    {
+        return forward ? index - index % 3 + (index % 3 + 1) % 3 : index;
+    }
 };
 
 bool is_degenerate(const Triangle& t)
@@ -38,60 +44,127 @@ bool is_degenerate(const Triangle& t)
     return t[0] == t[1] || t[1] == t[2] || t[2] == t[0];
 }
 
-std::vector<VertexFans> vertex_fans(const TriMesh& mesh)
+/// Throws unless every index is a vertex and the corners fit 32-bit union-find indices.
+void check_indices(std::span<const Triangle> triangles, std::size_t nv)
 {
-    const std::size_t nv = mesh.vertex_count();
-    std::vector<VertexFans> out(nv);
-    for (std::size_t f = 0; f < mesh.face_count(); ++f)
+    if (triangles.size() >= std::numeric_limits<std::uint32_t>::max() / 3)
+        throw InvalidInput("mesh: " + std::to_string(triangles.size()) +
+                           " triangles, too many for 32-bit corner indices");
+    for (std::size_t f = 0; f < triangles.size(); ++f)
+        for (const std::uint32_t v : triangles[f])
+            if (v >= nv)
+                throw InvalidInput("mesh: triangle " + std::to_string(f) + " references vertex " +
+                                   std::to_string(v) + " of " + std::to_string(nv));
+}
+
+/// The halfedges of the non-degenerate triangles, sorted by edge, then triangle, then slot, so
+/// that the halfedges of one edge are adjacent: a counting sort by the edge's lower end (linear),
+/// then a sort of each vertex's bucket by the upper end (buckets hold a vertex's valence, so
+/// this costs O(Σ d log d) ≤ O(F log F)). `nv` bounds every index.
+std::vector<HalfEdge> sorted_halfedges(std::span<const Triangle> triangles, std::size_t nv)
+{
+    std::vector<std::size_t> start(nv + 1, 0);
+    for (const Triangle& t : triangles)
+        if (!is_degenerate(t))
+            for (std::size_t j = 0; j < 3; ++j)
+                ++start[std::min(t[j], t[(j + 1) % 3]) + 1];
+    for (std::size_t v = 0; v < nv; ++v)
+        start[v + 1] += start[v];
+    std::vector<HalfEdge> half(start[nv]);
     {
-        if (!is_degenerate(mesh.triangles[f]))
+        std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+        for (std::size_t f = 0; f < triangles.size(); ++f)
         {
-            for (const std::uint32_t v : mesh.triangles[f])
+            const Triangle& t = triangles[f];
+            if (is_degenerate(t))
+                continue;
+            for (std::size_t j = 0; j < 3; ++j)
             {
-                out[v].faces.push_back(static_cast<std::uint32_t>(f));
+                const std::uint32_t a = t[j];
+                const std::uint32_t b = t[(j + 1) % 3];
+                half[fill[std::min(a, b)]++] = {
+                    (std::uint64_t{std::min(a, b)} << 32U) | std::max(a, b),
+                    static_cast<std::uint32_t>(3 * f + j), a < b};
             }
         }
     }
-    std::vector<std::size_t> parent;
     for (std::size_t v = 0; v < nv; ++v)
+        if (start[v + 1] - start[v] > 1)
+            std::sort(half.begin() + static_cast<std::ptrdiff_t>(start[v]),
+                      half.begin() + static_cast<std::ptrdiff_t>(start[v + 1]),
+                      [](const HalfEdge& x, const HalfEdge& y) {
+                          return x.key != y.key ? x.key < y.key : x.index < y.index;
+                      });
+    return half;
+}
+
+/// Calls visit(begin, end) for every run of halfedges of one edge in `half` (sorted).
+template <typename Visit>
+void for_each_edge(const std::vector<HalfEdge>& half, Visit&& visit)
+{
+    for (std::size_t i = 0; i < half.size();)
     {
-        VertexFans& fans = out[v];
-        const auto& around = fans.faces;
-        parent.resize(around.size());
-        std::iota(parent.begin(), parent.end(), 0);
-        auto find = [&](std::size_t x) {
-            while (parent[x] != x)
-            {
-                x = parent[x] = parent[parent[x]];
-            }
-            return x;
-        };
-        for (std::size_t a = 0; a < around.size(); ++a)
+        std::size_t j = i + 1;
+        while (j < half.size() && half[j].key == half[i].key)
+            ++j;
+        visit(i, j);
+        i = j;
+    }
+}
+
+/// The fans from the sorted halfedges: the corners of two triangles at vertex v are joined
+/// when the triangles share an edge (v, x), which makes each fan one union-find set of corners
+/// (corners at different vertices are never joined). Linear in the halfedges, up to the
+/// inverse-Ackermann factor.
+VertexFans fans_from(std::span<const Triangle> triangles, std::size_t nv,
+                     const std::vector<HalfEdge>& half)
+{
+    const std::size_t nf = triangles.size();
+    DisjointSets corners(3 * nf);
+    for_each_edge(half, [&](std::size_t i, std::size_t j) {
+        for (std::size_t k = i + 1; k < j; ++k)
         {
-            const Triangle& ta = mesh.triangles[around[a]];
-            for (std::size_t b = a + 1; b < around.size(); ++b)
+            corners.unite(half[i].lo_corner(), half[k].lo_corner());
+            corners.unite(half[i].hi_corner(), half[k].hi_corner());
+        }
+    });
+
+    VertexFans out;
+    out.offsets.assign(nv + 1, 0);
+    for (const Triangle& t : triangles)
+        if (!is_degenerate(t))
+            for (const std::uint32_t v : t)
+                ++out.offsets[v + 1];
+    for (std::size_t v = 0; v < nv; ++v)
+        out.offsets[v + 1] += out.offsets[v];
+    // Corner ids (3f + slot) per vertex, in triangle order.
+    std::vector<std::uint32_t> corner(out.offsets.back());
+    out.faces.resize(out.offsets.back());
+    {
+        std::vector<std::size_t> fill(out.offsets.begin(), out.offsets.end() - 1);
+        for (std::size_t f = 0; f < nf; ++f)
+        {
+            if (is_degenerate(triangles[f]))
+                continue;
+            for (std::size_t k = 0; k < 3; ++k)
             {
-                const Triangle& tb = mesh.triangles[around[b]];
-                for (const std::uint32_t x : ta)
-                {
-                    if (x != v && std::find(tb.begin(), tb.end(), x) != tb.end())
-                    {
-                        parent[find(a)] = find(b);
-                        break;
-                    }
-                }
+                const std::size_t at = fill[triangles[f][k]]++;
+                corner[at] = static_cast<std::uint32_t>(3 * f + k);
+                out.faces[at] = static_cast<std::uint32_t>(f);
             }
         }
-        fans.fan.assign(around.size(), 0);
-        std::vector<std::uint32_t> number(around.size(), std::numeric_limits<std::uint32_t>::max());
-        for (std::size_t a = 0; a < around.size(); ++a)
+    }
+    out.fan.resize(corner.size());
+    out.fan_count.assign(nv, 0);
+    std::vector<std::uint32_t> number(3 * nf, unset); // fan number of each set's root
+    for (std::size_t v = 0; v < nv; ++v)
+    {
+        for (std::size_t c = out.offsets[v]; c < out.offsets[v + 1]; ++c)
         {
-            const std::size_t r = find(a);
-            if (number[r] == std::numeric_limits<std::uint32_t>::max())
-            {
-                number[r] = fans.count++;
-            }
-            fans.fan[a] = number[r];
+            const std::size_t root = corners.find(corner[c]);
+            if (number[root] == unset)
+                number[root] = out.fan_count[v]++;
+            out.fan[c] = number[root];
         }
     }
     return out;
@@ -99,116 +172,79 @@ std::vector<VertexFans> vertex_fans(const TriMesh& mesh)
 
 } // namespace
 
+VertexFans vertex_fans(std::span<const Triangle> triangles, std::size_t vertex_count)
+{
+    check_indices(triangles, vertex_count);
+    return fans_from(triangles, vertex_count, sorted_halfedges(triangles, vertex_count));
+}
+
 MeshTopology analyze_topology(const TriMesh& mesh)
 {
     MeshTopology topo;
     const std::size_t nv = mesh.vertex_count();
     const std::size_t nf = mesh.face_count();
+    const std::span<const Triangle> triangles = mesh.triangles;
+    check_indices(triangles, nv);
     topo.faces = nf;
 
-    std::vector<HalfEdge> half;
-    half.reserve(3 * nf);
     std::vector<bool> used(nv, false);
-    for (std::size_t f = 0; f < nf; ++f)
+    for (const Triangle& t : triangles)
     {
-        const Triangle& t = mesh.triangles[f];
         for (const std::uint32_t v : t)
-        {
-            if (v >= nv)
-            {
-                throw InvalidInput("mesh: triangle " + std::to_string(f) + " references vertex " +
-                                   std::to_string(v) + " of " + std::to_string(nv));
-            }
             used[v] = true;
-        }
-        if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0])
-        {
+        if (is_degenerate(t))
             ++topo.degenerate_faces;
-            continue;
-        }
-        for (std::size_t j = 0; j < 3; ++j)
-        {
-            const std::uint32_t a = t[j];
-            const std::uint32_t b = t[(j + 1) % 3];
-            half.push_back({std::min(a, b), std::max(a, b), a < b, static_cast<std::uint32_t>(f)});
-        }
     }
     topo.vertices = static_cast<std::size_t>(std::count(used.begin(), used.end(), true));
-    std::sort(half.begin(), half.end(), [](const HalfEdge& x, const HalfEdge& y) {
-        return x.lo != y.lo ? x.lo < y.lo : x.hi != y.hi ? x.hi < y.hi : x.face < y.face;
-    });
+    const std::vector<HalfEdge> half = sorted_halfedges(triangles, nv);
 
     DisjointSets faces(nf);
     // Boundary edges, joined into loops through their vertices.
     DisjointSets boundary(nv);
     std::vector<std::uint32_t> boundary_degree(nv, 0);
-    for (std::size_t i = 0; i < half.size();)
-    {
-        std::size_t j = i;
-        while (j < half.size() && half[j].lo == half[i].lo && half[j].hi == half[i].hi)
-        {
-            ++j;
-        }
+    for_each_edge(half, [&](std::size_t i, std::size_t j) {
         const std::size_t count = j - i;
         ++topo.edges;
         if (count == 1)
         {
             ++topo.boundary_edges;
-            boundary.unite(half[i].lo, half[i].hi);
-            ++boundary_degree[half[i].lo];
-            ++boundary_degree[half[i].hi];
+            boundary.unite(half[i].lo(), half[i].hi());
+            ++boundary_degree[half[i].lo()];
+            ++boundary_degree[half[i].hi()];
         }
         else if (count == 2)
         {
             if (half[i].forward == half[i + 1].forward)
-            {
                 ++topo.misoriented_edges;
-            }
-            faces.unite(half[i].face, half[i + 1].face);
+            faces.unite(half[i].face(), half[i + 1].face());
         }
         else
         {
             ++topo.non_manifold_edges;
             for (std::size_t k = i + 1; k < j; ++k)
-            {
-                faces.unite(half[i].face, half[k].face);
-            }
+                faces.unite(half[i].face(), half[k].face());
         }
-        i = j;
-    }
+    });
 
     // Components of non-degenerate faces.
     std::vector<bool> root(nf, false);
     for (std::size_t f = 0; f < nf; ++f)
-    {
-        const Triangle& t = mesh.triangles[f];
-        if (t[0] != t[1] && t[1] != t[2] && t[2] != t[0])
-        {
+        if (!is_degenerate(triangles[f]))
             root[faces.find(f)] = true;
-        }
-    }
     topo.components = static_cast<std::size_t>(std::count(root.begin(), root.end(), true));
 
     // Boundary loops: components of the boundary-edge graph (a vertex where two loops touch
     // makes them one, and is counted as non-manifold below).
     std::vector<bool> loop_root(nv, false);
     for (std::size_t v = 0; v < nv; ++v)
-    {
         if (boundary_degree[v] > 0)
-        {
             loop_root[boundary.find(v)] = true;
-        }
-    }
     topo.boundary_loops =
         static_cast<std::size_t>(std::count(loop_root.begin(), loop_root.end(), true));
 
-    for (const VertexFans& fans : vertex_fans(mesh))
-    {
-        if (fans.count > 1)
-        {
-            ++topo.non_manifold_vertices;
-        }
-    }
+    const VertexFans fans = fans_from(triangles, nv, half);
+    topo.non_manifold_vertices = static_cast<std::size_t>(std::count_if(
+        fans.fan_count.begin(), fans.fan_count.end(), [](std::uint32_t n) { return n > 1; }));
 
     topo.euler_characteristic = static_cast<std::int64_t>(topo.vertices) -
                                 static_cast<std::int64_t>(topo.edges) +
@@ -216,53 +252,38 @@ MeshTopology analyze_topology(const TriMesh& mesh)
     return topo;
 }
 
-} // namespace pointform
-
-namespace pointform {
-
 std::size_t split_nonmanifold_vertices(TriMesh& mesh)
 {
-    const std::vector<VertexFans> all = vertex_fans(mesh);
+    const std::size_t nv = mesh.vertex_count();
+    const VertexFans fans = vertex_fans(mesh.triangles, nv);
     std::size_t added = 0;
     PointCloud& v = mesh.vertices;
-    for (std::size_t i = 0; i < all.size(); ++i)
+    for (std::size_t i = 0; i < nv; ++i)
     {
-        const VertexFans& fans = all[i];
-        if (fans.count < 2)
-        {
+        const std::uint32_t count = fans.fan_count[i];
+        if (count < 2)
             continue;
-        }
         const auto first_new = static_cast<std::uint32_t>(v.size());
-        for (std::uint32_t extra = 1; extra < fans.count; ++extra)
+        for (std::uint32_t extra = 1; extra < count; ++extra)
         {
             v.positions.push_back(v.positions[i]);
             if (v.has_normals())
-            {
                 v.normals.push_back(v.normals[i]);
-            }
             if (v.has_colors())
-            {
                 v.colors.push_back(v.colors[i]);
-            }
             if (v.has_radii())
-            {
                 v.radii.push_back(v.radii[i]);
-            }
             ++added;
         }
-        for (std::size_t a = 0; a < fans.faces.size(); ++a)
+        const auto faces = fans.faces_of(i);
+        const auto fan = fans.fans_of(i);
+        for (std::size_t a = 0; a < faces.size(); ++a)
         {
-            if (fans.fan[a] == 0)
-            {
+            if (fan[a] == 0)
                 continue;
-            }
-            for (std::uint32_t& corner : mesh.triangles[fans.faces[a]])
-            {
+            for (std::uint32_t& corner : mesh.triangles[faces[a]])
                 if (corner == i)
-                {
-                    corner = first_new + fans.fan[a] - 1;
-                }
-            }
+                    corner = first_new + fan[a] - 1;
         }
     }
     return added;

@@ -645,29 +645,53 @@ std::size_t default_base_faces(const TriMesh& intermediate, std::size_t share)
                               share);
 }
 
+MeshTopology check_intermediate_mesh(const TriMesh& intermediate)
+{
+    if (intermediate.face_count() == 0)
+    {
+        throw InvalidInput("base mesh: the intermediate mesh has no faces");
+    }
+    const MeshTopology topology = analyze_topology(intermediate);
+    if (!topology.is_oriented_manifold())
+    {
+        throw InvalidInput("base mesh: the intermediate mesh is not an oriented 2-manifold (" +
+                           std::to_string(topology.non_manifold_edges) + " non-manifold edges, " +
+                           std::to_string(topology.non_manifold_vertices) +
+                           " non-manifold vertices, " + std::to_string(topology.misoriented_edges) +
+                           " misoriented edges, " + std::to_string(topology.degenerate_faces) +
+                           " degenerate faces)");
+    }
+    std::vector<std::size_t> valence(intermediate.vertex_count(), 0);
+    for (const Triangle& t : intermediate.triangles)
+    {
+        for (const std::uint32_t v : t)
+        {
+            ++valence[v];
+        }
+    }
+    const auto highest = std::max_element(valence.begin(), valence.end());
+    if (*highest > max_intermediate_valence)
+    {
+        throw InvalidInput(
+            "base mesh: vertex " + std::to_string(highest - valence.begin()) + " is in " +
+            std::to_string(*highest) + " triangles, more than the " +
+            std::to_string(max_intermediate_valence) +
+            " the decimation takes (its cost grows with the cube of a vertex's valence); a "
+            "polygon fan-triangulated from one vertex does this: triangulate it another way");
+    }
+    return topology;
+}
+
 BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
                                const BaseMeshOptions& options)
 {
     const auto start = std::chrono::steady_clock::now();
     check_options(options);
-    if (intermediate.face_count() == 0)
-    {
-        throw InvalidInput("base mesh: the intermediate mesh has no faces");
-    }
     BaseMeshResult result;
     BaseMeshStats& stats = result.stats;
     stats.input_faces = intermediate.face_count();
-    stats.topology_before = analyze_topology(intermediate);
+    stats.topology_before = check_intermediate_mesh(intermediate);
     const MeshTopology& before = stats.topology_before;
-    if (!before.is_oriented_manifold())
-    {
-        throw InvalidInput("base mesh: the intermediate mesh is not an oriented 2-manifold (" +
-                           std::to_string(before.non_manifold_edges) + " non-manifold edges, " +
-                           std::to_string(before.non_manifold_vertices) +
-                           " non-manifold vertices, " + std::to_string(before.misoriented_edges) +
-                           " misoriented edges, " + std::to_string(before.degenerate_faces) +
-                           " degenerate faces)");
-    }
     stats.target_faces =
         options.target_faces
             ? *options.target_faces
@@ -952,50 +976,26 @@ PickedBaseMesh base_mesh_from_samples(std::span<const Triangle> triangles,
         }
     }
 
-    // Vertices: the triangles around a sample must form a single fan.
-    std::map<std::uint32_t, std::vector<std::size_t>> around;
-    for (std::size_t f = 0; f < nf; ++f)
+    // Vertices: the triangles around a sample must form a single fan (linear in the triangles
+    // whatever the valences, see vertex_fans).
+    const VertexFans fans = vertex_fans(triangles, samples.size());
+    for (std::size_t v = 0; v < samples.size(); ++v)
     {
-        for (const std::uint32_t v : triangles[f])
+        if (fans.fan_count[v] < 2)
         {
-            around[v].push_back(f);
+            continue;
         }
+        const auto faces = fans.faces_of(v);
+        const auto fan = fans.fans_of(v);
+        const std::size_t i = static_cast<std::size_t>(
+            std::find_if(fan.begin(), fan.end(), [](std::uint32_t n) { return n != 0; }) -
+            fan.begin());
+        throw InvalidInput(where(source, lines, faces[i]) + ": sample " + std::to_string(v) +
+                           " is a non-manifold vertex: its triangles form more than one fan "
+                           "(those on " +
+                           line_of(lines, faces[0]) + " and " + line_of(lines, faces[i]) +
+                           " meet only at it)");
     }
-    for (const auto& [v, faces] : around)
-    {
-        DisjointSets fans(faces.size());
-        for (std::size_t i = 0; i < faces.size(); ++i)
-        {
-            for (std::size_t j = i + 1; j < faces.size(); ++j)
-            {
-                int shared = 0;
-                for (const std::uint32_t a : triangles[faces[i]])
-                {
-                    for (const std::uint32_t b : triangles[faces[j]])
-                    {
-                        shared += (a == b && a != v) ? 1 : 0;
-                    }
-                }
-                if (shared > 0)
-                {
-                    fans.unite(i, j);
-                }
-            }
-        }
-        for (std::size_t i = 1; i < faces.size(); ++i)
-        {
-            if (fans.find(i) != fans.find(0))
-            {
-                throw InvalidInput(where(source, lines, faces[i]) + ": sample " +
-                                   std::to_string(v) +
-                                   " is a non-manifold vertex: its triangles form more than one "
-                                   "fan (those on " +
-                                   line_of(lines, faces[0]) + " and " + line_of(lines, faces[i]) +
-                                   " meet only at it)");
-            }
-        }
-    }
-
     // Consistent orientation: breadth-first over edge-adjacent triangles.
     std::vector<char> flip(nf, 0);
     std::vector<char> visited(nf, 0);
@@ -1077,8 +1077,12 @@ PickedBaseMesh base_mesh_from_samples(std::span<const Triangle> triangles,
     // Outwards: per component, the area-weighted normals against ∇f at the vertices.
     std::vector<double> vote(components, 0.0);
     std::map<std::uint32_t, Vec3d> outward;
-    for (const auto& [v, faces] : around)
+    for (std::uint32_t v = 0; v < samples.size(); ++v)
     {
+        if (fans.faces_of(v).empty())
+        {
+            continue;
+        }
         const Vec3d p = samples.world(v);
         const FieldSample s = field.evaluate(p);
         Vec3d g = Vec3d::Zero();

@@ -6,8 +6,6 @@
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 
-// Equal distances are ordered by index, so results do not depend on the tree's layout.
-#define NANOFLANN_FIRST_MATCH
 #include <nanoflann.hpp>
 
 #include <algorithm>
@@ -41,6 +39,65 @@ using NanoTree = nanoflann::KDTreeSingleIndexAdaptor<
     std::uint32_t>;
 
 constexpr std::size_t query_block = 2048;
+
+/// The k nearest in the order (squared distance, index), whatever the tree's layout.
+/// nanoflann's KNNResultSet (even with NANOFLANN_FIRST_MATCH) keeps whichever of several points
+/// tied at the k-th distance the traversal met first: its leaves only offer points strictly
+/// nearer than worstDist(), and it prunes a subtree when its distance bound, summed up
+/// incrementally in float, exceeds worstDist(), and that bound can round a few ulps above the
+/// distance of a point inside. Here, once full, worstDist() is the k-th distance plus a relative
+/// slack of 2^-16 (far above the float rounding of the bound, about 2^-18 at depth 32, and
+/// never less than one ulp), so every point tied at the k-th distance reaches addPoint(),
+/// which keeps the lowest indices.
+class OrderedKnnResult
+{
+public:
+    using DistanceType = float;
+    using IndexType = std::uint32_t;
+    using CountType = std::size_t;
+
+    OrderedKnnResult(std::size_t capacity, std::uint32_t* indices, float* distances)
+        : capacity_(capacity), indices_(indices), distances_(distances)
+    {}
+
+    [[nodiscard]] std::size_t size() const { return count_; }
+    [[nodiscard]] bool full() const { return count_ == capacity_; }
+
+    /// Inserts (dist, index) in order; always lets the search go on.
+    bool addPoint(float dist, std::uint32_t index)
+    {
+        const auto before = [](float d1, std::uint32_t i1, float d2, std::uint32_t i2) {
+            return d1 < d2 || (d1 == d2 && i1 < i2);
+        };
+        if (full() && !before(dist, index, distances_[capacity_ - 1], indices_[capacity_ - 1]))
+            return true;
+        std::size_t i = full() ? capacity_ - 1 : count_++;
+        for (; i > 0 && before(dist, index, distances_[i - 1], indices_[i - 1]); --i)
+        {
+            distances_[i] = distances_[i - 1];
+            indices_[i] = indices_[i - 1];
+        }
+        distances_[i] = dist;
+        indices_[i] = index;
+        return true;
+    }
+
+    [[nodiscard]] float worstDist() const
+    {
+        constexpr float infinity = std::numeric_limits<float>::infinity();
+        constexpr float slack = 1.0F + 0x1p-16F;
+        if (!full())
+            return infinity;
+        const float worst = distances_[capacity_ - 1];
+        return std::max(worst * slack, std::nextafter(worst, infinity));
+    }
+
+private:
+    std::size_t capacity_;
+    std::uint32_t* indices_;
+    float* distances_;
+    std::size_t count_ = 0;
+};
 
 } // namespace
 
@@ -86,8 +143,7 @@ std::size_t KdTree::knn(const Vec3f& query, std::size_t k, std::span<std::uint32
     k = std::min(k, size());
     if (k == 0)
         return 0;
-    nanoflann::KNNResultSet<float, std::uint32_t, std::size_t> result(k);
-    result.init(indices.data(), squared_distances.data());
+    OrderedKnnResult result(k, indices.data(), squared_distances.data());
     impl_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
     return result.size();
 }

@@ -155,6 +155,92 @@ TEST(KdTree, DuplicatePointsAreOrderedByIndex)
     EXPECT_EQ(table.indices, expected);
 }
 
+/// Squared distance as nanoflann's L2_Simple_Adaptor sums it (x, then y, then z, in float), so
+/// that exact ties are ties in both.
+float squared_distance(const Vec3f& a, const Vec3f& b)
+{
+    float d2 = 0.0F;
+    for (int k = 0; k < 3; ++k)
+    {
+        const float d = a[k] - b[k];
+        d2 += d * d;
+    }
+    return d2;
+}
+
+/// Sites with many coincident copies each (their indices scattered through the array), plus
+/// scattered points, so that the k-th neighbour distance of a query often ties.
+std::vector<Vec3f> clustered_points(std::uint64_t seed)
+{
+    std::vector<Vec3f> points = random_points(400, seed);
+    const std::vector<Vec3f> sites = random_points(8, seed + 1);
+    for (const Vec3f& site : sites)
+        for (int copy = 0; copy < 40; ++copy)
+            points.push_back(site);
+    // Two sites at the same distance from the origin, on opposite sides: ties across sites too.
+    for (int copy = 0; copy < 30; ++copy)
+    {
+        points.emplace_back(0.5F, 0.0F, 0.0F);
+        points.emplace_back(-0.5F, 0.0F, 0.0F);
+    }
+    std::mt19937_64 rng(seed + 2);
+    std::shuffle(points.begin(), points.end(), rng);
+    return points;
+}
+
+TEST(KdTree, TiesAtTheKthNeighbourGoToTheLowestIndices)
+{
+    const std::vector<Vec3f> points = clustered_points(31);
+    std::vector<Vec3f> queries = random_points(100, 32);
+    queries.emplace_back(0.0F, 0.0F, 0.0F); // equidistant from the two opposite sites
+    for (std::size_t i = 0; i < points.size(); i += 7)
+        queries.push_back(points[i]); // on a site: many neighbours at distance 0
+    for (const std::size_t leaf : {1, 4, 16, 64})
+    {
+        const KdTree tree(points, {.leaf_size = leaf});
+        for (const std::size_t k : {1, 5, 39, 40, 41, 60, 75})
+        {
+            const KnnTable table = knn_batch(tree, queries, k);
+            std::size_t tied = 0; // queries whose k-th distance is shared beyond k
+            for (std::size_t q = 0; q < queries.size(); ++q)
+            {
+                std::vector<std::pair<float, std::uint32_t>> truth;
+                for (std::uint32_t i = 0; i < points.size(); ++i)
+                    truth.emplace_back(squared_distance(points[i], queries[q]), i);
+                std::sort(truth.begin(), truth.end());
+                tied += truth[k].first == truth[k - 1].first ? 1 : 0;
+                for (std::size_t j = 0; j < k; ++j)
+                {
+                    ASSERT_EQ(table.neighbors(q)[j], truth[j].second)
+                        << "leaf " << leaf << " k " << k << " query " << q << " rank " << j;
+                    ASSERT_EQ(table.distances2(q)[j], truth[j].first);
+                }
+            }
+            if (k > 1)
+                EXPECT_GT(tied, 10U) << "k " << k; // the case under test does occur
+        }
+    }
+}
+
+TEST(KdTree, TiedResultsIndependentOfThreadCountAndLayout)
+{
+    const std::vector<Vec3f> points = clustered_points(41);
+    const std::vector<Vec3f> queries = points; // every point: ties at distance 0
+    const KdTree reference_tree(points, {.leaf_size = 1});
+    set_thread_count(1);
+    const KnnTable reference = knn_batch(reference_tree, queries, 45);
+    for (const int threads : {2, 0})
+        for (const std::size_t leaf : {8, 32})
+        {
+            set_thread_count(threads);
+            const KdTree tree(points, {.leaf_size = leaf});
+            const KnnTable table = knn_batch(tree, queries, 45);
+            EXPECT_EQ(table.indices, reference.indices) << threads << " threads, leaf " << leaf;
+            EXPECT_EQ(table.squared_distances, reference.squared_distances);
+        }
+    set_thread_count(0);
+}
+
 TEST(KdTree, NearestAndEmptyTree)
 {
     const std::vector<Vec3f> none;

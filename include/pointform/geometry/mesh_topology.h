@@ -7,6 +7,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
+#include <vector>
 
 namespace pointform {
 
@@ -37,8 +39,43 @@ struct MeshTopology
 };
 
 /// \brief Counts the mesh's edges, boundary loops, components and defects.
-/// \throw InvalidInput if a triangle references a vertex that does not exist
+///
+/// O(F log F) whatever the valences: the halfedges are sorted by edge, and the fans around
+/// each vertex come from a union-find over the triangle corners joined across their edges (no
+/// pair of triangles around a vertex is ever compared).
+/// \throw InvalidInput if a triangle references a vertex that does not exist, or if the mesh has
+///        2³² / 3 triangles or more
 [[nodiscard]] MeshTopology analyze_topology(const TriMesh& mesh);
+
+/// \brief The triangles around each vertex grouped into fans, in CSR form. Two triangles around
+/// v are in one fan when a chain of triangles, each sharing an edge through v with the next,
+/// joins them. Degenerate triangles (a repeated index) belong to no fan and are left out.
+struct VertexFans
+{
+    /// vertex_count + 1 entries: the corners of vertex v are [offsets[v], offsets[v + 1]).
+    std::vector<std::size_t> offsets;
+    /// The triangle of each corner, increasing within each vertex.
+    std::vector<std::uint32_t> faces;
+    /// The fan of each corner, numbered from 0 per vertex in order of first appearance (so the
+    /// vertex's lowest triangle is in fan 0).
+    std::vector<std::uint32_t> fan;
+    /// Number of fans of each vertex (0 for a vertex in no triangle).
+    std::vector<std::uint32_t> fan_count;
+
+    [[nodiscard]] std::span<const std::uint32_t> faces_of(std::size_t v) const
+    {
+        return std::span<const std::uint32_t>(faces).subspan(offsets[v],
+                                                             offsets[v + 1] - offsets[v]);
+    }
+    [[nodiscard]] std::span<const std::uint32_t> fans_of(std::size_t v) const
+    {
+        return std::span<const std::uint32_t>(fan).subspan(offsets[v], offsets[v + 1] - offsets[v]);
+    }
+};
+
+/// \brief The fans of every vertex of `vertex_count` (see VertexFans). O(F log F) whatever the
+/// valences. \throw InvalidInput as analyze_topology()
+[[nodiscard]] VertexFans vertex_fans(std::span<const Triangle> triangles, std::size_t vertex_count);
 
 /// \brief Gives every vertex whose triangles form several fans (two sheets touching at one
 /// point, e.g. where two holes meet) one copy per extra fan, so that every vertex is a manifold

@@ -115,6 +115,21 @@ inline constexpr std::size_t default_base_share = 64;
 [[nodiscard]] std::size_t fit_base_faces_to_budget(std::size_t target, std::size_t vertex_budget,
                                                    double fill = 0.6);
 
+/// Most triangles around one vertex that build_base_mesh() takes. The decimation re-ranks every
+/// collapse around a vertex whenever its neighbourhood changes, and each test walks the vertex's
+/// one-ring (OpenMesh), so a vertex of valence d costs O(d³). Measured on a flat polygon
+/// fan-triangulated from one vertex (release build): valence 1000 takes 2.1 s to decimate,
+/// valence 3000 takes 49 s.
+inline constexpr std::size_t max_intermediate_valence = 1000;
+
+/// \brief Checks that build_base_mesh() can take `intermediate`: at least one face, an oriented
+/// 2-manifold without degenerate faces, no vertex in more than max_intermediate_valence
+/// triangles. O(F log F) whatever the valences.
+/// \return its topology
+/// \throw InvalidInput saying what is wrong (for a valence too high: the vertex, its triangle
+///        count and the limit)
+MeshTopology check_intermediate_mesh(const TriMesh& intermediate);
+
 /// \brief Automatic base mesh M⁰ (§5.1, Fig. 5): the intermediate (marching-cubes) mesh
 /// simplified by topology-safe edge collapses to a target face count, its triangles shaped, and
 /// every vertex moved onto f = 0.
@@ -141,8 +156,8 @@ inline constexpr std::size_t default_base_share = 64;
 /// never thrown. Deterministic: the same input gives the same mesh whatever the thread count.
 /// \param intermediate  an oriented 2-manifold mesh (with or without boundary), e.g.
 ///                      marching_cubes(field, ...).mesh
-/// \throw InvalidInput if the intermediate mesh is empty, not an oriented manifold or has a
-///        degenerate face, if the target is 0 or larger than its face count, or if an option is
+/// \throw InvalidInput if check_intermediate_mesh() refuses the intermediate mesh, if the target is
+/// 0 or larger than its face count, or if an option is
 ///        out of range
 /// \throw Cancelled if the progress callback asks to stop
 [[nodiscard]] BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,

@@ -33,7 +33,9 @@ struct KnnOptions
 ///
 /// Zero-copy: the tree refers to the caller's positions, which must outlive it and stay
 /// unchanged. Queries are const and may run concurrently. Results are exact (Euclidean, in the
-/// positions' units) and deterministic: ties are broken by the tree's fixed traversal order.
+/// positions' units) and deterministic: knn() returns the k smallest (squared distance, index)
+/// pairs, so points tied at the k-th distance (coincident points) are taken lowest index first,
+/// whatever the tree's layout (leaf size) or the thread count.
 class KdTree
 {
 public:
