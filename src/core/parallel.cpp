@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
+#include <cstdint>
 #include <exception>
 #include <mutex>
 #include <vector>
@@ -22,7 +24,39 @@ int default_threads()
     return threads;
 }
 
+std::atomic<std::uint64_t> stat_loops{0};
+std::atomic<std::uint64_t> stat_blocks{0};
+std::atomic<std::uint64_t> stat_multi_block_loops{0};
+std::atomic<int> stat_max_threads{0};
+
+void record_threads(int threads)
+{
+    int seen = stat_max_threads.load(std::memory_order_relaxed);
+    while (seen < threads &&
+           !stat_max_threads.compare_exchange_weak(seen, threads, std::memory_order_relaxed))
+    {
+    }
+}
+
 } // namespace
+
+ParallelStats parallel_stats()
+{
+    ParallelStats stats;
+    stats.loops = stat_loops.load(std::memory_order_relaxed);
+    stats.blocks = stat_blocks.load(std::memory_order_relaxed);
+    stats.multi_block_loops = stat_multi_block_loops.load(std::memory_order_relaxed);
+    stats.max_threads_per_loop = stat_max_threads.load(std::memory_order_relaxed);
+    return stats;
+}
+
+void reset_parallel_stats()
+{
+    stat_loops.store(0, std::memory_order_relaxed);
+    stat_blocks.store(0, std::memory_order_relaxed);
+    stat_multi_block_loops.store(0, std::memory_order_relaxed);
+    stat_max_threads.store(0, std::memory_order_relaxed);
+}
 
 int thread_count()
 {
@@ -44,14 +78,25 @@ void parallel_blocks(std::size_t n, std::size_t block,
     if (block == 0)
         block = 4096;
     const std::size_t blocks = (n + block - 1) / block;
+    stat_loops.fetch_add(1, std::memory_order_relaxed);
+    if (blocks > 1)
+        stat_multi_block_loops.fetch_add(1, std::memory_order_relaxed);
     std::vector<std::exception_ptr> errors(blocks);
     std::atomic<std::size_t> done{0};
     std::atomic<bool> stop{false};
     std::mutex reporting;
 
+    // Bit t set: the team's thread t ran a block (threads past 63 share the last bit, so the
+    // count saturates at 64).
+    std::atomic<std::uint64_t> ran_on{0};
+
     const auto run_block = [&](std::size_t b) {
         if (stop.load(std::memory_order_relaxed))
             return;
+        const int t = std::min(omp_get_thread_num(), 63);
+        const std::uint64_t bit = std::uint64_t{1} << t;
+        if ((ran_on.load(std::memory_order_relaxed) & bit) == 0)
+            ran_on.fetch_or(bit, std::memory_order_relaxed);
         try
         {
             body(b * block, std::min(n, (b + 1) * block));
@@ -91,6 +136,8 @@ void parallel_blocks(std::size_t n, std::size_t block,
         for (std::ptrdiff_t b = 0; b < count; ++b)
             run_block(static_cast<std::size_t>(b));
     }
+    stat_blocks.fetch_add(done.load(), std::memory_order_relaxed);
+    record_threads(std::popcount(ran_on.load(std::memory_order_relaxed)));
     for (const auto& e : errors)
         if (e)
             std::rethrow_exception(e);
