@@ -34,8 +34,7 @@ void record_threads(int threads)
     int seen = stat_max_threads.load(std::memory_order_relaxed);
     while (seen < threads &&
            !stat_max_threads.compare_exchange_weak(seen, threads, std::memory_order_relaxed))
-    {
-    }
+    {}
 }
 
 } // namespace

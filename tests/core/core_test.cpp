@@ -42,8 +42,7 @@ TEST(ParallelBlocks, StatsCountLoopsBlocksAndThreads)
         // Long enough per block that the other threads of the team join in.
         const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(200);
         while (std::chrono::steady_clock::now() < until)
-        {
-        }
+        {}
         (void)begin;
         (void)end;
     };

@@ -81,8 +81,8 @@ TEST(Determinism, BaseMesh)
 {
     const Torus& t = torus();
     ASSERT_GT(t.mc.vertex_count(), 4 * 256U); // relaxation blocks of 256 vertices
-    const auto runs = at_thread_counts(
-        [&] { return build_base_mesh(t.mc, *t.field, {.target_faces = 1500}); });
+    const auto runs =
+        at_thread_counts([&] { return build_base_mesh(t.mc, *t.field, {.target_faces = 1500}); });
     ASSERT_GT(runs[0].mesh.face_count(), 1000U);
     for (std::size_t i = 1; i < runs.size(); ++i)
     {

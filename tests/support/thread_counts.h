@@ -34,8 +34,8 @@ auto at_thread_counts(Run&& run, std::uint64_t min_multi_block_loops = 1,
         results.push_back(run());
         const ParallelStats stats = parallel_stats();
         EXPECT_GE(stats.multi_block_loops, min_multi_block_loops)
-            << threads << " threads: too few loops split into blocks (" << stats.loops
-            << " loops, " << stats.blocks << " blocks): the input is too small";
+            << threads << " threads: too few loops split into blocks (" << stats.loops << " loops, "
+            << stats.blocks << " blocks): the input is too small";
         if (threads == 1)
             EXPECT_EQ(stats.max_threads_per_loop, 1) << "blocks ran on several threads at -j 1";
         else
