@@ -121,6 +121,7 @@ void add_run_report(nlohmann::json& out, const Timings& timings)
     out["parallel"] = {{"loops", parallel.loops},
                        {"blocks", parallel.blocks},
                        {"multi_block_loops", parallel.multi_block_loops},
+                       {"max_team_threads", parallel.max_team_threads},
                        {"max_threads_per_loop", parallel.max_threads_per_loop}};
     out["peak_rss_bytes"] = peak_rss_bytes();
 }

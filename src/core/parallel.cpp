@@ -27,14 +27,16 @@ int default_threads()
 std::atomic<std::uint64_t> stat_loops{0};
 std::atomic<std::uint64_t> stat_blocks{0};
 std::atomic<std::uint64_t> stat_multi_block_loops{0};
+std::atomic<int> stat_max_team{0};
 std::atomic<int> stat_max_threads{0};
 
-void record_threads(int threads)
+void record_max(std::atomic<int>& max, int value)
 {
-    int seen = stat_max_threads.load(std::memory_order_relaxed);
-    while (seen < threads &&
-           !stat_max_threads.compare_exchange_weak(seen, threads, std::memory_order_relaxed))
-    {}
+    int seen = max.load(std::memory_order_relaxed);
+    while (seen < value && !max.compare_exchange_weak(seen, value, std::memory_order_relaxed))
+    {
+        // seen now holds the current maximum
+    }
 }
 
 } // namespace
@@ -45,6 +47,7 @@ ParallelStats parallel_stats()
     stats.loops = stat_loops.load(std::memory_order_relaxed);
     stats.blocks = stat_blocks.load(std::memory_order_relaxed);
     stats.multi_block_loops = stat_multi_block_loops.load(std::memory_order_relaxed);
+    stats.max_team_threads = stat_max_team.load(std::memory_order_relaxed);
     stats.max_threads_per_loop = stat_max_threads.load(std::memory_order_relaxed);
     return stats;
 }
@@ -54,6 +57,7 @@ void reset_parallel_stats()
     stat_loops.store(0, std::memory_order_relaxed);
     stat_blocks.store(0, std::memory_order_relaxed);
     stat_multi_block_loops.store(0, std::memory_order_relaxed);
+    stat_max_team.store(0, std::memory_order_relaxed);
     stat_max_threads.store(0, std::memory_order_relaxed);
 }
 
@@ -88,6 +92,7 @@ void parallel_blocks(std::size_t n, std::size_t block,
     // Bit t set: the team's thread t ran a block (threads past 63 share the last bit, so the
     // count saturates at 64).
     std::atomic<std::uint64_t> ran_on{0};
+    std::atomic<int> team{1};
 
     const auto run_block = [&](std::size_t b) {
         if (stop.load(std::memory_order_relaxed))
@@ -95,7 +100,10 @@ void parallel_blocks(std::size_t n, std::size_t block,
         const int t = std::min(omp_get_thread_num(), 63);
         const std::uint64_t bit = std::uint64_t{1} << t;
         if ((ran_on.load(std::memory_order_relaxed) & bit) == 0)
+        {
             ran_on.fetch_or(bit, std::memory_order_relaxed);
+            record_max(team, omp_get_num_threads());
+        }
         try
         {
             body(b * block, std::min(n, (b + 1) * block));
@@ -136,7 +144,8 @@ void parallel_blocks(std::size_t n, std::size_t block,
             run_block(static_cast<std::size_t>(b));
     }
     stat_blocks.fetch_add(done.load(), std::memory_order_relaxed);
-    record_threads(std::popcount(ran_on.load(std::memory_order_relaxed)));
+    record_max(stat_max_team, team.load(std::memory_order_relaxed));
+    record_max(stat_max_threads, std::popcount(ran_on.load(std::memory_order_relaxed)));
     for (const auto& e : errors)
         if (e)
             std::rethrow_exception(e);

@@ -43,10 +43,15 @@ void expect_same_bytes(const std::string& command, const std::vector<std::string
         const auto& parallel = report["parallel"];
         EXPECT_GE(parallel["multi_block_loops"].get<int>(), 3) << j << " threads";
         EXPECT_GE(parallel["blocks"].get<int>(), parallel["loops"].get<int>()) << j;
+        EXPECT_EQ(parallel["max_team_threads"].get<int>(), j);
         if (j == 1)
+        {
             EXPECT_EQ(parallel["max_threads_per_loop"].get<int>(), 1);
+        }
         else
+        {
             EXPECT_GT(parallel["max_threads_per_loop"].get<int>(), 1) << j << " threads";
+        }
         EXPECT_EQ(report["threads"].get<int>(), j);
         for (std::size_t o = 0; o < outputs.size(); ++o)
         {

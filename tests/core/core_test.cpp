@@ -55,6 +55,7 @@ TEST(ParallelBlocks, StatsCountLoopsBlocksAndThreads)
     EXPECT_EQ(stats.loops, 2U);
     EXPECT_EQ(stats.blocks, 101U);
     EXPECT_EQ(stats.multi_block_loops, 1U);
+    EXPECT_EQ(stats.max_team_threads, 1);
     EXPECT_EQ(stats.max_threads_per_loop, 1);
 
     for (const int threads : {2, 3})
@@ -66,6 +67,7 @@ TEST(ParallelBlocks, StatsCountLoopsBlocksAndThreads)
         EXPECT_EQ(stats.loops, 1U);
         EXPECT_EQ(stats.blocks, 100U);
         EXPECT_EQ(stats.multi_block_loops, 1U);
+        EXPECT_EQ(stats.max_team_threads, threads);
         EXPECT_GT(stats.max_threads_per_loop, 1) << threads;
         EXPECT_LE(stats.max_threads_per_loop, threads);
     }
@@ -83,7 +85,12 @@ TEST(ParallelBlocks, StatsCountLoopsBlocksAndThreads)
     reset_parallel_stats();
     stats = parallel_stats();
     EXPECT_EQ(stats.loops + stats.blocks + stats.multi_block_loops, 0U);
+    EXPECT_EQ(stats.max_team_threads, 0);
     EXPECT_EQ(stats.max_threads_per_loop, 0);
+    // One block, or one thread: a team of one.
+    set_thread_count(3);
+    parallel_blocks(50, 100, busy);
+    EXPECT_EQ(parallel_stats().max_team_threads, 1);
     set_thread_count(0);
 }
 

@@ -45,7 +45,11 @@ struct ParallelStats
     std::uint64_t loops = 0;             ///< calls of parallel_blocks with n > 0
     std::uint64_t blocks = 0;            ///< blocks run (skipped ones after a failure not counted)
     std::uint64_t multi_block_loops = 0; ///< calls that split their range into 2 or more blocks
-    /// Most distinct threads that ran blocks of one call (1 when every call ran serially).
+    /// Most threads in the team of one call: 1 when every call ran serially, else the thread
+    /// count of the calls that split their range (fixed by the thread count, unlike the next).
+    int max_team_threads = 0;
+    /// Most distinct threads that actually ran blocks of one call (1 when every call ran
+    /// serially; up to the team's size, as the threads happened to be scheduled).
     int max_threads_per_loop = 0;
 };
 
