@@ -65,7 +65,8 @@ PlaneFit fit_plane(std::span<const Vec3f> positions, std::span<const std::uint32
 Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
                          const ProgressCallback& progress)
 {
-    check_knn_table(neighbors, positions.size(), positions.size(), "estimate_normals");
+    // The rows' indices are checked below as each fit reads them.
+    check_knn_table_shape(neighbors, positions.size(), "estimate_normals");
     Normals result;
     result.normals.resize(positions.size());
     std::vector<std::uint8_t> degenerate(positions.size(), 0);
@@ -75,7 +76,14 @@ Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neigh
         [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i)
             {
-                const PlaneFit fit = fit_unchecked(positions, neighbors.neighbors(i));
+                const std::span<const std::uint32_t> row = neighbors.neighbors(i);
+                for (const std::uint32_t index : row)
+                    if (index >= positions.size())
+                        throw InvalidInput("estimate_normals: neighbour " + std::to_string(index) +
+                                           " of row " + std::to_string(i) +
+                                           " is out of range for " +
+                                           std::to_string(positions.size()) + " points");
+                const PlaneFit fit = fit_unchecked(positions, row);
                 result.normals[i] = fit.normal.cast<float>();
                 degenerate[i] = fit.degenerate ? 1 : 0;
             }

@@ -74,8 +74,7 @@ std::size_t KdTree::size() const
     return impl_->data.points.size();
 }
 
-void check_knn_table(const KnnTable& table, std::size_t rows, std::size_t points,
-                     const char* function)
+void check_knn_table_shape(const KnnTable& table, std::size_t rows, const char* function)
 {
     const std::string name(function);
     if (table.k == 0 ? !table.indices.empty() : table.indices.size() % table.k != 0)
@@ -86,11 +85,26 @@ void check_knn_table(const KnnTable& table, std::size_t rows, std::size_t points
                            " rows for " + std::to_string(rows) + " points");
     check_same_size(function, "the neighbour table's squared_distances",
                     table.squared_distances.size(), table.indices.size());
-    for (std::size_t i = 0; i < table.indices.size(); ++i)
-        if (table.indices[i] >= points)
-            throw InvalidInput(name + ": neighbour " + std::to_string(table.indices[i]) +
-                               " of row " + std::to_string(i / table.k) + " is out of range for " +
-                               std::to_string(points) + " points");
+}
+
+void check_knn_table(const KnnTable& table, std::size_t rows, std::size_t points,
+                     const char* function)
+{
+    check_knn_table_shape(table, rows, function);
+    // Whether any is out of range first (a loop without branches), the offender only then.
+    const auto limit = static_cast<std::uint64_t>(points);
+    bool out_of_range = false;
+    for (const std::uint32_t index : table.indices)
+        out_of_range |= index >= limit;
+    if (!out_of_range)
+        return;
+    const auto bad = static_cast<std::size_t>(
+        std::find_if(table.indices.begin(), table.indices.end(),
+                     [&](std::uint32_t index) { return index >= points; }) -
+        table.indices.begin());
+    throw InvalidInput(std::string(function) + ": neighbour " + std::to_string(table.indices[bad]) +
+                       " of row " + std::to_string(bad / table.k) + " is out of range for " +
+                       std::to_string(points) + " points");
 }
 
 std::span<const Vec3f> KdTree::positions() const

@@ -38,6 +38,10 @@ struct KnnTable
 void check_knn_table(const KnnTable& table, std::size_t rows, std::size_t points,
                      const char* function);
 
+/// \brief check_knn_table() without the pass over the indices, for a caller that checks each
+/// row's indices as it reads them (one memory pass instead of two).
+void check_knn_table_shape(const KnnTable& table, std::size_t rows, const char* function);
+
 /// \brief Variable-size neighbourhoods in compressed sparse row form: the neighbours of query i
 /// are indices[offsets[i] .. offsets[i+1]), nearest first.
 struct RadiusTable
