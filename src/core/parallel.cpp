@@ -94,15 +94,18 @@ void parallel_blocks(std::size_t n, std::size_t block,
     std::atomic<std::uint64_t> ran_on{0};
     std::atomic<int> team{1};
 
-    const auto run_block = [&](std::size_t b) {
+    // in_team: run by the team of the parallel region below (not serially here, where the
+    // caller may itself be a thread of some other team).
+    const auto run_block = [&](std::size_t b, bool in_team) {
         if (stop.load(std::memory_order_relaxed))
             return;
-        const int t = std::min(omp_get_thread_num(), 63);
+        const int t = in_team ? std::min(omp_get_thread_num(), 63) : 0;
         const std::uint64_t bit = std::uint64_t{1} << t;
         if ((ran_on.load(std::memory_order_relaxed) & bit) == 0)
         {
             ran_on.fetch_or(bit, std::memory_order_relaxed);
-            record_max(team, omp_get_num_threads());
+            if (in_team)
+                record_max(team, omp_get_num_threads());
         }
         try
         {
@@ -134,14 +137,14 @@ void parallel_blocks(std::size_t n, std::size_t block,
     if (blocks == 1 || thread_count() == 1)
     {
         for (std::size_t b = 0; b < blocks; ++b)
-            run_block(b);
+            run_block(b, false);
     }
     else
     {
         const auto count = static_cast<std::ptrdiff_t>(blocks);
 #pragma omp parallel for schedule(dynamic, 1)
         for (std::ptrdiff_t b = 0; b < count; ++b)
-            run_block(static_cast<std::size_t>(b));
+            run_block(static_cast<std::size_t>(b), true);
     }
     stat_blocks.fetch_add(done.load(), std::memory_order_relaxed);
     record_max(stat_max_team, team.load(std::memory_order_relaxed));
