@@ -121,6 +121,14 @@ void add_run_report(nlohmann::json& out, const Timings& timings)
     stages["total"] = timings.total();
     out["timings_s"] = stages;
     out["threads"] = thread_count();
+    // What the parallel runtime did in this process: shows the work really was split in blocks
+    // run by several threads (tests compare outputs across --threads with it).
+    const ParallelStats parallel = parallel_stats();
+    out["parallel"] = {{"loops", parallel.loops},
+                       {"blocks", parallel.blocks},
+                       {"multi_block_loops", parallel.multi_block_loops},
+                       {"max_team_threads", parallel.max_team_threads},
+                       {"max_threads_per_loop", parallel.max_threads_per_loop}};
     out["peak_rss_bytes"] = peak_rss_bytes();
 }
 

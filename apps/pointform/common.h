@@ -64,7 +64,7 @@ private:
 };
 
 /// \brief Adds what every JSON report ends with: "timings_s" (each stage and the total),
-/// "threads" and "peak_rss_bytes".
+/// "threads", "parallel" (parallel_stats() of the run) and "peak_rss_bytes".
 void add_run_report(nlohmann::json& out, const Timings& timings);
 
 /// \brief Prints the "seconds" row: each stage, then the total.

@@ -38,5 +38,13 @@ void assert_fail(const char* expr, const char* file, int line)
     std::abort();
 }
 
+void throw_buffer_size(const char* function, const char* buffer, std::size_t size,
+                       std::size_t needed, bool exact)
+{
+    throw InvalidInput(std::string(function) + ": " + buffer + " has " + std::to_string(size) +
+                       " entries, " + (exact ? "expected " : "needs at least ") +
+                       std::to_string(needed));
+}
+
 } // namespace detail
 } // namespace pointform

@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
+#include <cstdint>
 #include <exception>
 #include <mutex>
 #include <vector>
@@ -22,7 +24,42 @@ int default_threads()
     return threads;
 }
 
+std::atomic<std::uint64_t> stat_loops{0};
+std::atomic<std::uint64_t> stat_blocks{0};
+std::atomic<std::uint64_t> stat_multi_block_loops{0};
+std::atomic<int> stat_max_team{0};
+std::atomic<int> stat_max_threads{0};
+
+void record_max(std::atomic<int>& max, int value)
+{
+    int seen = max.load(std::memory_order_relaxed);
+    while (seen < value && !max.compare_exchange_weak(seen, value, std::memory_order_relaxed))
+    {
+        // seen now holds the current maximum
+    }
+}
+
 } // namespace
+
+ParallelStats parallel_stats()
+{
+    ParallelStats stats;
+    stats.loops = stat_loops.load(std::memory_order_relaxed);
+    stats.blocks = stat_blocks.load(std::memory_order_relaxed);
+    stats.multi_block_loops = stat_multi_block_loops.load(std::memory_order_relaxed);
+    stats.max_team_threads = stat_max_team.load(std::memory_order_relaxed);
+    stats.max_threads_per_loop = stat_max_threads.load(std::memory_order_relaxed);
+    return stats;
+}
+
+void reset_parallel_stats()
+{
+    stat_loops.store(0, std::memory_order_relaxed);
+    stat_blocks.store(0, std::memory_order_relaxed);
+    stat_multi_block_loops.store(0, std::memory_order_relaxed);
+    stat_max_team.store(0, std::memory_order_relaxed);
+    stat_max_threads.store(0, std::memory_order_relaxed);
+}
 
 int thread_count()
 {
@@ -44,14 +81,32 @@ void parallel_blocks(std::size_t n, std::size_t block,
     if (block == 0)
         block = 4096;
     const std::size_t blocks = (n + block - 1) / block;
+    stat_loops.fetch_add(1, std::memory_order_relaxed);
+    if (blocks > 1)
+        stat_multi_block_loops.fetch_add(1, std::memory_order_relaxed);
     std::vector<std::exception_ptr> errors(blocks);
     std::atomic<std::size_t> done{0};
     std::atomic<bool> stop{false};
     std::mutex reporting;
 
-    const auto run_block = [&](std::size_t b) {
+    // Bit t set: the team's thread t ran a block (threads past 63 share the last bit, so the
+    // count saturates at 64).
+    std::atomic<std::uint64_t> ran_on{0};
+    std::atomic<int> team{1};
+
+    // in_team: run by the team of the parallel region below (not serially here, where the
+    // caller may itself be a thread of some other team).
+    const auto run_block = [&](std::size_t b, bool in_team) {
         if (stop.load(std::memory_order_relaxed))
             return;
+        const int t = in_team ? std::min(omp_get_thread_num(), 63) : 0;
+        const std::uint64_t bit = std::uint64_t{1} << t;
+        if ((ran_on.load(std::memory_order_relaxed) & bit) == 0)
+        {
+            ran_on.fetch_or(bit, std::memory_order_relaxed);
+            if (in_team)
+                record_max(team, omp_get_num_threads());
+        }
         try
         {
             body(b * block, std::min(n, (b + 1) * block));
@@ -82,15 +137,18 @@ void parallel_blocks(std::size_t n, std::size_t block,
     if (blocks == 1 || thread_count() == 1)
     {
         for (std::size_t b = 0; b < blocks; ++b)
-            run_block(b);
+            run_block(b, false);
     }
     else
     {
         const auto count = static_cast<std::ptrdiff_t>(blocks);
 #pragma omp parallel for schedule(dynamic, 1)
         for (std::ptrdiff_t b = 0; b < count; ++b)
-            run_block(static_cast<std::size_t>(b));
+            run_block(static_cast<std::size_t>(b), true);
     }
+    stat_blocks.fetch_add(done.load(), std::memory_order_relaxed);
+    record_max(stat_max_team, team.load(std::memory_order_relaxed));
+    record_max(stat_max_threads, std::popcount(ran_on.load(std::memory_order_relaxed)));
     for (const auto& e : errors)
         if (e)
             std::rethrow_exception(e);

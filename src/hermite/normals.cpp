@@ -18,11 +18,9 @@ namespace {
 /// undefined. Relative, so independent of units.
 constexpr double collinear_ratio = 1e-10;
 
-} // namespace
-
-PlaneFit fit_plane(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices)
+/// fit_plane() on indices known to be in range (a checked neighbour table), at least one.
+PlaneFit fit_unchecked(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices)
 {
-    PF_ASSERT(!indices.empty());
     PlaneFit fit;
     // Shift by the first point so the sums do not lose precision far from the origin.
     const Vec3d shift = positions[indices[0]].cast<double>();
@@ -50,13 +48,25 @@ PlaneFit fit_plane(std::span<const Vec3f> positions, std::span<const std::uint32
     return fit;
 }
 
+} // namespace
+
+PlaneFit fit_plane(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices)
+{
+    if (indices.empty())
+        throw InvalidInput("fit_plane: no indices");
+    for (const std::uint32_t index : indices)
+        if (index >= positions.size())
+            throw InvalidInput("fit_plane: index " + std::to_string(index) +
+                               " is out of range for " + std::to_string(positions.size()) +
+                               " points");
+    return fit_unchecked(positions, indices);
+}
+
 Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
                          const ProgressCallback& progress)
 {
-    if (neighbors.rows() != positions.size())
-        throw InvalidInput("estimate_normals: neighbour table has " +
-                           std::to_string(neighbors.rows()) + " rows for " +
-                           std::to_string(positions.size()) + " points");
+    // The rows' indices are checked below as each fit reads them.
+    check_knn_table_shape(neighbors, positions.size(), "estimate_normals");
     Normals result;
     result.normals.resize(positions.size());
     std::vector<std::uint8_t> degenerate(positions.size(), 0);
@@ -66,7 +76,14 @@ Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neigh
         [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i)
             {
-                const PlaneFit fit = fit_plane(positions, neighbors.neighbors(i));
+                const std::span<const std::uint32_t> row = neighbors.neighbors(i);
+                for (const std::uint32_t index : row)
+                    if (index >= positions.size())
+                        throw InvalidInput("estimate_normals: neighbour " + std::to_string(index) +
+                                           " of row " + std::to_string(i) +
+                                           " is out of range for " +
+                                           std::to_string(positions.size()) + " points");
+                const PlaneFit fit = fit_unchecked(positions, row);
                 result.normals[i] = fit.normal.cast<float>();
                 degenerate[i] = fit.degenerate ? 1 : 0;
             }

@@ -315,6 +315,7 @@ RiemannianForest riemannian_spanning_forest(std::span<const Vec3f> positions,
         throw InvalidInput("orientation: " + std::to_string(n) + " points, " +
                            std::to_string(normals.size()) + " normals and " +
                            std::to_string(neighbors.rows()) + " neighbour rows must agree");
+    check_knn_table(neighbors, n, n, "orientation");
     if (n >= RiemannianForest::none)
         throw InvalidInput("orientation: too many points for 32-bit indices");
     RiemannianForest forest;
@@ -438,6 +439,7 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
         throw InvalidInput("orientation: " + std::to_string(positions.size()) + " points, " +
                            std::to_string(fine_normals.size()) + " normals and " +
                            std::to_string(neighbors.rows()) + " neighbour rows must agree");
+    check_knn_table(neighbors, positions.size(), positions.size(), "orientation");
     // 0. On noisy clouds, orientation follows normals at a coarser scale and hands their signs to
     //    the samples' own normals at the end (step 3).
     std::vector<Vec3f> guide;

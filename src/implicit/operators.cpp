@@ -124,7 +124,8 @@ void unary_batch(const Field& member, std::span<const Vec3d> points, std::span<c
                  std::span<const double> hi, std::span<FieldSample> out, const Range& range,
                  const Finish& finish)
 {
-    PF_ASSERT(points.size() == out.size() && lo.size() == out.size() && hi.size() == out.size());
+    check_within_sizes("unary operator evaluate_within", points.size(), lo.size(), hi.size(),
+                       out.size());
     parallel_blocks(points.size(), operator_block, [&](std::size_t begin, std::size_t end) {
         const std::size_t n = end - begin;
         std::vector<double> member_lo(n);
@@ -326,7 +327,8 @@ FieldSample BooleanField::evaluate_within(const Vec3d& p, double lo, double hi) 
 void BooleanField::evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
                                    std::span<const double> hi, std::span<FieldSample> out) const
 {
-    PF_ASSERT(points.size() == out.size() && lo.size() == out.size() && hi.size() == out.size());
+    check_within_sizes("BooleanField::evaluate_within", points.size(), lo.size(), hi.size(),
+                       out.size());
     parallel_blocks(points.size(), operator_block, [&](std::size_t begin, std::size_t end) {
         const std::size_t n = end - begin;
         std::vector<Minimum> minima;
@@ -470,7 +472,8 @@ void SmoothBooleanField::evaluate_within(std::span<const Vec3d> points, std::spa
                                          std::span<const double> hi,
                                          std::span<FieldSample> out) const
 {
-    PF_ASSERT(points.size() == out.size() && lo.size() == out.size() && hi.size() == out.size());
+    check_within_sizes("SmoothBooleanField::evaluate_within", points.size(), lo.size(), hi.size(),
+                       out.size());
     const bool b_first = b_->cost() < a_->cost();
     const Field& first = b_first ? *b_ : *a_;
     const Field& second = b_first ? *a_ : *b_;

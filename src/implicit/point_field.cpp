@@ -764,13 +764,15 @@ double PointField::cost() const
 
 void PointField::evaluate(std::span<const Vec3d> points, std::span<FieldSample> out) const
 {
+    check_same_size("PointField::evaluate", "out", out.size(), points.size());
     evaluate_batch(points, {}, out);
 }
 
-void PointField::evaluate_within(std::span<const Vec3d> points, std::span<const double> /*lo*/,
+void PointField::evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
                                  std::span<const double> hi, std::span<FieldSample> out) const
 {
-    PF_ASSERT(hi.size() == points.size());
+    check_within_sizes("PointField::evaluate_within", points.size(), lo.size(), hi.size(),
+                       out.size());
     evaluate_batch(points, hi, out);
 }
 

@@ -78,7 +78,8 @@ FieldSample TransformedField::evaluate_within(const Vec3d& p, double lo, double 
 void TransformedField::evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
                                        std::span<const double> hi, std::span<FieldSample> out) const
 {
-    PF_ASSERT(points.size() == out.size() && lo.size() == out.size() && hi.size() == out.size());
+    check_within_sizes("TransformedField::evaluate_within", points.size(), lo.size(), hi.size(),
+                       out.size());
     parallel_blocks(points.size(), 1024, [&](std::size_t begin, std::size_t end) {
         const std::size_t n = end - begin;
         std::vector<Vec3d> local(n);

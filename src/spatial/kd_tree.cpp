@@ -131,6 +131,39 @@ std::size_t KdTree::size() const
     return impl_->data.points.size();
 }
 
+void check_knn_table_shape(const KnnTable& table, std::size_t rows, const char* function)
+{
+    const std::string name(function);
+    if (table.k == 0 ? !table.indices.empty() : table.indices.size() % table.k != 0)
+        throw InvalidInput(name + ": neighbour table of " + std::to_string(table.indices.size()) +
+                           " indices is not whole rows of k = " + std::to_string(table.k));
+    if (table.rows() != rows)
+        throw InvalidInput(name + ": neighbour table has " + std::to_string(table.rows()) +
+                           " rows for " + std::to_string(rows) + " points");
+    check_same_size(function, "the neighbour table's squared_distances",
+                    table.squared_distances.size(), table.indices.size());
+}
+
+void check_knn_table(const KnnTable& table, std::size_t rows, std::size_t points,
+                     const char* function)
+{
+    check_knn_table_shape(table, rows, function);
+    // Whether any is out of range first (a loop without branches), the offender only then.
+    const auto limit = static_cast<std::uint64_t>(points);
+    bool out_of_range = false;
+    for (const std::uint32_t index : table.indices)
+        out_of_range |= index >= limit;
+    if (!out_of_range)
+        return;
+    const auto bad = static_cast<std::size_t>(
+        std::find_if(table.indices.begin(), table.indices.end(),
+                     [&](std::uint32_t index) { return index >= points; }) -
+        table.indices.begin());
+    throw InvalidInput(std::string(function) + ": neighbour " + std::to_string(table.indices[bad]) +
+                       " of row " + std::to_string(bad / table.k) + " is out of range for " +
+                       std::to_string(points) + " points");
+}
+
 std::span<const Vec3f> KdTree::positions() const
 {
     return impl_->data.points;
@@ -139,8 +172,9 @@ std::span<const Vec3f> KdTree::positions() const
 std::size_t KdTree::knn(const Vec3f& query, std::size_t k, std::span<std::uint32_t> indices,
                         std::span<float> squared_distances) const
 {
-    PF_ASSERT(indices.size() >= k && squared_distances.size() >= k);
     k = std::min(k, size());
+    check_buffer_size("KdTree::knn", "indices", indices.size(), k);
+    check_buffer_size("KdTree::knn", "squared_distances", squared_distances.size(), k);
     if (k == 0)
         return 0;
     OrderedKnnResult result(k, indices.data(), squared_distances.data());
@@ -170,7 +204,9 @@ PointId KdTree::nearest_within_factor(const Vec3f& query, float factor, PointId 
                                       float* squared_distance) const
 {
     PF_ASSERT(factor >= 1.0F);
-    PF_ASSERT(start.is_valid() && start.value < size());
+    if (!start.is_valid() || start.value >= size()) [[unlikely]]
+        throw InvalidInput("KdTree::nearest_within_factor: start " + std::to_string(start.value) +
+                           " is not a point of the tree (" + std::to_string(size()) + " points)");
     // The result set's worst distance is the search's bound: preset it to the start's, so
     // that the search only looks for points nearer than that.
     std::uint32_t index = 0;

@@ -784,7 +784,8 @@ std::size_t PointGrid::knn_nearby(const Vec3f& query, std::size_t k, std::span<s
                                   std::span<float> squared_distances) const
 {
     k = std::min(k, count_);
-    PF_ASSERT(slots.size() >= k && squared_distances.size() >= k);
+    check_buffer_size("PointGrid::knn", "slots", slots.size(), k);
+    check_buffer_size("PointGrid::knn", "squared_distances", squared_distances.size(), k);
     if (k == 0)
     {
         return 0;
@@ -861,7 +862,12 @@ void PointGrid::knn_nearby(std::span<const Vec3f> queries, std::size_t k,
                            std::span<std::uint32_t> found) const
 {
     const std::size_t n = queries.size();
-    PF_ASSERT(found.size() >= n && slots.size() >= k * n && squared_distances.size() >= k * n);
+    check_buffer_size("PointGrid::knn_nearby", "found", found.size(), n);
+    if (n > 0 && k > std::numeric_limits<std::size_t>::max() / n)
+        throw InvalidInput("PointGrid::knn_nearby: k · queries overflows");
+    check_buffer_size("PointGrid::knn_nearby", "slots", slots.size(), k * n);
+    check_buffer_size("PointGrid::knn_nearby", "squared_distances", squared_distances.size(),
+                      k * n);
     const std::size_t want = std::min(k, count_);
 #if PF_GRID_AVX2
     const bool wide = has_avx2();

@@ -36,6 +36,64 @@ TEST(ParallelBlocks, CoversEveryIndexOnceWhateverTheThreadCount)
     parallel_blocks(0, 10, [](std::size_t, std::size_t) { FAIL() << "called on empty range"; });
 }
 
+TEST(ParallelBlocks, StatsCountLoopsBlocksAndThreads)
+{
+    const auto busy = [](std::size_t begin, std::size_t end) {
+        // Long enough per block that the other threads of the team join in.
+        const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(200);
+        while (std::chrono::steady_clock::now() < until)
+        {}
+        (void)begin;
+        (void)end;
+    };
+    set_thread_count(1);
+    reset_parallel_stats();
+    parallel_blocks(10000, 100, busy);
+    parallel_blocks(50, 100, busy); // one block
+    parallel_blocks(0, 100, busy);  // nothing: not a loop
+    ParallelStats stats = parallel_stats();
+    EXPECT_EQ(stats.loops, 2U);
+    EXPECT_EQ(stats.blocks, 101U);
+    EXPECT_EQ(stats.multi_block_loops, 1U);
+    EXPECT_EQ(stats.max_team_threads, 1);
+    EXPECT_EQ(stats.max_threads_per_loop, 1);
+
+    for (const int threads : {2, 3})
+    {
+        set_thread_count(threads);
+        reset_parallel_stats();
+        parallel_blocks(10000, 100, busy);
+        stats = parallel_stats();
+        EXPECT_EQ(stats.loops, 1U);
+        EXPECT_EQ(stats.blocks, 100U);
+        EXPECT_EQ(stats.multi_block_loops, 1U);
+        EXPECT_EQ(stats.max_team_threads, threads);
+        EXPECT_GT(stats.max_threads_per_loop, 1) << threads;
+        EXPECT_LE(stats.max_threads_per_loop, threads);
+    }
+
+    // Blocks skipped after a failure are not counted.
+    set_thread_count(1);
+    reset_parallel_stats();
+    EXPECT_THROW(parallel_blocks(1000, 100,
+                                 [](std::size_t begin, std::size_t) {
+                                     if (begin == 300)
+                                         throw InvalidInput("stop");
+                                 }),
+                 InvalidInput);
+    EXPECT_EQ(parallel_stats().blocks, 4U);
+    reset_parallel_stats();
+    stats = parallel_stats();
+    EXPECT_EQ(stats.loops + stats.blocks + stats.multi_block_loops, 0U);
+    EXPECT_EQ(stats.max_team_threads, 0);
+    EXPECT_EQ(stats.max_threads_per_loop, 0);
+    // One block, or one thread: a team of one.
+    set_thread_count(3);
+    parallel_blocks(50, 100, busy);
+    EXPECT_EQ(parallel_stats().max_team_threads, 1);
+    set_thread_count(0);
+}
+
 TEST(ParallelBlocks, RethrowsTheFirstFailingBlock)
 {
     set_thread_count(2);

@@ -8,6 +8,7 @@
 #include "pointform/geometry/shapes.h"
 
 #include "support/test_support.h"
+#include "support/thread_counts.h"
 
 #include <gtest/gtest.h>
 
@@ -76,12 +77,10 @@ TEST(EstimateNormals, TorusNormalsWithNoise)
 TEST(EstimateNormals, SameResultForOneAndTwoThreads)
 {
     const PointCloud torus = sample_shape(Shape::Torus, {.count = 20000, .seed = 4});
-    set_thread_count(1);
-    const Normals one = estimate_normals(torus.positions, {.k = 12});
-    set_thread_count(2);
-    const Normals two = estimate_normals(torus.positions, {.k = 12});
-    set_thread_count(0);
-    EXPECT_EQ(one.normals, two.normals);
+    const auto runs =
+        test::at_thread_counts([&] { return estimate_normals(torus.positions, {.k = 12}); });
+    EXPECT_EQ(runs[0].normals, runs[1].normals);
+    EXPECT_EQ(runs[0].normals, runs[2].normals);
 }
 
 TEST(EstimateNormals, RejectsTooFewPointsAndTinyK)

@@ -8,6 +8,7 @@
 #include "pointform/geometry/shapes.h"
 
 #include "support/test_support.h"
+#include "support/thread_counts.h"
 
 #include <gtest/gtest.h>
 
@@ -66,14 +67,13 @@ TEST(ComputeSurfels, SameOutputForOneAndTwoThreads)
 {
     const PointCloud cloud =
         sample_shape(Shape::TwoSpheres, {.count = 20000, .seed = 12, .noise = 0.003, .holes = 4});
-    set_thread_count(1);
-    const SurfelResult one = compute_surfels(cloud);
-    set_thread_count(2);
-    const SurfelResult two = compute_surfels(cloud);
-    set_thread_count(0);
-    EXPECT_EQ(one.surfels.normals, two.surfels.normals);
-    EXPECT_EQ(one.surfels.radii, two.surfels.radii);
-    EXPECT_EQ(one.orientation.flipped, two.orientation.flipped);
+    const auto runs = test::at_thread_counts([&] { return compute_surfels(cloud); });
+    for (std::size_t i = 1; i < runs.size(); ++i)
+    {
+        EXPECT_EQ(runs[0].surfels.normals, runs[i].surfels.normals) << i + 1 << " threads";
+        EXPECT_EQ(runs[0].surfels.radii, runs[i].surfels.radii) << i + 1 << " threads";
+        EXPECT_EQ(runs[0].orientation.flipped, runs[i].orientation.flipped) << i + 1;
+    }
 }
 
 TEST(ComputeSurfels, RejectsBadInput)

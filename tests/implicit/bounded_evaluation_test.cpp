@@ -16,6 +16,8 @@
 #include "pointform/polygonize/marching_cubes.h"
 #include "pointform/spatial/kd_tree.h"
 
+#include "support/thread_counts.h"
+
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -177,13 +179,15 @@ TEST(BoundedEvaluation, EveryOperatorIsExactWithinItsRangeAndKeepsTheSideBeyond)
                           c.name + " at point " + std::to_string(i));
         }
         // Batches give the same samples as one by one, with any number of threads.
-        for (const int threads : {1, 2})
+        for (const int threads : {1, 2, 3})
         {
             set_thread_count(threads);
+            reset_parallel_stats();
             std::vector<FieldSample> batch(points.size());
             c.field->evaluate_within(points, lo, hi, batch);
             std::vector<FieldSample> plain(points.size());
             c.field->evaluate(points, plain);
+            test::expect_parallel_run(threads, {.min_multi_block_loops = 2});
             for (std::size_t i = 0; i < points.size(); ++i)
             {
                 const FieldSample one = c.field->evaluate_within(points[i], lo[i], hi[i]);

@@ -11,6 +11,8 @@
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/spatial_sort.h"
 
+#include "support/thread_counts.h"
+
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -87,8 +89,10 @@ void expect_batch_as_single(const PointField& field, const Queries& queries, int
 {
     const int saved = thread_count();
     set_thread_count(threads);
+    reset_parallel_stats();
     std::vector<FieldSample> batch(queries.points.size());
     field.evaluate(queries.points, batch);
+    test::expect_parallel_run(threads);
     set_thread_count(saved);
     std::size_t defined = 0;
     for (std::size_t i = 0; i < queries.points.size(); ++i)

@@ -9,6 +9,8 @@
 #include "pointform/implicit/point_field.h"
 #include "pointform/spatial/feature_grid.h"
 
+#include "support/thread_counts.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -286,9 +288,13 @@ TEST(PointFieldFar, SameValuesWhateverTheThreadCountAndTheQueryOrder)
     std::vector<FieldSample> two(points.size());
     std::vector<FieldSample> one(points.size());
     set_thread_count(2);
+    reset_parallel_stats();
     first.evaluate(points, two);
+    test::expect_parallel_run(2);
     set_thread_count(1);
+    reset_parallel_stats();
     first.evaluate(points, one);
+    test::expect_parallel_run(1);
     set_thread_count(saved);
     // The second builds it in a lone query at the deepest point.
     const auto deepest = static_cast<std::size_t>(

@@ -8,6 +8,8 @@
 #include "pointform/geometry/shapes.h"
 #include "pointform/hermite/surfels.h"
 
+#include "support/thread_counts.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -184,21 +186,22 @@ TEST(PointField, BatchEqualsSingleWhateverTheThreadCount)
     {
         points.emplace_back(u(rng), u(rng), u(rng));
     }
-    const int saved = thread_count();
-    std::vector<FieldSample> one(points.size());
-    std::vector<FieldSample> two(points.size());
-    set_thread_count(1);
-    field.evaluate(points, one);
-    set_thread_count(2);
-    field.evaluate(points, two);
-    set_thread_count(saved);
+    const auto runs = test::at_thread_counts([&] {
+        std::vector<FieldSample> out(points.size());
+        field.evaluate(points, out);
+        return out;
+    });
+    const std::vector<FieldSample>& one = runs[0];
     for (std::size_t i = 0; i < points.size(); ++i)
     {
         const FieldSample single = field.evaluate(points[i]);
         ASSERT_EQ(one[i].value, single.value);
-        ASSERT_EQ(two[i].value, single.value);
-        ASSERT_EQ(two[i].defined, single.defined);
-        ASSERT_EQ(two[i].gradient, single.gradient);
+        ASSERT_EQ(runs[1][i].value, single.value);
+        ASSERT_EQ(runs[2][i].value, single.value);
+        ASSERT_EQ(runs[1][i].defined, single.defined);
+        ASSERT_EQ(runs[2][i].defined, single.defined);
+        ASSERT_EQ(runs[1][i].gradient, single.gradient);
+        ASSERT_EQ(runs[2][i].gradient, single.gradient);
     }
 }
 
@@ -244,8 +247,10 @@ TEST(PointField, SmoothPlanesAreMoreAccurateOnNoisyScans)
     EXPECT_LT(centroid, 0.6 * raw);
     EXPECT_LT(blend, 0.6 * raw);
     EXPECT_LE(blend, centroid * 1.05);
-    // The quadrics' wider neighbourhood averages more noise than the centroid planes.
-    EXPECT_LE(quadric, blend);
+    // The quadrics' wider neighbourhood averages the noise as well as the blended planes do:
+    // with the guide normals at the noise's own scale (orientation.h) both land within 1% of
+    // each other (0.000968 and 0.000963 here; with the fine PCA normals the quadrics were ahead).
+    EXPECT_LE(quadric, 1.02 * blend);
 }
 
 TEST(PointField, QuadricsFollowCurvatureThatPlanesCutThrough)

@@ -13,6 +13,7 @@
 
 #include "support/test_meshes.h"
 #include "support/test_support.h"
+#include "support/thread_counts.h"
 
 #include <gtest/gtest.h>
 
@@ -222,28 +223,27 @@ TEST(Compare, SameResultWhateverTheThreadCount)
     const TriMesh bunny = read_mesh(test::data_path("meshes/bunny_uniform.off"));
     const TriMesh sphere = test::icosphere(3, bunny.vertices.bounds().center(), 0.06);
     const CompareOptions options{.samples = 3000, .seed = 3};
-    set_thread_count(1);
-    const DistanceComparison one = compare(bunny, sphere, options);
-    set_thread_count(3);
-    const DistanceComparison three = compare(bunny, sphere, options);
-    set_thread_count(0);
-    for (const auto& [x, y] : {std::pair{one.absolute.a_to_b, three.absolute.a_to_b},
-                               std::pair{one.absolute.b_to_a, three.absolute.b_to_a},
-                               std::pair{one.absolute.symmetric, three.absolute.symmetric}})
+    const auto runs = test::at_thread_counts([&] { return compare(bunny, sphere, options); });
+    const DistanceComparison& one = runs[0];
+    for (std::size_t i = 1; i < runs.size(); ++i)
     {
-        EXPECT_EQ(x.max, y.max);
-        EXPECT_EQ(x.mean, y.mean);
-        EXPECT_EQ(x.rms, y.rms);
-        EXPECT_EQ(x.p50, y.p50);
-        EXPECT_EQ(x.p99, y.p99);
+        const DistanceComparison& other = runs[i];
+        for (const auto& [x, y] : {std::pair{one.absolute.a_to_b, other.absolute.a_to_b},
+                                   std::pair{one.absolute.b_to_a, other.absolute.b_to_a},
+                                   std::pair{one.absolute.symmetric, other.absolute.symmetric}})
+        {
+            EXPECT_EQ(x.max, y.max) << i + 1 << " threads";
+            EXPECT_EQ(x.mean, y.mean) << i + 1 << " threads";
+            EXPECT_EQ(x.rms, y.rms) << i + 1 << " threads";
+            EXPECT_EQ(x.p50, y.p50) << i + 1 << " threads";
+            EXPECT_EQ(x.p99, y.p99) << i + 1 << " threads";
+        }
     }
     const PointCloud samples = sample_surface(bunny, {.count = 3000});
-    set_thread_count(1);
-    const auto d1 = distances_to_mesh(samples, sphere);
-    set_thread_count(3);
-    const auto d3 = distances_to_mesh(samples, sphere);
-    set_thread_count(0);
-    EXPECT_TRUE(d1 == d3);
+    const auto distances =
+        test::at_thread_counts([&] { return distances_to_mesh(samples, sphere); });
+    EXPECT_TRUE(distances[0] == distances[1]);
+    EXPECT_TRUE(distances[0] == distances[2]);
 }
 
 /// The rectangle [0, 1] × [0, height] in the plane z = 0, two triangles.

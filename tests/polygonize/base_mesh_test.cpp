@@ -16,6 +16,7 @@
 #include "pointform/spatial/kd_tree.h"
 
 #include "support/test_support.h"
+#include "support/thread_counts.h"
 
 #include <gtest/gtest.h>
 
@@ -327,15 +328,16 @@ TEST(BaseMesh, VerticesWhereTheFieldIsUndefinedStayAndAreCounted)
 
 TEST(BaseMesh, SameMeshWhateverTheThreadCount)
 {
-    const Scene scene = sampled(Shape::Sphere, 3000, sphere_area);
-    const int saved = thread_count();
-    set_thread_count(1);
-    const TriMesh one = build_base_mesh(scene.mc, *scene.field, {.target_faces = 200}).mesh;
-    set_thread_count(2);
-    const TriMesh two = build_base_mesh(scene.mc, *scene.field, {.target_faces = 200}).mesh;
-    set_thread_count(saved);
-    EXPECT_EQ(one.triangles, two.triangles);
-    EXPECT_EQ(one.vertices.positions, two.vertices.positions);
+    // Enough base vertices for several blocks of the shape rounds' relaxation (256 a block).
+    const Scene scene = sampled(Shape::Sphere, 12000, sphere_area);
+    const auto runs = test::at_thread_counts(
+        [&] { return build_base_mesh(scene.mc, *scene.field, {.target_faces = 3000}).mesh; });
+    ASSERT_GT(runs[0].vertex_count(), 4 * 256U);
+    for (std::size_t i = 1; i < runs.size(); ++i)
+    {
+        EXPECT_EQ(runs[0].triangles, runs[i].triangles) << i + 1 << " threads";
+        EXPECT_EQ(runs[0].vertices.positions, runs[i].vertices.positions) << i + 1 << " threads";
+    }
 }
 
 TEST(BaseMesh, RejectsBadTargetsAndMeshes)

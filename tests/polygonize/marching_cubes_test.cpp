@@ -15,6 +15,7 @@
 #include "pointform/spatial/kd_tree.h"
 
 #include "support/self_intersection.h"
+#include "support/thread_counts.h"
 
 #include <gtest/gtest.h>
 
@@ -334,14 +335,13 @@ TEST(MarchingCubes, SameMeshWhateverTheThreadCount)
     const PointField field(
         compute_surfels(samples, {.radius_scale = default_field_radius_scale}).surfels);
     const CellGrid grid = grid_over(field.bounds(), default_cell_size(field));
-    const int saved = thread_count();
-    set_thread_count(1);
-    const TriMesh one = marching_cubes(field, grid).mesh;
-    set_thread_count(2);
-    const TriMesh two = marching_cubes(field, grid).mesh;
-    set_thread_count(saved);
-    ASSERT_EQ(one.triangles, two.triangles);
-    ASSERT_EQ(one.vertices.positions, two.vertices.positions);
+    const auto runs = test::at_thread_counts([&] { return marching_cubes(field, grid).mesh; });
+    const TriMesh& one = runs[0];
+    for (std::size_t i = 1; i < runs.size(); ++i)
+    {
+        ASSERT_EQ(one.triangles, runs[i].triangles) << i + 1 << " threads";
+        ASSERT_EQ(one.vertices.positions, runs[i].vertices.positions) << i + 1 << " threads";
+    }
     EXPECT_EQ(analyze_topology(one).euler_characteristic, 0);
 }
 

@@ -14,6 +14,7 @@
 #include "pointform/spatial/kd_tree.h"
 
 #include "support/test_meshes.h"
+#include "support/thread_counts.h"
 
 #include <gtest/gtest.h>
 
@@ -611,17 +612,19 @@ TEST(Refine, SameResultWhateverTheThreadCount)
 {
     const PointCloud samples = sampled_sphere(4000);
     const PointField field(samples);
-    std::vector<std::vector<Vec3d>> results;
-    for (const int threads : {1, 3})
-    {
-        set_thread_count(threads);
-        MultiresMesh mesh(octahedron());
-        for (int level = 0; level < 3; ++level)
-            refine_once(mesh, field, {.predictor = Predictor::Butterfly, .relax_iterations = 2});
-        results.emplace_back(mesh.positions().begin(), mesh.positions().end());
-    }
-    set_thread_count(0);
+    // Five levels from the octahedron: the last ones split their 512 and 2048 faces' edges into
+    // several blocks of new vertices (512 a block) and of faces (1024 a block).
+    const auto results = test::at_thread_counts(
+        [&] {
+            MultiresMesh mesh(octahedron());
+            for (int level = 0; level < 5; ++level)
+                refine_once(mesh, field,
+                            {.predictor = Predictor::Butterfly, .relax_iterations = 2});
+            return std::vector<Vec3d>(mesh.positions().begin(), mesh.positions().end());
+        },
+        {.min_multi_block_loops = 4});
     EXPECT_TRUE(results[0] == results[1]);
+    EXPECT_TRUE(results[0] == results[2]);
 }
 
 TEST(Refine, RejectsBadInput)

@@ -12,6 +12,7 @@
 
 #include "support/test_meshes.h"
 #include "support/test_support.h"
+#include "support/thread_counts.h"
 
 #include <gtest/gtest.h>
 
@@ -287,12 +288,9 @@ TEST(RenderMesh, SameImageWhateverTheThreadCount)
 {
     const TriMesh mesh = test::icosphere(4, Vec3d::Zero(), 1.0);
     RenderOptions options{.width = 200, .height = 150, .wireframe = true};
-    set_thread_count(1);
-    const Image one = render_mesh(mesh, options);
-    set_thread_count(3);
-    const Image three = render_mesh(mesh, options);
-    set_thread_count(0);
-    EXPECT_EQ(one.rgb, three.rgb);
+    const auto runs = test::at_thread_counts([&] { return render_mesh(mesh, options); });
+    EXPECT_EQ(runs[0].rgb, runs[1].rgb);
+    EXPECT_EQ(runs[0].rgb, runs[2].rgb);
 }
 
 TEST(RenderMesh, RejectsBadInput)
@@ -436,12 +434,9 @@ TEST(RenderPoints, SameImageWhateverTheThreadCount)
 {
     PointCloud cloud = sample_shape(Shape::Torus, {.count = 8000});
     const RenderOptions options{.width = 200, .height = 150};
-    set_thread_count(1);
-    const Image one = render_points(cloud, options);
-    set_thread_count(3);
-    const Image three = render_points(cloud, options);
-    set_thread_count(0);
-    EXPECT_EQ(one.rgb, three.rgb);
+    const auto runs = test::at_thread_counts([&] { return render_points(cloud, options); });
+    EXPECT_EQ(runs[0].rgb, runs[1].rgb);
+    EXPECT_EQ(runs[0].rgb, runs[2].rgb);
 }
 
 TEST(RenderPoints, RejectsBadInput)

@@ -7,6 +7,8 @@
 #include "pointform/core/parallel.h"
 #include "pointform/geometry/shapes.h"
 
+#include "support/thread_counts.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -135,13 +137,12 @@ TEST(KdTree, ResultsIndependentOfThreadCount)
 {
     const PointCloud cloud = sample_shape(Shape::Torus, {.count = 20000, .seed = 5});
     const KdTree tree(cloud.positions);
-    set_thread_count(1);
-    const KnnTable one = knn_batch(tree, cloud.positions, 10);
-    set_thread_count(2);
-    const KnnTable two = knn_batch(tree, cloud.positions, 10);
-    set_thread_count(0);
-    EXPECT_EQ(one.indices, two.indices);
-    EXPECT_EQ(one.squared_distances, two.squared_distances);
+    const auto runs = test::at_thread_counts([&] { return knn_batch(tree, cloud.positions, 10); });
+    for (std::size_t i = 1; i < runs.size(); ++i)
+    {
+        EXPECT_EQ(runs[0].indices, runs[i].indices) << i + 1 << " threads";
+        EXPECT_EQ(runs[0].squared_distances, runs[i].squared_distances) << i + 1 << " threads";
+    }
 }
 
 TEST(KdTree, DuplicatePointsAreOrderedByIndex)

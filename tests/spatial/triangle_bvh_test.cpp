@@ -9,6 +9,8 @@
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 
+#include "support/thread_counts.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -278,17 +280,18 @@ TEST(TriangleBvh, BatchMatchesSingleWhateverTheThreadCount)
 {
     const TriMesh mesh = random_mesh(300, 600, 31);
     const TriangleBvh bvh(mesh);
-    const auto queries = random_queries(2000, 1.5, 32);
-    set_thread_count(1);
-    const auto one = closest_points(bvh, queries);
-    set_thread_count(3);
-    const auto three = closest_points(bvh, queries);
-    set_thread_count(0);
+    const auto queries = random_queries(20000, 1.5, 32); // several blocks of queries
+    const auto runs = test::at_thread_counts([&] { return closest_points(bvh, queries); });
+    const auto& one = runs[0];
     ASSERT_EQ(one.size(), queries.size());
     for (std::size_t i = 0; i < queries.size(); ++i)
     {
-        EXPECT_EQ(one[i].distance, three[i].distance);
-        EXPECT_EQ(one[i].face, three[i].face);
+        for (std::size_t r = 1; r < runs.size(); ++r)
+        {
+            ASSERT_EQ(one[i].distance, runs[r][i].distance) << r + 1 << " threads";
+            ASSERT_EQ(one[i].face, runs[r][i].face) << r + 1 << " threads";
+            ASSERT_EQ(one[i].point, runs[r][i].point) << r + 1 << " threads";
+        }
         EXPECT_EQ(one[i].distance, bvh.closest(queries[i]).distance);
     }
     PointCloud cloud;

@@ -3,6 +3,7 @@
 
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -85,4 +86,29 @@ public:
 
 namespace pointform::detail {
 [[noreturn]] void assert_fail(const char* expr, const char* file, int line);
+[[noreturn]] void throw_buffer_size(const char* function, const char* buffer, std::size_t size,
+                                    std::size_t needed, bool exact);
 } // namespace pointform::detail
+
+namespace pointform {
+
+/// \brief Checks, in every build, that a caller's buffer holds at least `needed` items, so that
+/// a public function cannot read or write past it: once per call, not per item.
+/// \throw InvalidInput naming the function, the buffer, its size and the size needed
+inline void check_buffer_size(const char* function, const char* buffer, std::size_t size,
+                              std::size_t needed)
+{
+    if (size < needed) [[unlikely]]
+        detail::throw_buffer_size(function, buffer, size, needed, false);
+}
+
+/// \brief check_buffer_size() for a buffer that must hold exactly `expected` items (say, one
+/// per query point).
+inline void check_same_size(const char* function, const char* buffer, std::size_t size,
+                            std::size_t expected)
+{
+    if (size != expected) [[unlikely]]
+        detail::throw_buffer_size(function, buffer, size, expected, true);
+}
+
+} // namespace pointform

@@ -37,6 +37,7 @@ struct PlaneFit
 /// double precision. Allocates nothing.
 /// \param positions  N points
 /// \param indices    the subset to fit, each < N; at least one
+/// \throw InvalidInput if `indices` is empty or one is out of range
 [[nodiscard]] PlaneFit fit_plane(std::span<const Vec3f> positions,
                                  std::span<const std::uint32_t> indices);
 
@@ -62,7 +63,7 @@ struct Normals
 /// \brief Estimates a normal for every point by PCA over the given neighbourhoods, in parallel.
 /// \param positions  N points
 /// \param neighbors  an N by k table (e.g. knn_batch of the points against themselves)
-/// \throw InvalidInput if the table does not have N rows
+/// \throw InvalidInput if the table does not have N rows or is malformed (check_knn_table())
 [[nodiscard]] Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
                                        const ProgressCallback& progress = {});
 

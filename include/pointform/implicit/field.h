@@ -47,6 +47,7 @@ public:
     /// \brief Value and gradient at many points, in parallel; `out.size()` must equal
     /// `points.size()`. The result is the same as calling evaluate() per point, whatever the
     /// thread count. By default the batch evaluate_within() over (−∞, ∞).
+    /// \throw InvalidInput if the sizes differ (every implementation checks)
     virtual void evaluate(std::span<const Vec3d> points, std::span<FieldSample> out) const;
 
     /// \brief evaluate(p) where its value lies in [lo, hi]; elsewhere only the side is kept: a
@@ -61,6 +62,7 @@ public:
 
     /// \brief evaluate_within() at many points, point i within [lo[i], hi[i]], in parallel (the
     /// same results as one by one, whatever the thread count). All spans have the same size.
+    /// \throw InvalidInput if they do not (every implementation checks: check_within_sizes())
     virtual void evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
                                  std::span<const double> hi, std::span<FieldSample> out) const;
 
@@ -78,5 +80,11 @@ public:
     /// appends nothing and is polygonized densely over bounds().
     virtual void append_seeds(std::vector<Vec3d>& seeds) const;
 };
+
+/// \brief For the batch Field::evaluate_within() and its overrides: throws InvalidInput, naming
+/// `function`, unless `lo`, `hi` and `out` hold one entry per point. Every implementation checks
+/// once per call, in every build, so no caller's span is read or written past its end.
+void check_within_sizes(const char* function, std::size_t points, std::size_t lo, std::size_t hi,
+                        std::size_t out);
 
 } // namespace pointform

@@ -52,8 +52,10 @@ public:
     [[nodiscard]] std::span<const Vec3f> positions() const;
 
     /// \brief The k nearest points to `query` (a point of the tree is its own nearest).
-    /// \param indices, squared_distances  caller buffers of size >= k, filled nearest first
+    /// \param indices, squared_distances  caller buffers of size >= min(k, size()), filled
+    ///        nearest first
     /// \return the number found, min(k, size())
+    /// \throw InvalidInput if a buffer is shorter
     std::size_t knn(const Vec3f& query, std::size_t k, std::span<std::uint32_t> indices,
                     std::span<float> squared_distances) const;
 
@@ -70,6 +72,7 @@ public:
     /// so it skips every subtree farther than that from the start, and returns `start` itself
     /// when no point is nearer than its distance over `factor`. Same guarantee: the point
     /// returned is at most `factor` times as far as the nearest.
+    /// \throw InvalidInput if `start` is not a point of the tree
     [[nodiscard]] PointId nearest_within_factor(const Vec3f& query, float factor, PointId start,
                                                 float* squared_distance = nullptr) const;
 

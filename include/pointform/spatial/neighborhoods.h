@@ -31,6 +31,17 @@ struct KnnTable
     }
 };
 
+/// \brief Checks a neighbour table handed to a public function (it may have been built by hand):
+/// `rows` rows of k > 0 columns (unless rows = 0), as many squared distances as indices, every
+/// index below `points`. Linear in the table, so it costs little next to any use of it.
+/// \throw InvalidInput naming `function` and what is wrong
+void check_knn_table(const KnnTable& table, std::size_t rows, std::size_t points,
+                     const char* function);
+
+/// \brief check_knn_table() without the pass over the indices, for a caller that checks each
+/// row's indices as it reads them (one memory pass instead of two).
+void check_knn_table_shape(const KnnTable& table, std::size_t rows, const char* function);
+
 /// \brief Variable-size neighbourhoods in compressed sparse row form: the neighbours of query i
 /// are indices[offsets[i] .. offsets[i+1]), nearest first.
 struct RadiusTable

@@ -37,8 +37,9 @@ public:
 
     /// \brief The k nearest points to `query`, nearest first, as slots (positions in grid
     /// order; original_index() maps them back).
-    /// \param slots, squared_distances  caller buffers of size >= k
+    /// \param slots, squared_distances  caller buffers of size >= min(k, point count)
     /// \return how many were found: min(k, point count)
+    /// \throw InvalidInput if a buffer is shorter
     std::size_t knn(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
                     std::span<float> squared_distances) const;
 
@@ -58,6 +59,8 @@ public:
     /// distance plus about the previous query's spread to its k-th (widened while fewer than k
     /// are there) instead of all those within the reach. Uses AVX2 where the CPU has it.
     /// \param slots, squared_distances  caller buffers of size >= k · queries.size()
+    /// \param found  a caller buffer of size >= queries.size()
+    /// \throw InvalidInput if a buffer is shorter
     void knn_nearby(std::span<const Vec3f> queries, std::size_t k, std::span<std::uint32_t> slots,
                     std::span<float> squared_distances, std::span<std::uint32_t> found) const;
 
