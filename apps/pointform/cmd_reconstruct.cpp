@@ -6,6 +6,7 @@
 #include "pointform/geometry/mesh_topology.h"
 #include "pointform/implicit/point_field.h"
 #include "pointform/polygonize/base_mesh.h"
+#include "pointform/polygonize/components.h"
 #include "pointform/polygonize/marching_cubes.h"
 
 #include "common.h"
@@ -29,6 +30,7 @@ struct ReconstructOptions
     int resolution = 0;
     double cell = 0.0;
     std::string fit = "quadric";
+    std::optional<long long> min_component_samples;
     SurfelInputOptions surfels;
     SemiRegularOptions refine;
 };
@@ -50,6 +52,7 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
     std::optional<PickedBaseMesh> picked;
     double cell = 0.0;
     std::size_t intermediate_faces = 0;
+    ComponentFilterReport debris;
     std::size_t intermediate_vertices = 0;
     std::size_t degenerate_triangles = 0;
     std::size_t degenerate_kept = 0;
@@ -84,6 +87,11 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
         intermediate_vertices = mc.mesh.vertex_count();
         degenerate_triangles = mc.stats.degenerate_triangles;
         degenerate_kept = mc.stats.degenerate_kept;
+        debris = remove_unsupported_components(
+            mc.mesh, field.surfels(),
+            options.min_component_samples ? static_cast<std::size_t>(*options.min_component_samples)
+                                          : default_min_component_samples(field.surfels().size()));
+        timings.lap("debris");
         const std::size_t target =
             base_face_target(options.refine, mc.mesh, default_base_share, input.surfels.size());
         if (options.refine.levels)
@@ -113,6 +121,10 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
             out["intermediate_vertices"] = intermediate_vertices;
             out["degenerate_triangles"] = degenerate_triangles;
             out["degenerate_kept"] = degenerate_kept;
+            out["debris"] = {{"components", debris.components},
+                             {"removed_components", debris.removed_components},
+                             {"removed_faces", debris.removed_faces},
+                             {"min_samples", debris.min_samples}};
             out["base_mesh"] = base_mesh_json(*base_stats);
             out["base_mesh"]["source"] = "automatic";
         }
@@ -149,6 +161,10 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
                   std::to_string(intermediate_faces) + " faces (marching cubes, cell " +
                       format_number(cell) + ", " + options.fit + " field; degenerate " +
                       describe_degenerate(degenerate_triangles, degenerate_kept) + ")");
+        print_row("debris", "removed " + std::to_string(debris.removed_components) + " of " +
+                                std::to_string(debris.components) + " components (" +
+                                std::to_string(debris.removed_faces) + " faces) that fewer than " +
+                                std::to_string(debris.min_samples) + " samples are nearest to");
         print_base_mesh(*base_stats);
     }
     else
@@ -198,6 +214,11 @@ void register_reconstruct(CLI::App& app, const GlobalOptions& global)
                     "influence radius)")
         ->check(CLI::PositiveNumber)
         ->excludes(resolution);
+    cmd->add_option("--min-component-samples", options->min_component_samples,
+                    "Remove the marching-cubes components that fewer than N samples are nearest "
+                    "to (debris of stray samples or flipped normals) before the base mesh; "
+                    "default: 0.1% of the samples, at least 32; 0 keeps every component")
+        ->check(CLI::NonNegativeNumber);
     cmd->add_option("--fit", options->fit,
                     "Local surfaces of the field: quadric, blend, centroid or raw (see `pointform "
                     "mc`)")

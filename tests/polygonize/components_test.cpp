@@ -1,0 +1,95 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/polygonize/components.h"
+
+#include "pointform/geometry/mesh_topology.h"
+#include "pointform/geometry/shapes.h"
+#include "pointform/hermite/surfels.h"
+#include "pointform/implicit/point_field.h"
+#include "pointform/polygonize/marching_cubes.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace pointform {
+namespace {
+
+/// 20k samples of the unit sphere plus six clusters of 10 to 30 stray points 2 to 2.5 from its
+/// centre (clear of the sphere's field): raw points, as a scanner's stray returns come.
+PointCloud sphere_with_stray_clusters()
+{
+    PointCloud cloud = sample_shape(Shape::Sphere, {.count = 20000, .seed = 2});
+    cloud.normals.clear();
+    std::mt19937_64 rng(7);
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    std::uniform_real_distribution<double> uni(0.0, 1.0);
+    for (int c = 0; c < 6; ++c)
+    {
+        Vec3d d(gauss(rng), gauss(rng), gauss(rng));
+        const Vec3d centre = d.normalized() * (2.0 + 0.5 * uni(rng));
+        for (int i = 0; i < 10 + 4 * c; ++i)
+            cloud.positions.emplace_back(
+                (centre + 0.04 * Vec3d(gauss(rng), gauss(rng), gauss(rng))).cast<float>());
+    }
+    return cloud;
+}
+
+TEST(Components, StrayClustersLeaveDebrisThatIsRemoved)
+{
+    const PointCloud raw = sphere_with_stray_clusters();
+    const PointField field(compute_surfels(raw, {.radius_scale = 1.5}).surfels);
+    TriMesh mesh = marching_cubes(field, grid_over(field.bounds(), default_cell_size(field))).mesh;
+    const MeshTopology before = analyze_topology(mesh);
+    ASSERT_GT(before.components, 1U) << "the strays make no debris: the test tests nothing";
+    const ComponentFilterReport report = remove_unsupported_components(
+        mesh, field.surfels(), default_min_component_samples(raw.size()));
+    EXPECT_EQ(report.components, before.components);
+    EXPECT_EQ(report.min_samples, 32U);
+    EXPECT_GT(report.removed_components, 0U);
+    EXPECT_GT(report.removed_faces, 0U);
+    // Left: the sphere alone, closed.
+    const MeshTopology after = analyze_topology(mesh);
+    EXPECT_EQ(after.components, 1U);
+    EXPECT_EQ(report.removed_components, before.components - 1);
+    EXPECT_TRUE(after.is_closed());
+    EXPECT_EQ(after.euler_characteristic, 2);
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+        ASSERT_NEAR(mesh.vertices.world(v).norm(), 1.0, 0.02);
+    for (const Triangle& t : mesh.triangles)
+        for (const std::uint32_t v : t)
+            ASSERT_LT(v, mesh.vertex_count());
+    for (const Triangle& t : mesh.triangles)
+        for (const std::uint32_t v : t)
+            ASSERT_LT(v, mesh.vertex_count());
+}
+
+TEST(Components, SupportedComponentsStay)
+{
+    // Two spheres, each with half the samples: both stay, and nothing changes.
+    const PointCloud samples = sample_shape(Shape::TwoSpheres, {.count = 20000, .seed = 3});
+    const PointField field(compute_surfels(samples, {.radius_scale = 1.5}).surfels);
+    TriMesh mesh = marching_cubes(field, grid_over(field.bounds(), default_cell_size(field))).mesh;
+    const TriMesh copy = mesh;
+    const ComponentFilterReport report =
+        remove_unsupported_components(mesh, field.surfels(), default_min_component_samples(20000));
+    EXPECT_EQ(report.components, 2U);
+    EXPECT_EQ(report.removed_components, 0U);
+    EXPECT_EQ(mesh.triangles, copy.triangles);
+    EXPECT_EQ(mesh.vertices.positions, copy.vertices.positions);
+    // A support above every component's keeps the best supported one only.
+    const ComponentFilterReport all = remove_unsupported_components(mesh, field.surfels(), 1000000);
+    EXPECT_EQ(all.removed_components, 1U);
+    EXPECT_EQ(analyze_topology(mesh).components, 1U);
+    // 0 keeps everything.
+    TriMesh again = copy;
+    EXPECT_EQ(remove_unsupported_components(again, field.surfels(), 0).removed_components, 0U);
+    EXPECT_EQ(again.triangles, copy.triangles);
+    EXPECT_EQ(default_min_component_samples(1000), 32U);
+    EXPECT_EQ(default_min_component_samples(1000000), 1000U);
+}
+
+} // namespace
+} // namespace pointform
