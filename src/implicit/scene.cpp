@@ -1317,9 +1317,8 @@ private:
         const Arguments arguments = bind_arguments(*function, node);
         if (function->name == "scan")
         {
-            return {.type = Type::Field,
-                    .field = scan(node, arguments.get("path").string),
-                    .depth = 1};
+            return {
+                .type = Type::Field, .field = scan(node, arguments.get("path").string), .depth = 1};
         }
         Value value{.type = Type::Field, .depth = arguments.depth + 1};
         if (value.depth > max_nesting)
