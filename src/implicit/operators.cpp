@@ -1182,9 +1182,8 @@ void SharedField::evaluate_within(std::span<const Vec3d> points, std::span<const
     else
     {
         member_->evaluate_within(points, lo, hi, out);
-        // The member may have asked this field's own members (not this field) meanwhile; the
-        // reference is still valid: unordered_map keeps its elements where they are unless
-        // cleared, and only another SharedField's first batch clears it.
+        // Looked up again: the member's evaluation may have remembered other shared fields
+        // meanwhile, and forgotten them all (this one too) if there were too many.
         Remembered& fresh = remembered()[id_];
         fresh.points.assign(points.begin(), points.end());
         fresh.lo.assign(lo.begin(), lo.end());
