@@ -16,6 +16,7 @@
 #include <string>
 #include <tuple>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -1104,13 +1105,40 @@ struct Remembered
     std::vector<FieldSample> samples;
 };
 
-/// The batches remembered by this thread, by SharedField id. Forgotten all at once when it holds
-/// more than this many (ids of fields that no longer exist are never asked again).
-constexpr std::size_t remembered_fields = 4096;
+/// The SharedFields that exist, and how many have ceased to: a thread drops what it remembers of
+/// the dead ones when it holds more than `purge_above` batches and some have died since it last
+/// looked, so threads that outlive scenes do not keep their batches.
+struct Registry
+{
+    std::mutex mutex;
+    std::unordered_set<std::uint64_t> live;
+    std::atomic<std::uint64_t> deaths{0};
+};
 
+Registry& registry()
+{
+    static Registry r;
+    return r;
+}
+
+constexpr std::size_t purge_above = 64;
+
+/// The batches remembered by this thread, by SharedField id.
 std::unordered_map<std::uint64_t, Remembered>& remembered()
 {
     thread_local std::unordered_map<std::uint64_t, Remembered> map;
+    thread_local std::uint64_t deaths_seen = 0;
+    if (map.size() > purge_above)
+    {
+        Registry& r = registry();
+        const std::uint64_t deaths = r.deaths.load(std::memory_order_acquire);
+        if (deaths != deaths_seen)
+        {
+            const std::lock_guard lock(r.mutex);
+            std::erase_if(map, [&r](const auto& entry) { return !r.live.contains(entry.first); });
+            deaths_seen = deaths;
+        }
+    }
     return map;
 }
 
@@ -1126,8 +1154,20 @@ std::atomic<std::uint64_t> next_shared_id{1};
 SharedField::SharedField(FieldPtr member) : member_(std::move(member)), id_(next_shared_id++)
 {
     require_member(member_, "shared field");
+    {
+        const std::lock_guard lock(registry().mutex);
+        registry().live.insert(id_);
+    }
     cost_ = member_->cost();
     bounds_ = member_->bounds();
+}
+
+SharedField::~SharedField()
+{
+    Registry& r = registry();
+    const std::lock_guard lock(r.mutex);
+    r.live.erase(id_);
+    r.deaths.fetch_add(1, std::memory_order_release);
 }
 
 FieldSample SharedField::evaluate(const Vec3d& p) const
@@ -1153,12 +1193,7 @@ void SharedField::evaluate_within(std::span<const Vec3d> points, std::span<const
         member_->evaluate_within(points, lo, hi, out);
         return;
     }
-    auto& map = remembered();
-    if (map.size() > remembered_fields && map.find(id_) == map.end())
-    {
-        map.clear();
-    }
-    Remembered& r = map[id_];
+    Remembered& r = remembered()[id_];
     std::vector<std::size_t> missing;
     if (r.points.size() == n &&
         std::equal(points.begin(), points.end(), r.points.begin(), same_point))
@@ -1183,7 +1218,7 @@ void SharedField::evaluate_within(std::span<const Vec3d> points, std::span<const
     {
         member_->evaluate_within(points, lo, hi, out);
         // Looked up again: the member's evaluation may have remembered other shared fields
-        // meanwhile, and forgotten them all (this one too) if there were too many.
+        // meanwhile (the map keeps its elements in place, but may drop dead fields' ones).
         Remembered& fresh = remembered()[id_];
         fresh.points.assign(points.begin(), points.end());
         fresh.lo.assign(lo.begin(), lo.end());

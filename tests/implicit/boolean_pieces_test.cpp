@@ -5,9 +5,11 @@
 // from the operators' seeds gives meshes whose area, volume and component count match the
 // analytic shapes, including pieces that hold no seed of any member.
 
+#include "pointform/core/parallel.h"
 #include "pointform/geometry/mesh_topology.h"
 #include "pointform/implicit/operators.h"
 #include "pointform/implicit/primitives.h"
+#include "pointform/implicit/scene.h"
 #include "pointform/implicit/transform.h"
 #include "pointform/polygonize/marching_cubes.h"
 
@@ -254,6 +256,36 @@ TEST(BooleanPieces, OtherOperatorsKeepEveryPiece)
         EXPECT_EQ(m.components, c.components);
         EXPECT_GT(m.volume, 0.0);
     }
+}
+
+TEST(BooleanPieces, SharedBindingsGiveTheSameMeshWhateverTheThreadCount)
+{
+    // Bindings named several times are shared nodes that remember batches per thread: the mesh
+    // is the same bytes with one thread and with several.
+    const Scene scene = parse_scene(
+        "let a = sphere([0, 0, 0], 1)\n"
+        "let b = box([0.3, 0.3, 0.3], [2, 2, 2])\n"
+        "let c = intersection(a, b)\n"
+        "let d = union(c, translate(c, [-0.9, 0, 0]), c)\n"
+        "difference(d, sphere([0.45, 0.45, 0.45], 0.1), translate(d, [0, 0, 1.5]))");
+    const CellGrid grid = grid_over(scene.field->bounds(), 1.0 / 64.0);
+    const int threads = thread_count();
+    set_thread_count(1);
+    const MarchingCubesResult one = marching_cubes(*scene.field, grid);
+    set_thread_count(std::max(threads, 4));
+    const MarchingCubesResult many = marching_cubes(*scene.field, grid);
+    set_thread_count(0);
+    ASSERT_FALSE(one.mesh.triangles.empty());
+    ASSERT_EQ(one.mesh.vertex_count(), many.mesh.vertex_count());
+    ASSERT_EQ(one.mesh.triangles, many.mesh.triangles);
+    for (std::size_t v = 0; v < one.mesh.vertex_count(); ++v)
+    {
+        ASSERT_EQ(one.mesh.vertices.world(v), many.mesh.vertices.world(v));
+    }
+    // Two corners of the ball, one with a cavity: three surfaces.
+    const Measured m = measure(*scene.field, 1.0 / 64.0);
+    EXPECT_EQ(m.components, 3U);
+    EXPECT_TRUE(m.closed);
 }
 
 TEST(BooleanPieces, SeedsLieOnTheResult)

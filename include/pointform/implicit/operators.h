@@ -309,7 +309,8 @@ private:
 /// (`let a1 = union(a0, a0)`, `let a2 = union(a1, a1)`, …).
 ///
 /// Each thread remembers, per shared field, the last batch of up to 1024 points asked of it
-/// (operators ask their members in such blocks), with the range each point was asked within; a
+/// (operators ask their members in such blocks; what it remembers of a field goes when the field
+/// does), with the range each point was asked within; a
 /// request for the same points within ranges that those contain is answered from it, the rest
 /// from the member. Every answer is one the member gave for a range that contains the one asked,
 /// so it keeps Field::evaluate_within's contract, and exact values are the member's exactly.
@@ -317,6 +318,7 @@ class SharedField final : public Field
 {
 public:
     explicit SharedField(std::shared_ptr<const Field> member);
+    ~SharedField() override;
 
     [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override;
     using Field::evaluate;
