@@ -1,15 +1,37 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# Builds the libFuzzer harnesses (Clang, ASan + UBSan) and fuzzes every reader for SECONDS
-# (default 60), seeded with the small files in data/. Fails on any crash or sanitizer report.
+# Builds the libFuzzer harnesses (Clang, ASan + UBSan) and fuzzes for SECONDS in all (default
+# 60): every reader (half the time, seeded with the small files in data/), the hierarchy reader
+# and the scene language (a quarter each, seeded from tests/fuzz/seeds/). Fails on any crash,
+# hang or sanitizer report.
 #   bash scripts/fuzz.sh [SECONDS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-60}"
+readers_seconds=$(( (seconds + 1) / 2 ))
+other_seconds=$(( (seconds - readers_seconds + 1) / 2 ))
+other_seconds=$(( other_seconds > 0 ? other_seconds : 1 ))
 
 bash scripts/setup.sh --fuzz
 cmake --preset fuzz
-cmake --build --preset fuzz --target read_fuzz
+cmake --build --preset fuzz --target read_fuzz hierarchy_fuzz scene_fuzz
+harnesses=build/fuzz/tests/fuzz
+common=(-timeout=10 -rss_limit_mb=4096 -print_final_stats=1 -artifact_prefix=build/fuzz/)
+# regressions HARNESS PREFIX: runs the inputs in tests/fuzz/regressions/ that once found a bug in
+# that harness (named PREFIX-...; the readers' are the rest).
+regressions() {
+  local files=()
+  if [[ "$2" == readers ]]; then
+    mapfile -d '' files < <(find tests/fuzz/regressions -maxdepth 1 -type f \
+      ! -name 'hierarchy-*' ! -name 'scene-*' -print0 | sort -z)
+  else
+    mapfile -d '' files < <(find tests/fuzz/regressions -maxdepth 1 -type f -name "$2-*" -print0 |
+      sort -z)
+  fi
+  if (( ${#files[@]} > 0 )); then
+    "$harnesses/$1" "${files[@]}"
+  fi
+}
 
 corpus=build/fuzz/corpus
 mkdir -p "$corpus"
@@ -21,7 +43,21 @@ for ext in ply xyz pts csv off obj pcd las; do
   done < <(find data -name "*.$ext" -size -64k -print0)
   index=$((index + 1))
 done
-# Inputs that once found a bug run first, then the fuzzer explores from the seeds.
-./build/fuzz/tests/fuzz/read_fuzz tests/fuzz/regressions/*
-./build/fuzz/tests/fuzz/read_fuzz -max_total_time="$seconds" -max_len=65536 -timeout=10 \
-  -rss_limit_mb=4096 -print_final_stats=1 -artifact_prefix=build/fuzz/ "$corpus"
+# Inputs that once found a bug run first (each harness takes those of its kind), then the fuzzers
+# explore from the seeds.
+regressions read_fuzz readers
+"$harnesses/read_fuzz" -max_total_time="$readers_seconds" -max_len=65536 "${common[@]}" "$corpus"
+
+hierarchy_corpus=build/fuzz/corpus-hierarchy
+mkdir -p "$hierarchy_corpus"
+cp tests/fuzz/seeds/hierarchy/* "$hierarchy_corpus"/
+regressions hierarchy_fuzz hierarchy
+"$harnesses/hierarchy_fuzz" -max_total_time="$other_seconds" -max_len=65536 "${common[@]}" \
+  "$hierarchy_corpus"
+
+scene_corpus=build/fuzz/corpus-scene
+mkdir -p "$scene_corpus"
+cp tests/fuzz/seeds/scene/* "$scene_corpus"/
+regressions scene_fuzz scene
+"$harnesses/scene_fuzz" -max_total_time="$other_seconds" -max_len=16384 \
+  -dict=tests/fuzz/scene.dict "${common[@]}" "$scene_corpus"

@@ -8,11 +8,15 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numeric>
 #include <string>
 #include <tuple>
+#include <unordered_map>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -26,13 +30,23 @@ constexpr double infinity = std::numeric_limits<double>::infinity();
 /// Points per block of an operator's batch evaluation: its members answer each block together.
 constexpr std::size_t operator_block = 1024;
 
-/// An operator's cost: its members' and its own.
+/// An operator's cost: its own and its distinct members' (a member given twice is asked once
+/// per point only if it is a SharedField, but counting it once keeps costs from doubling per
+/// level of a shared chain).
 double summed_cost(std::span<const FieldPtr> members)
 {
     double sum = 1.0;
-    for (const FieldPtr& m : members)
+    for (std::size_t i = 0; i < members.size(); ++i)
     {
-        sum += m->cost();
+        bool seen = false;
+        for (std::size_t j = 0; j < i && !seen; ++j)
+        {
+            seen = members[j] == members[i];
+        }
+        if (!seen)
+        {
+            sum += members[i]->cost();
+        }
     }
     return sum;
 }
@@ -208,6 +222,208 @@ void project_seeds(const Field& field, std::vector<Vec3d>& seeds, std::size_t fi
     }
 }
 
+/// Candidate seeds of an operator: points near its members' surfaces, each with the member's
+/// |value| there (how near zero the member itself is at its seed).
+struct Candidates
+{
+    std::vector<Vec3d> points;
+    std::vector<double> slack;
+    bool complete = true; ///< false if a member knows no seeds: then neither does the operator
+};
+
+/// Adds `member`'s seeds to the candidates (a member that appears twice: once).
+void gather(const FieldPtr& member, Candidates& c, std::vector<const Field*>& seen)
+{
+    if (std::find(seen.begin(), seen.end(), member.get()) != seen.end())
+    {
+        return;
+    }
+    seen.push_back(member.get());
+    const std::size_t first = c.points.size();
+    member->append_seeds(c.points);
+    if (c.points.size() == first)
+    {
+        c.complete = false;
+        return;
+    }
+    std::vector<FieldSample> samples(c.points.size() - first);
+    member->evaluate(std::span<const Vec3d>(c.points).subspan(first), samples);
+    for (const FieldSample& s : samples)
+    {
+        c.slack.push_back(std::isfinite(s.value) ? std::abs(s.value) : 0.0);
+    }
+}
+
+Candidates gather_all(std::span<const FieldPtr> members)
+{
+    Candidates c;
+    std::vector<const Field*> seen;
+    for (const FieldPtr& m : members)
+    {
+        gather(m, c, seen);
+        if (!c.complete)
+        {
+            break;
+        }
+    }
+    return c;
+}
+
+/// Rounding and Newton's leftovers: what counts as zero near p for a field over `box`.
+double zero_tolerance(const Aabb& box, const Vec3d& p)
+{
+    const double diagonal = box.is_empty() ? 0.0 : box.diagonal();
+    const double size = std::isfinite(diagonal) ? diagonal : 0.0;
+    const double at = p.allFinite() ? p.cwiseAbs().maxCoeff() : 0.0;
+    return 1e-6 * size + 1e-9 * (1.0 + at);
+}
+
+/// Appends the candidates where `field` is as near zero as the member was there (or within the
+/// tolerance); returns how many.
+std::size_t keep_near_zero(const Field& field, std::span<const Vec3d> points,
+                           std::span<const double> slack, std::vector<Vec3d>& seeds)
+{
+    std::vector<FieldSample> samples(points.size());
+    field.evaluate(points, samples);
+    const Aabb box = field.bounds();
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < points.size(); ++i)
+    {
+        const double v = std::abs(samples[i].value);
+        if (points[i].allFinite() && v <= std::max(slack[i], zero_tolerance(box, points[i])))
+        {
+            seeds.push_back(points[i]);
+            ++kept;
+        }
+    }
+    return kept;
+}
+
+/// Seeds where a coarse sweep of the field's bounds finds its sign change between neighbouring
+/// nodes (both defined), moved onto the surface by Newton steps; none if the bounds are not
+/// finite.
+void sweep_seeds(const Field& field, std::vector<Vec3d>& seeds)
+{
+    const Aabb box = field.bounds();
+    if (box.is_empty() || !box.min.allFinite() || !box.max.allFinite())
+    {
+        return;
+    }
+    constexpr int cells = 32;
+    const double longest = (box.max - box.min).maxCoeff();
+    const double h = longest > 0.0 ? longest / cells : 1e-3 * (1.0 + box.max.cwiseAbs().maxCoeff());
+    if (!(h > 0.0) || !std::isfinite(h))
+    {
+        return;
+    }
+    // Half a cell of margin: a surface may touch the bounds (a sphere its box).
+    const Vec3d origin = box.min - Vec3d::Constant(0.5 * h);
+    std::array<std::size_t, 3> n{};
+    for (int a = 0; a < 3; ++a)
+    {
+        const double span = box.max[a] - box.min[a] + h;
+        n[static_cast<std::size_t>(a)] =
+            static_cast<std::size_t>(std::clamp(std::ceil(span / h), 1.0, double{cells + 1})) + 1;
+    }
+    const auto index = [&n](std::size_t i, std::size_t j, std::size_t k) {
+        return i + n[0] * (j + n[1] * k);
+    };
+    std::vector<Vec3d> nodes(n[0] * n[1] * n[2]);
+    for (std::size_t k = 0; k < n[2]; ++k)
+    {
+        for (std::size_t j = 0; j < n[1]; ++j)
+        {
+            for (std::size_t i = 0; i < n[0]; ++i)
+            {
+                nodes[index(i, j, k)] =
+                    origin + h * Vec3d(static_cast<double>(i), static_cast<double>(j),
+                                       static_cast<double>(k));
+            }
+        }
+    }
+    std::vector<FieldSample> samples(nodes.size());
+    field.evaluate(nodes, samples);
+    std::vector<Vec3d> found;
+    const auto edge = [&](std::size_t a, std::size_t b) {
+        const FieldSample& sa = samples[a];
+        const FieldSample& sb = samples[b];
+        if (!sa.defined || !sb.defined || !std::isfinite(sa.value) || !std::isfinite(sb.value) ||
+            (sa.value < 0.0) == (sb.value < 0.0))
+        {
+            return;
+        }
+        const double t = sa.value / (sa.value - sb.value);
+        found.push_back(nodes[a] + std::clamp(t, 0.0, 1.0) * (nodes[b] - nodes[a]));
+    };
+    for (std::size_t k = 0; k < n[2]; ++k)
+    {
+        for (std::size_t j = 0; j < n[1]; ++j)
+        {
+            for (std::size_t i = 0; i < n[0]; ++i)
+            {
+                const std::size_t at = index(i, j, k);
+                if (i + 1 < n[0])
+                {
+                    edge(at, index(i + 1, j, k));
+                }
+                if (j + 1 < n[1])
+                {
+                    edge(at, index(i, j + 1, k));
+                }
+                if (k + 1 < n[2])
+                {
+                    edge(at, index(i, j, k + 1));
+                }
+            }
+        }
+    }
+    if (found.empty())
+    {
+        return;
+    }
+    std::vector<Vec3d> moved = found;
+    project_seeds(field, moved, 0, 3);
+    std::vector<FieldSample> before(found.size());
+    std::vector<FieldSample> after(found.size());
+    field.evaluate(found, before);
+    field.evaluate(moved, after);
+    for (std::size_t i = 0; i < found.size(); ++i)
+    {
+        // Newton's point where it came nearer zero (and stayed within a cell), else the edge's.
+        const bool better = moved[i].allFinite() &&
+                            std::abs(after[i].value) < std::abs(before[i].value) &&
+                            (moved[i] - found[i]).norm() <= 2.0 * h;
+        seeds.push_back(better ? moved[i] : found[i]);
+    }
+}
+
+/// The seeds of an operator's result from its members' candidates (see operators.h): moved onto
+/// the result's surface first by `displaced` Newton steps (0 where the surface is a member's),
+/// kept where the result is near zero; else all moved by Newton steps and kept where they reach
+/// zero; else a sweep of the bounds.
+void operator_seeds(const Field& field, Candidates c, int displaced, std::vector<Vec3d>& seeds)
+{
+    if (!c.complete || c.points.empty())
+    {
+        return;
+    }
+    if (displaced > 0)
+    {
+        project_seeds(field, c.points, 0, displaced);
+    }
+    if (keep_near_zero(field, c.points, c.slack, seeds) > 0)
+    {
+        return;
+    }
+    project_seeds(field, c.points, 0, 4);
+    std::fill(c.slack.begin(), c.slack.end(), 0.0);
+    if (keep_near_zero(field, c.points, c.slack, seeds) > 0)
+    {
+        return;
+    }
+    sweep_seeds(field, seeds);
+}
+
 /// Members' samples at one point, on the stack for the usual few members.
 class SampleBuffer
 {
@@ -243,11 +459,16 @@ BooleanField::BooleanField(BooleanOp op, std::vector<FieldPtr> members)
                        : op == BooleanOp::Intersection ? "intersection"
                                                        : "difference";
     require_members(members_, op == BooleanOp::Difference ? 2 : 1, name);
+    std::vector<double> costs(members_.size());
+    for (std::size_t i = 0; i < members_.size(); ++i)
+    {
+        costs[i] = members_[i]->cost();
+    }
     order_.resize(members_.size());
     std::iota(order_.begin(), order_.end(), std::size_t{0});
-    std::stable_sort(order_.begin(), order_.end(), [this](std::size_t i, std::size_t j) {
-        return members_[i]->cost() < members_[j]->cost();
-    });
+    std::stable_sort(order_.begin(), order_.end(),
+                     [&costs](std::size_t i, std::size_t j) { return costs[i] < costs[j]; });
+    cost_ = summed_cost(members_);
 }
 
 FieldSample BooleanField::evaluate(const Vec3d& p) const
@@ -361,7 +582,7 @@ void BooleanField::evaluate_within(std::span<const Vec3d> points, std::span<cons
 
 double BooleanField::cost() const
 {
-    return summed_cost(members_);
+    return cost_;
 }
 
 Aabb BooleanField::bounds() const
@@ -381,10 +602,7 @@ Aabb BooleanField::bounds() const
 
 void BooleanField::append_seeds(std::vector<Vec3d>& seeds) const
 {
-    for (const FieldPtr& m : members_)
-    {
-        m->append_seeds(seeds);
-    }
+    operator_seeds(*this, gather_all(members_), 0, seeds);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -400,6 +618,9 @@ SmoothBooleanField::SmoothBooleanField(BooleanOp op, FieldPtr a, FieldPtr b, dou
         throw InvalidInput("smooth Boolean: the blend radius must be positive and finite, got " +
                            std::to_string(radius));
     }
+    b_first_ = b_->cost() < a_->cost();
+    const std::array<FieldPtr, 2> members = {a_, b_};
+    cost_ = summed_cost(members);
 }
 
 FieldSample SmoothBooleanField::evaluate(const Vec3d& p) const
@@ -458,7 +679,7 @@ FieldSample SmoothBooleanField::combine(const FieldSample& sa, FieldSample sb) c
 
 FieldSample SmoothBooleanField::evaluate_within(const Vec3d& p, double lo, double hi) const
 {
-    const bool b_first = b_->cost() < a_->cost();
+    const bool b_first = b_first_;
     const Field& first = b_first ? *b_ : *a_;
     const Field& second = b_first ? *a_ : *b_;
     const auto [first_lo, first_hi] = range_of(b_first, lo, hi, nullptr);
@@ -474,7 +695,7 @@ void SmoothBooleanField::evaluate_within(std::span<const Vec3d> points, std::spa
 {
     check_within_sizes("SmoothBooleanField::evaluate_within", points.size(), lo.size(), hi.size(),
                        out.size());
-    const bool b_first = b_->cost() < a_->cost();
+    const bool b_first = b_first_;
     const Field& first = b_first ? *b_ : *a_;
     const Field& second = b_first ? *a_ : *b_;
     parallel_blocks(points.size(), operator_block, [&](std::size_t begin, std::size_t end) {
@@ -505,7 +726,7 @@ void SmoothBooleanField::evaluate_within(std::span<const Vec3d> points, std::spa
 
 double SmoothBooleanField::cost() const
 {
-    return 1.0 + a_->cost() + b_->cost();
+    return cost_;
 }
 
 Aabb SmoothBooleanField::bounds() const
@@ -524,8 +745,8 @@ Aabb SmoothBooleanField::bounds() const
 
 void SmoothBooleanField::append_seeds(std::vector<Vec3d>& seeds) const
 {
-    a_->append_seeds(seeds);
-    b_->append_seeds(seeds);
+    const std::array<FieldPtr, 2> members = {a_, b_};
+    operator_seeds(*this, gather_all(members), 0, seeds);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -562,6 +783,7 @@ BlendField::BlendField(BlendKind kind, std::vector<FieldPtr> members, std::vecto
                            std::to_string(beta));
     }
     alpha_max_ = *std::max_element(alphas_.begin(), alphas_.end());
+    cost_ = summed_cost(members_);
 }
 
 FieldSample BlendField::evaluate(const Vec3d& p) const
@@ -657,7 +879,7 @@ FieldSample BlendField::evaluate(const Vec3d& p) const
 
 double BlendField::cost() const
 {
-    return summed_cost(members_);
+    return cost_;
 }
 
 Aabb BlendField::bounds() const
@@ -673,15 +895,7 @@ Aabb BlendField::bounds() const
 
 void BlendField::append_seeds(std::vector<Vec3d>& seeds) const
 {
-    const std::size_t first = seeds.size();
-    for (const FieldPtr& m : members_)
-    {
-        m->append_seeds(seeds);
-    }
-    if (kind_ == BlendKind::Hyperbolic)
-    {
-        project_seeds(*this, seeds, first, 4);
-    }
+    operator_seeds(*this, gather_all(members_), kind_ == BlendKind::Hyperbolic ? 4 : 0, seeds);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -694,6 +908,7 @@ OffsetField::OffsetField(FieldPtr member, double distance, UndefinedPolicy polic
     {
         throw InvalidInput("offset: the distance must be finite");
     }
+    cost_ = 1.0 + member_->cost();
 }
 
 FieldSample OffsetField::evaluate(const Vec3d& p) const
@@ -718,7 +933,7 @@ void OffsetField::evaluate_within(std::span<const Vec3d> points, std::span<const
 
 double OffsetField::cost() const
 {
-    return 1.0 + member_->cost();
+    return cost_;
 }
 
 Aabb OffsetField::bounds() const
@@ -728,12 +943,7 @@ Aabb OffsetField::bounds() const
 
 void OffsetField::append_seeds(std::vector<Vec3d>& seeds) const
 {
-    const std::size_t first = seeds.size();
-    member_->append_seeds(seeds);
-    if (distance_ != 0.0)
-    {
-        project_seeds(*this, seeds, first, 3);
-    }
+    operator_seeds(*this, gather_all(std::span(&member_, 1)), distance_ != 0.0 ? 3 : 0, seeds);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -747,6 +957,7 @@ ShellField::ShellField(FieldPtr member, double thickness, UndefinedPolicy policy
         throw InvalidInput("shell: the thickness must be positive and finite, got " +
                            std::to_string(thickness));
     }
+    cost_ = 1.0 + member_->cost();
 }
 
 FieldSample ShellField::evaluate(const Vec3d& p) const
@@ -771,7 +982,7 @@ void ShellField::evaluate_within(std::span<const Vec3d> points, std::span<const 
 
 double ShellField::cost() const
 {
-    return 1.0 + member_->cost();
+    return cost_;
 }
 
 Aabb ShellField::bounds() const
@@ -782,25 +993,32 @@ Aabb ShellField::bounds() const
 void ShellField::append_seeds(std::vector<Vec3d>& seeds) const
 {
     // The two surfaces are separate pieces: push every member seed to both sides.
-    std::vector<Vec3d> base;
-    member_->append_seeds(base);
-    std::vector<FieldSample> samples(base.size());
-    member_->evaluate(base, samples);
-    const std::size_t first = seeds.size();
-    seeds.reserve(first + 2 * base.size());
-    for (std::size_t i = 0; i < base.size(); ++i)
+    const Candidates base = gather_all(std::span(&member_, 1));
+    if (!base.complete)
+    {
+        return;
+    }
+    std::vector<FieldSample> samples(base.points.size());
+    member_->evaluate(base.points, samples);
+    Candidates c;
+    c.points.reserve(2 * base.points.size());
+    for (std::size_t i = 0; i < base.points.size(); ++i)
     {
         const double g = samples[i].gradient.norm();
         if (!(g > 0.0) || !samples[i].gradient.allFinite())
         {
-            seeds.push_back(base[i]);
+            c.points.push_back(base.points[i]);
+            c.slack.push_back(base.slack[i]);
             continue;
         }
         const Vec3d step = (0.5 * thickness_ / g) * samples[i].gradient;
-        seeds.push_back(base[i] + step);
-        seeds.push_back(base[i] - step);
+        for (const Vec3d& p : {Vec3d(base.points[i] + step), Vec3d(base.points[i] - step)})
+        {
+            c.points.push_back(p);
+            c.slack.push_back(base.slack[i]);
+        }
     }
-    project_seeds(*this, seeds, first, 2);
+    operator_seeds(*this, std::move(c), 2, seeds);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -820,6 +1038,8 @@ MorphField::MorphField(FieldPtr from, FieldPtr to, double t, UndefinedPolicy pol
             "morph: the bounds of the two fields do not overlap, so the in-between shapes "
             "would be empty");
     }
+    const std::array<FieldPtr, 2> members = {from_, to_};
+    cost_ = summed_cost(members);
 }
 
 FieldSample MorphField::evaluate(const Vec3d& p) const
@@ -845,7 +1065,7 @@ FieldSample MorphField::evaluate(const Vec3d& p) const
 
 double MorphField::cost() const
 {
-    return 1.0 + from_->cost() + to_->cost();
+    return cost_;
 }
 
 Aabb MorphField::bounds() const
@@ -863,19 +1083,202 @@ Aabb MorphField::bounds() const
 
 void MorphField::append_seeds(std::vector<Vec3d>& seeds) const
 {
-    const std::size_t first = seeds.size();
+    std::vector<FieldPtr> members;
     if (t_ < 1.0)
     {
-        from_->append_seeds(seeds);
+        members.push_back(from_);
     }
     if (t_ > 0.0)
     {
-        to_->append_seeds(seeds);
+        members.push_back(to_);
     }
-    if (t_ > 0.0 && t_ < 1.0)
+    operator_seeds(*this, gather_all(members), t_ > 0.0 && t_ < 1.0 ? 4 : 0, seeds);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+/// What one thread remembers of the last batch asked of one SharedField.
+struct Remembered
+{
+    std::vector<Vec3d> points;
+    std::vector<double> lo;
+    std::vector<double> hi;
+    std::vector<FieldSample> samples;
+};
+
+/// The SharedFields that exist, and how many have ceased to: a thread drops what it remembers of
+/// the dead ones when it holds more than `purge_above` batches and some have died since it last
+/// looked, so threads that outlive scenes do not keep their batches.
+struct Registry
+{
+    std::mutex mutex;
+    std::unordered_set<std::uint64_t> live;
+    std::atomic<std::uint64_t> deaths{0};
+};
+
+Registry& registry()
+{
+    static Registry r;
+    return r;
+}
+
+constexpr std::size_t purge_above = 64;
+
+/// The batches remembered by this thread, by SharedField id.
+std::unordered_map<std::uint64_t, Remembered>& remembered()
+{
+    thread_local std::unordered_map<std::uint64_t, Remembered> map;
+    thread_local std::uint64_t deaths_seen = 0;
+    if (map.size() > purge_above)
     {
-        project_seeds(*this, seeds, first, 4);
+        Registry& r = registry();
+        const std::uint64_t deaths = r.deaths.load(std::memory_order_acquire);
+        if (deaths != deaths_seen)
+        {
+            const std::lock_guard lock(r.mutex);
+            std::erase_if(map, [&r](const auto& entry) { return !r.live.contains(entry.first); });
+            deaths_seen = deaths;
+        }
     }
+    return map;
+}
+
+bool same_point(const Vec3d& a, const Vec3d& b)
+{
+    return std::memcmp(a.data(), b.data(), sizeof(double) * 3) == 0;
+}
+
+std::atomic<std::uint64_t> next_shared_id{1};
+
+} // namespace
+
+SharedField::SharedField(FieldPtr member) : member_(std::move(member)), id_(next_shared_id++)
+{
+    require_member(member_, "shared field");
+    {
+        const std::lock_guard lock(registry().mutex);
+        registry().live.insert(id_);
+    }
+    cost_ = member_->cost();
+    bounds_ = member_->bounds();
+}
+
+SharedField::~SharedField()
+{
+    Registry& r = registry();
+    const std::lock_guard lock(r.mutex);
+    r.live.erase(id_);
+    r.deaths.fetch_add(1, std::memory_order_release);
+}
+
+FieldSample SharedField::evaluate(const Vec3d& p) const
+{
+    return evaluate_within(p, -infinity, infinity);
+}
+
+FieldSample SharedField::evaluate_within(const Vec3d& p, double lo, double hi) const
+{
+    FieldSample out;
+    evaluate_within(std::span(&p, 1), std::span(&lo, 1), std::span(&hi, 1), std::span(&out, 1));
+    return out;
+}
+
+void SharedField::evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
+                                  std::span<const double> hi, std::span<FieldSample> out) const
+{
+    check_within_sizes("SharedField::evaluate_within", points.size(), lo.size(), hi.size(),
+                       out.size());
+    const std::size_t n = points.size();
+    if (n > operator_block)
+    {
+        // Only the top of an evaluation asks for more at once, and it asks once.
+        member_->evaluate_within(points, lo, hi, out);
+        return;
+    }
+    Remembered& r = remembered()[id_];
+    std::vector<std::size_t> missing;
+    if (r.points.size() == n &&
+        std::equal(points.begin(), points.end(), r.points.begin(), same_point))
+    {
+        for (std::size_t i = 0; i < n; ++i)
+        {
+            if (r.lo[i] <= lo[i] && r.hi[i] >= hi[i])
+            {
+                out[i] = r.samples[i];
+            }
+            else
+            {
+                missing.push_back(i);
+            }
+        }
+        if (missing.empty())
+        {
+            return;
+        }
+    }
+    else
+    {
+        member_->evaluate_within(points, lo, hi, out);
+        // Looked up again: the member's evaluation may have remembered other shared fields
+        // meanwhile (the map keeps its elements in place, but may drop dead fields' ones).
+        Remembered& fresh = remembered()[id_];
+        fresh.points.assign(points.begin(), points.end());
+        fresh.lo.assign(lo.begin(), lo.end());
+        fresh.hi.assign(hi.begin(), hi.end());
+        fresh.samples.assign(out.begin(), out.end());
+        return;
+    }
+    std::vector<Vec3d> at(missing.size());
+    std::vector<double> at_lo(missing.size());
+    std::vector<double> at_hi(missing.size());
+    std::vector<FieldSample> samples(missing.size());
+    for (std::size_t j = 0; j < missing.size(); ++j)
+    {
+        at[j] = points[missing[j]];
+        at_lo[j] = lo[missing[j]];
+        at_hi[j] = hi[missing[j]];
+    }
+    member_->evaluate_within(at, at_lo, at_hi, samples);
+    Remembered& again = remembered()[id_];
+    const bool still = again.points.size() == n;
+    for (std::size_t j = 0; j < missing.size(); ++j)
+    {
+        const std::size_t i = missing[j];
+        out[i] = samples[j];
+        if (still)
+        {
+            again.lo[i] = at_lo[j];
+            again.hi[i] = at_hi[j];
+            again.samples[i] = samples[j];
+        }
+    }
+}
+
+double SharedField::cost() const
+{
+    return cost_;
+}
+
+Aabb SharedField::bounds() const
+{
+    return bounds_;
+}
+
+void SharedField::append_seeds(std::vector<Vec3d>& seeds) const
+{
+    std::call_once(seeds_once_, [this] { member_->append_seeds(seeds_); });
+    seeds.insert(seeds.end(), seeds_.begin(), seeds_.end());
+}
+
+std::shared_ptr<const Field> make_shared_node(FieldPtr member)
+{
+    if (std::dynamic_pointer_cast<const SharedField>(member) != nullptr)
+    {
+        return member;
+    }
+    return std::make_shared<const SharedField>(std::move(member));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -106,10 +106,17 @@ Aabb SphereField::bounds() const
 
 void SphereField::append_seeds(std::vector<Vec3d>& seeds) const
 {
+    // The 6 axis points and the 8 octant diagonals: an operator keeps those on its result.
     for (int axis = 0; axis < 3; ++axis)
     {
         seeds.push_back(center_ + radius_ * Vec3d::Unit(axis));
         seeds.push_back(center_ - radius_ * Vec3d::Unit(axis));
+    }
+    for (int octant = 0; octant < 8; ++octant)
+    {
+        const Vec3d d((octant & 1) != 0 ? 1.0 : -1.0, (octant & 2) != 0 ? 1.0 : -1.0,
+                      (octant & 4) != 0 ? 1.0 : -1.0);
+        seeds.push_back(center_ + (radius_ / std::sqrt(3.0)) * d);
     }
 }
 
@@ -180,11 +187,32 @@ Aabb BoxField::bounds() const
 
 void BoxField::append_seeds(std::vector<Vec3d>& seeds) const
 {
+    // The face centres, and the corners and edge midpoints (on the rounding where it is
+    // rounded): an operator keeps those on its result.
     for (int axis = 0; axis < 3; ++axis)
     {
         const Vec3d offset = half_extents_[axis] * rotation_.col(axis);
         seeds.push_back(center_ + offset);
         seeds.push_back(center_ - offset);
+    }
+    const Vec3d inner = half_extents_ - Vec3d::Constant(rounding_);
+    for (int x = -1; x <= 1; ++x)
+    {
+        for (int y = -1; y <= 1; ++y)
+        {
+            for (int z = -1; z <= 1; ++z)
+            {
+                const Vec3d d(x, y, z);
+                const int nonzero = std::abs(x) + std::abs(y) + std::abs(z);
+                if (nonzero < 2)
+                {
+                    continue; // the centre and the face centres
+                }
+                const Vec3d local =
+                    inner.cwiseProduct(d) + (rounding_ / std::sqrt(double(nonzero))) * d;
+                seeds.push_back(center_ + rotation_ * local);
+            }
+        }
     }
 }
 

@@ -27,6 +27,11 @@ namespace {
 
 using FieldPtr = std::shared_ptr<const Field>;
 
+/// How deep calls and vectors may nest in a scene's text, and operators and transforms in its
+/// field (through bindings too): deeper scenes are refused, so that parsing, checking, building,
+/// evaluating and destroying one never recurses deeper than this.
+constexpr int max_nesting = 256;
+
 // ---------------------------------------------------------------------------------------------
 // Diagnostics
 
@@ -584,6 +589,28 @@ private:
         fail(token.pos, "expected " + expected + ", found " + describe(token));
     }
 
+    /// Counts one more open '(' or '[' while it lives; refuses more than max_nesting.
+    class Nesting
+    {
+    public:
+        Nesting(Parser& parser, Pos open) : parser_(parser)
+        {
+            if (++parser_.nesting_ > max_nesting)
+            {
+                parser_.fail(open, "nested too deep: more than " + std::to_string(max_nesting) +
+                                       " calls and vectors open at once");
+            }
+        }
+        ~Nesting() { --parser_.nesting_; }
+        Nesting(const Nesting&) = delete;
+        Nesting& operator=(const Nesting&) = delete;
+        Nesting(Nesting&&) = delete;
+        Nesting& operator=(Nesting&&) = delete;
+
+    private:
+        Parser& parser_;
+    };
+
     NodePtr parse_call()
     {
         auto node = std::make_unique<Node>();
@@ -592,6 +619,7 @@ private:
         node->pos = name.pos;
         node->text = name.text;
         const Pos open = next().pos; // '('
+        const Nesting nesting(*this, open);
         std::size_t count = 0;
         bool seen_keyword = false;
         while (peek().kind != Tok::RParen)
@@ -646,6 +674,7 @@ private:
         auto node = std::make_unique<Node>();
         node->kind = Node::Kind::Vector;
         node->pos = next().pos; // '['
+        const Nesting nesting(*this, node->pos);
         while (peek().kind != Tok::RBracket)
         {
             const std::size_t count = node->components.size() + 1;
@@ -684,6 +713,7 @@ private:
     std::vector<Token> tokens_;
     const std::string& source_;
     std::size_t i_ = 0;
+    int nesting_ = 0; // open calls and vectors
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -704,6 +734,7 @@ struct Value
     Vec3d vector = Vec3d::Zero();
     std::string string;
     FieldPtr field; // null while checking
+    int depth = 0;  // a field's nesting of operators and transforms (1: a primitive or a scan)
 };
 
 std::string describe(Type type)
@@ -759,6 +790,7 @@ struct Arguments
     const std::vector<Param>* params = nullptr;
     std::vector<Value> values;
     std::vector<FieldPtr> members;
+    int depth = 0; // the deepest field among the arguments
 
     [[nodiscard]] const Value& get(std::string_view name) const
     {
@@ -1070,8 +1102,42 @@ public:
     Scene run()
     {
         const Node& result = check();
-        Scene scene;
+        // The bindings the result needs, through the bindings they use (each refers only to
+        // earlier ones), and how many times each is named there.
+        const std::size_t n = statements_.size();
+        std::vector<bool> needed(n, false);
+        std::vector<std::size_t> uses(n, 0);
+        needed[n - 1] = true;
+        for (std::size_t i = n; i-- > 0;)
+        {
+            if (!needed[i])
+            {
+                continue;
+            }
+            for (const std::size_t used : references_[i])
+            {
+                needed[used] = true;
+                ++uses[used];
+            }
+        }
+        // Built in order, each once: a field named more than once becomes one shared node,
+        // evaluated once per batch of points whatever the number of paths to it.
         building_ = true;
+        for (std::size_t i = 0; i + 1 < n; ++i)
+        {
+            if (!needed[i])
+            {
+                continue;
+            }
+            Binding& binding = bindings_.at(statements_[i].name);
+            Value value = evaluate(*statements_[i].expr);
+            if (value.type == Type::Field && uses[i] > 1)
+            {
+                value.field = make_shared_node(std::move(value.field));
+            }
+            binding.built = std::move(value);
+        }
+        Scene scene;
         scene.field = evaluate(result).field;
         scene.scans = std::move(scans_);
         return scene;
@@ -1081,7 +1147,7 @@ private:
     struct Binding
     {
         Pos pos;
-        const Node* expr = nullptr;
+        std::size_t statement = 0;
         Value checked;
         std::optional<Value> built;
     };
@@ -1129,11 +1195,12 @@ private:
                                                  "; choose another name");
                 }
             }
+            references_.emplace_back();
             Value value = evaluate(*statement.expr);
             if (statement.binding && statement.name != "result")
             {
                 bindings_[statement.name] = {
-                    .pos = statement.name_pos, .expr = statement.expr.get(), .checked = value};
+                    .pos = statement.name_pos, .statement = i, .checked = value};
             }
             if (last)
             {
@@ -1213,11 +1280,12 @@ private:
         Binding& binding = it->second;
         if (!building_)
         {
+            references_.back().push_back(binding.statement);
             return binding.checked;
         }
         if (!binding.built)
         {
-            binding.built = evaluate(*binding.expr);
+            fail(node.pos, "internal error: '" + node.text + "' is not built");
         }
         return *binding.built;
     }
@@ -1249,9 +1317,16 @@ private:
         const Arguments arguments = bind_arguments(*function, node);
         if (function->name == "scan")
         {
-            return {.type = Type::Field, .field = scan(node, arguments.get("path").string)};
+            return {
+                .type = Type::Field, .field = scan(node, arguments.get("path").string), .depth = 1};
         }
-        Value value{.type = Type::Field};
+        Value value{.type = Type::Field, .depth = arguments.depth + 1};
+        if (value.depth > max_nesting)
+        {
+            fail(node.pos, function->name + " nests the scene's field too deep: more than " +
+                               std::to_string(max_nesting) +
+                               " operators and transforms inside one another (through bindings)");
+        }
         if (building_)
         {
             try
@@ -1279,6 +1354,10 @@ private:
             const Argument& argument = node.arguments[i];
             const std::string ordinal = std::to_string(i + 1);
             Value value = evaluate(*argument.value);
+            if (value.type == Type::Field)
+            {
+                arguments.depth = std::max(arguments.depth, value.depth);
+            }
             if (argument.keyword.empty())
             {
                 ++positional;
@@ -1539,6 +1618,8 @@ private:
     Pos end_;
     bool building_ = false;
     std::map<std::string, Binding, std::less<>> bindings_;
+    /// Per statement checked so far: the statements of the bindings it names, once per mention.
+    std::vector<std::vector<std::size_t>> references_;
     std::map<std::string, FieldPtr, std::less<>> loaded_;
     std::vector<std::string> scans_;
 };

@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -492,6 +493,104 @@ TEST(SceneErrors, ScansAreCheckedBeforeAnyIsLoaded)
     };
     EXPECT_EQ(error_of("scan(\"a.ply\")", options),
               "expression:1:1: scan(\"a.ply\"): too few points");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Hostile scenes: deep nesting, and bindings shared along exponentially many paths
+
+TEST(SceneHostile, NestingDeeperThan256IsAnErrorAtTheOpeningThatExceedsIt)
+{
+    std::string deep;
+    for (int i = 0; i < 20000; ++i)
+    {
+        deep += "union(";
+    }
+    // The 257th '(' stands at column 6 · 257.
+    const std::string message = error_of(deep);
+    EXPECT_EQ(message.rfind("expression:1:1542: nested too deep: more than 256", 0), 0U) << message;
+
+    std::string brackets = "sphere(";
+    for (int i = 0; i < 5000; ++i)
+    {
+        brackets += "[";
+    }
+    EXPECT_EQ(error_of(brackets).rfind("expression:1:263: nested too deep", 0), 0U)
+        << error_of(brackets);
+
+    // 250 levels are fine, and mean what they say.
+    std::string moved = "sphere([0, 0, 0], 1)";
+    for (int i = 0; i < 250; ++i)
+    {
+        moved = "translate(" + moved + ", [0.01, 0, 0])";
+    }
+    const FieldPtr field = parse(moved);
+    EXPECT_NEAR(field->evaluate(Vec3d(3.5, 0.0, 0.0)).value, 0.0, 1e-9);
+}
+
+TEST(SceneHostile, BindingsNestedDeeperThan256AreAnErrorAtTheirLineAndColumn)
+{
+    std::string text = "let a0 = sphere([0, 0, 0], 1)\n";
+    for (int i = 1; i <= 300; ++i)
+    {
+        text += "let a" + std::to_string(i) + " = translate(a" + std::to_string(i - 1) +
+                ", [0.01, 0, 0])\n";
+    }
+    text += "a300\n";
+    // a0 is a primitive (1); a_i nests i + 1 deep: a256 is the first too deep, on line 257.
+    const std::string message = error_of(text);
+    EXPECT_EQ(message.rfind("expression:257:12: translate nests the scene's field too deep", 0), 0U)
+        << message;
+}
+
+TEST(SceneHostile, SharedBindingsAreEvaluatedOncePerPoint)
+{
+    // 40 levels of union(a, a): 2^40 paths, 41 distinct nodes.
+    std::string text = "let a0 = sphere([0.1, 0.2, 0.3], 1)\n";
+    for (int i = 1; i < 40; ++i)
+    {
+        text += "let a" + std::to_string(i) + " = union(a" + std::to_string(i - 1) + ", a" +
+                std::to_string(i - 1) + ")\n";
+    }
+    text += "translate(a39, [1, 0, 0])\n";
+    const auto start = std::chrono::steady_clock::now();
+    const FieldPtr field = parse(text);
+    const FieldPtr expected = translate(make_sphere(Vec3d(0.1, 0.2, 0.3), 1.0), Vec3d::UnitX());
+    expect_same_field(*field, *expected);
+    std::vector<Vec3d> points;
+    for (int i = 0; i < 5000; ++i)
+    {
+        points.emplace_back(0.001 * i - 2.5, std::sin(i), std::cos(0.5 * i));
+    }
+    std::vector<FieldSample> batch(points.size());
+    field->evaluate(points, batch);
+    for (std::size_t i = 0; i < points.size(); ++i)
+    {
+        ASSERT_EQ(batch[i].value, expected->evaluate(points[i]).value);
+    }
+    std::vector<Vec3d> seeds;
+    field->append_seeds(seeds);
+    std::vector<Vec3d> sphere_seeds;
+    expected->append_seeds(sphere_seeds);
+    EXPECT_EQ(seeds.size(), sphere_seeds.size());
+    EXPECT_LT(field->cost(), 100.0); // linear in the distinct nodes, not 2^40
+    // Without sharing this would take 2^40 evaluations per point; with it, well under a second
+    // (a generous bound for loaded machines).
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+              20.0);
+}
+
+TEST(SceneHostile, SharedBindingsKeepTheirValuesInEveryUse)
+{
+    // One binding used at different points (through a transform) and at the same ones.
+    const FieldPtr field = parse(
+        "let a = box([-1, -1, -1], [1, 1, 1])\n"
+        "let b = union(a, translate(a, [1.5, 0, 0]), a)\n"
+        "difference(b, translate(b, [0, 0, 1.8]), b)");
+    const FieldPtr a = make_box(Vec3d::Constant(-1.0), Vec3d::Constant(1.0));
+    const FieldPtr b = make_union({a, translate(a, Vec3d(1.5, 0, 0)), a});
+    const FieldPtr expected = std::make_shared<const BooleanField>(
+        BooleanOp::Difference, std::vector<FieldPtr>{b, translate(b, Vec3d(0, 0, 1.8)), b});
+    expect_same_field(*field, *expected);
 }
 
 TEST(Scene, FunctionSummaryListsEveryFunction)

@@ -5,7 +5,9 @@
 
 #include "pointform/implicit/field.h"
 
+#include <cstdint>
 #include <memory>
+#include <mutex>
 #include <span>
 #include <utility>
 #include <vector>
@@ -29,11 +31,17 @@ namespace pointform {
 ///   no inner surface (inside B, A's undefined negative value wins the min) and a difference cuts
 ///   cleanly. The other operators take the AND over the members that shape the value at p, as
 ///   filtered by their UndefinedPolicy.
-/// - Seeds: an operator appends its members' seeds (moved onto its own surface where that
-///   surface is displaced: offset, shell, hyperbolic blend, morph). Marching cubes follows the
-///   surface from every seed that lies on it, so a piece of an intersection or difference that
-///   holds no member seed (e.g. A ∩ B where no seed of A lies inside B and none of B inside A)
-///   is missed; with point fields (a seed per sample) and the primitives' seeds this is rare.
+/// - Seeds come from the operator's result, not passed through from its members: each distinct
+///   member's seeds, moved onto the operator's surface by Newton steps where that surface is
+///   displaced (offset, shell, hyperbolic blend, morph), kept where the result is as near zero
+///   as the member is there (so A's seeds inside B are no seeds of A ∪ B); when none is kept,
+///   the members' seeds moved by Newton steps onto the result, and if that finds none either, a
+///   coarse sweep of bounds() (32 cells along its longest side) for sign changes. So every piece
+///   of the result that holds a member's seed, or is larger than the sweep's cells when none
+///   does, is found (e.g. A ∩ B where no seed of A lies inside B and none of B inside A). An
+///   operator with a member that knows no seeds knows none either (dense polygonization).
+/// - cost() is computed once, when the operator is made (a member that appears twice counts
+///   once); members shared through SharedField are evaluated once per batch of points.
 /// - Bounded evaluation (Field::evaluate_within): Booleans, smooth Booleans, offsets and shells
 ///   ask each member only for the range of values that can still decide their own result, the
 ///   cheaper members first (Field::cost), and give evaluate()'s result wherever it lies in the
@@ -95,6 +103,7 @@ private:
     BooleanOp op_;
     std::vector<std::shared_ptr<const Field>> members_;
     std::vector<std::size_t> order_; ///< members by cost, then by position
+    double cost_ = 1.0;
 };
 
 /// \brief Smooth union, intersection or difference of two fields with blend radius k, by the
@@ -139,6 +148,8 @@ private:
     std::shared_ptr<const Field> b_;
     double radius_;
     UndefinedPolicy policy_;
+    bool b_first_ = false; ///< b is cheaper: asked first
+    double cost_ = 1.0;
 };
 
 /// \brief Which blend of Table 3 (see BlendField).
@@ -202,6 +213,7 @@ private:
     double beta_;
     UndefinedPolicy policy_;
     double alpha_max_;
+    double cost_ = 1.0;
 };
 
 /// \brief Offset (§4.2, Fig. 3): f − d, the surface moved outwards by d (inwards for d < 0).
@@ -231,6 +243,7 @@ private:
     std::shared_ptr<const Field> member_;
     double distance_;
     UndefinedPolicy policy_;
+    double cost_ = 1.0;
 };
 
 /// \brief Hollow shell of thickness t around the surface: |f| − t/2 (two surfaces, at f = ±t/2;
@@ -257,6 +270,7 @@ private:
     std::shared_ptr<const Field> member_;
     double thickness_;
     UndefinedPolicy policy_;
+    double cost_ = 1.0;
 };
 
 /// \brief Metamorphosis (§4.2): f_t = (1 − t)·f₁ + t·f₂ for t in [0, 1]; f₁'s surface at t = 0,
@@ -286,6 +300,44 @@ private:
     std::shared_ptr<const Field> to_;
     double t_;
     UndefinedPolicy policy_;
+    double cost_ = 1.0;
+};
+
+/// \brief A field that several operators share (a scene's `let` binding used more than once):
+/// its member is evaluated once per batch of points however many operators ask it, and its seeds
+/// are computed once, so the work of a scene grows with its distinct nodes, not with its paths
+/// (`let a1 = union(a0, a0)`, `let a2 = union(a1, a1)`, …).
+///
+/// Each thread remembers, per shared field, the last batch of up to 1024 points asked of it
+/// (operators ask their members in such blocks; what it remembers of a field goes when the field
+/// does), with the range each point was asked within; a
+/// request for the same points within ranges that those contain is answered from it, the rest
+/// from the member. Every answer is one the member gave for a range that contains the one asked,
+/// so it keeps Field::evaluate_within's contract, and exact values are the member's exactly.
+class SharedField final : public Field
+{
+public:
+    explicit SharedField(std::shared_ptr<const Field> member);
+    ~SharedField() override;
+
+    [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override;
+    using Field::evaluate;
+    [[nodiscard]] FieldSample evaluate_within(const Vec3d& p, double lo, double hi) const override;
+    void evaluate_within(std::span<const Vec3d> points, std::span<const double> lo,
+                         std::span<const double> hi, std::span<FieldSample> out) const override;
+    [[nodiscard]] double cost() const override;
+    [[nodiscard]] Aabb bounds() const override;
+    void append_seeds(std::vector<Vec3d>& seeds) const override;
+
+    [[nodiscard]] const std::shared_ptr<const Field>& member() const { return member_; }
+
+private:
+    std::shared_ptr<const Field> member_;
+    std::uint64_t id_; ///< unique over the process: the key of the threads' remembered batches
+    double cost_;
+    Aabb bounds_;
+    mutable std::once_flag seeds_once_;
+    mutable std::vector<Vec3d> seeds_;
 };
 
 /// \name Factories (the same validation as the constructors)
@@ -317,6 +369,8 @@ private:
                                                       double thickness);
 [[nodiscard]] std::shared_ptr<const Field> make_morph(std::shared_ptr<const Field> from,
                                                       std::shared_ptr<const Field> to, double t);
+/// \brief `member` as a SharedField (itself if it is one already).
+[[nodiscard]] std::shared_ptr<const Field> make_shared_node(std::shared_ptr<const Field> member);
 /// @}
 
 } // namespace pointform

@@ -43,14 +43,16 @@ namespace pointform {
 ///     name      = letter_or_underscore { letter_or_underscore | digit } ;
 ///
 /// Inside parentheses and brackets newlines are plain white space, so an expression may span
-/// lines. The scene's result is its last statement: an expression, or a binding named `result`.
-/// A scene has exactly one result; every earlier statement is a binding. A binding may hold any
-/// value (a number, a vector, a string or a field) and is visible to the statements after it; a
-/// name is bound once, and may not be `let` or a function's name. Positional arguments come
-/// before keyword arguments; a keyword argument names a parameter (e.g.
-/// `sphere(radius = 1, center = [0, 0, 0])`). Values have four types: number, vector
-/// ([x, y, z]), string and field; a parameter accepts one type (scale's factor: number or
-/// vector).
+/// lines. Calls and vectors nest at most 256 deep in the text, and a field at most 256 operators
+/// and transforms deep counting through bindings; a binding is one node however often it is
+/// named (a field named more than once is a SharedField: evaluated once per batch of points). The
+/// scene's result is its last statement: an expression, or a binding named `result`. A scene has
+/// exactly one result; every earlier statement is a binding. A binding may hold any value (a
+/// number, a vector, a string or a field) and is visible to the statements after it; a name is
+/// bound once, and may not be `let` or a function's name. Positional arguments come before keyword
+/// arguments; a keyword argument names a parameter (e.g. `sphere(radius = 1, center = [0, 0, 0])`).
+/// Values have four types: number, vector ([x, y, z]), string and field; a parameter accepts one
+/// type (scale's factor: number or vector).
 ///
 /// Functions (parameters with a default are optional; `...` takes any number of fields):
 ///
