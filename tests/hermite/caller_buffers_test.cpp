@@ -4,6 +4,8 @@
 // Public functions of hermite that take caller-built index lists and neighbour tables check them
 // in every build: a bad one gets InvalidInput naming the function, never a read out of bounds.
 
+#include "support/caller_buffers.h"
+
 #include "pointform/core/error.h"
 #include "pointform/geometry/shapes.h"
 #include "pointform/hermite/normals.h"
@@ -21,27 +23,11 @@
 namespace pointform {
 namespace {
 
-/// Runs `call`, expecting InvalidInput whose message holds `function` and `buffer`.
-template <typename Call>
-void expect_rejected(const Call& call, const std::string& function, const std::string& buffer)
-{
-    try
-    {
-        call();
-        ADD_FAILURE() << function << " accepted a " << buffer << " of the wrong size";
-    }
-    catch (const InvalidInput& e)
-    {
-        const std::string what = e.what();
-        EXPECT_NE(what.find(function), std::string::npos) << what;
-        EXPECT_NE(what.find(buffer), std::string::npos) << what;
-    }
-}
+using test::expect_rejected;
 
 const PointCloud& torus()
 {
-    static const PointCloud cloud = sample_shape(Shape::Torus, {.count = 3000, .seed = 4});
-    return cloud;
+    return test::buffer_test_torus();
 }
 
 TEST(CallerBuffers, FitPlane)
