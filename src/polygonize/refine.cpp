@@ -827,13 +827,17 @@ std::vector<std::uint64_t> unique_edges(std::span<const Triangle> faces)
     return edges;
 }
 
-/// Vertices of the level after the finest: V + E, with E = V + F − χ and χ from the base mesh,
-/// which every level keeps.
-std::size_t next_level_vertices(const MultiresMesh& mesh)
+/// The Euler characteristic of the base mesh, which every level keeps.
+long long euler_characteristic(const MultiresMesh& mesh)
 {
-    const auto base_edges = static_cast<long long>(unique_edges(mesh.base_faces()).size());
-    const long long chi = static_cast<long long>(mesh.vertex_count(0)) - base_edges +
-                          static_cast<long long>(mesh.base_faces().size());
+    return static_cast<long long>(mesh.vertex_count(0)) -
+           static_cast<long long>(unique_edges(mesh.base_faces()).size()) +
+           static_cast<long long>(mesh.base_faces().size());
+}
+
+/// Vertices of the level after the finest: V + E, with E = V + F − χ.
+std::size_t next_level_vertices(const MultiresMesh& mesh, long long chi)
+{
     const std::size_t level = mesh.finest_level();
     const auto v = static_cast<long long>(mesh.vertex_count(level));
     const auto f = static_cast<long long>(mesh.face_count(level));
@@ -890,6 +894,7 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
         report.detail_threshold =
             std::max(options.detail_factor * report.field_residual, 1e-3 * report.sampling_density);
     }
+    const long long chi = automatic ? euler_characteristic(mesh) : 0;
     const std::size_t start_level = mesh.finest_level();
     if (initial.hausdorff < report.sampling_density)
         report.paper_level = 0;
@@ -908,7 +913,7 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
         }
         if (automatic)
         {
-            if (next_level_vertices(mesh) > report.vertex_budget)
+            if (next_level_vertices(mesh, chi) > report.vertex_budget)
             {
                 report.stop = RefineStop::VertexBudget;
                 break;
