@@ -46,8 +46,7 @@ bool fits(std::size_t base_faces, std::size_t level)
 {
     const double faces = faces_at_level(base_faces, level);
     return faces <= static_cast<double>(std::numeric_limits<std::uint32_t>::max()) &&
-           estimate_refinement_bytes(base_faces, level) <=
-               0.8 * static_cast<double>(memory_limit_bytes());
+           fits_in_memory(estimate_refinement_bytes(base_faces, level));
 }
 
 std::string percent_of(double value, double diagonal)

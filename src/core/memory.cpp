@@ -140,18 +140,20 @@ std::uint64_t memory_limit_bytes()
     return memory_limit().bytes;
 }
 
+bool fits_in_memory(double need_bytes, const MemoryLimit& limit)
+{
+    return limit.bytes == UINT64_MAX ||
+           !(need_bytes > 0.8 * static_cast<double>(limit.bytes)); // NaN: no estimate
+}
+
 void check_memory(double need_bytes, const std::string& what, const std::string& advice)
 {
     const MemoryLimit limit = memory_limit();
-    if (limit.bytes == UINT64_MAX)
+    if (fits_in_memory(need_bytes, limit))
     {
         return;
     }
     const auto have = static_cast<double>(limit.bytes);
-    if (!(need_bytes > 0.8 * have)) // NaN: no estimate, nothing to refuse
-    {
-        return;
-    }
     constexpr double gib = 1024.0 * 1024.0 * 1024.0;
     char text[160];
     std::snprintf(text, sizeof text, " would need about %.3g GiB, more than the %.3g GiB",

@@ -37,6 +37,10 @@ struct MemoryLimitFiles
 /// \brief memory_limit().bytes.
 [[nodiscard]] std::uint64_t memory_limit_bytes();
 
+/// \brief Whether work estimated to need `need_bytes` fits in 80% of `limit` (no limit, or no
+/// estimate (NaN): it fits). The rule check_memory() refuses by.
+[[nodiscard]] bool fits_in_memory(double need_bytes, const MemoryLimit& limit = memory_limit());
+
 /// \brief Refuses, before anything is allocated, work estimated to need more than 80% of
 /// memory_limit().
 /// \param need_bytes  the estimate, in bytes (may be infinite)
