@@ -88,6 +88,7 @@ std::vector<double> distances_to_mesh(const PointCloud& points, const TriMesh& m
                                       const DistanceOptions& options)
 {
     check_finite(points, "point-to-mesh distance");
+    check_query_work(mesh, points.size(), "point-to-mesh distance");
     const TriangleBvh bvh(mesh);
     return distances_to_mesh(bvh, points, {.progress = options.progress});
 }

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <utility>
 
@@ -448,6 +449,65 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
         for (std::size_t i = first; i < last; ++i)
             corners_[i] = corners_of(face_ids_[i]);
     });
+}
+
+double triangle_box_depth(const TriMesh& mesh)
+{
+    const std::size_t v_count = mesh.vertex_count();
+    const std::size_t f_count = mesh.face_count();
+    Aabb all;
+    for (const Triangle& t : mesh.triangles)
+        for (const std::uint32_t v : t)
+        {
+            if (v >= v_count)
+                throw InvalidInput("triangle box depth: a triangle refers to vertex " +
+                                   std::to_string(v) + " of " + std::to_string(v_count));
+            all.extend(mesh.vertices.positions[v].cast<double>());
+        }
+    const double total = half_area(all);
+    if (!(total > 0.0))
+        return static_cast<double>(f_count);
+    // Partial sums per fixed block, added in block order: the same bits for any thread count.
+    constexpr std::size_t block = 16384;
+    std::vector<double> sums((f_count + block - 1) / block, 0.0);
+    parallel_blocks(sums.size(), 1, [&](std::size_t first, std::size_t last) {
+        for (std::size_t b = first; b < last; ++b)
+        {
+            double sum = 0.0;
+            for (std::size_t f = b * block; f < std::min(f_count, (b + 1) * block); ++f)
+            {
+                Aabb box;
+                for (const std::uint32_t v : mesh.triangles[f])
+                    box.extend(mesh.vertices.positions[v].cast<double>());
+                sum += half_area(box);
+            }
+            sums[b] = sum;
+        }
+    });
+    double sum = 0.0;
+    for (const double s : sums)
+        sum += s;
+    return sum / total;
+}
+
+void check_query_work(const TriMesh& mesh, std::size_t queries, std::string_view what,
+                      double work_limit)
+{
+    constexpr double depth_limit = 64.0;
+    if (mesh.face_count() == 0 || queries == 0)
+        return;
+    const double depth = triangle_box_depth(mesh);
+    const double work = depth * static_cast<double>(queries);
+    if (depth <= depth_limit || work <= work_limit)
+        return;
+    char figures[160];
+    std::snprintf(figures, sizeof figures,
+                  "each of %zu queries would test about %.0f of its %zu triangles (%.2g tests)",
+                  queries, depth, mesh.face_count(), work);
+    throw InvalidInput(std::string(what) +
+                       ": the mesh's triangles are long slivers whose bounding boxes overlap (as "
+                       "in a polygon of many vertices triangulated as a fan): " +
+                       figures + "; remesh or retriangulate it first");
 }
 
 Aabb TriangleBvh::bounds() const

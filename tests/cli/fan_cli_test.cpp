@@ -72,6 +72,22 @@ TEST_P(FanCli, RemeshRefusesTheMillionGonWithAClearMessage)
     EXPECT_FALSE(std::filesystem::exists(output));
 }
 
+TEST_P(FanCli, DistanceAndRenderRefuseTheMillionGonWithAClearMessage)
+{
+    // Its slivers' boxes overlap about n / (2π) deep: a query anywhere tests ~159,000 triangles.
+    const test::TempDir dir;
+    const auto input = dir / ("fan." + GetParam());
+    write_fan(input, n);
+    const auto distance = run("distance " + quoted(input) + " " + quoted(input));
+    EXPECT_EQ(distance.exit_code, 2) << distance.out;
+    EXPECT_NE(distance.out.find("retriangulate"), std::string::npos) << distance.out;
+    const auto image = dir / "fan.png";
+    const auto render = run("render " + quoted(input) + " -o " + quoted(image));
+    EXPECT_EQ(render.exit_code, 2) << render.out;
+    EXPECT_NE(render.out.find("retriangulate"), std::string::npos) << render.out;
+    EXPECT_FALSE(std::filesystem::exists(image));
+}
+
 INSTANTIATE_TEST_SUITE_P(Formats, FanCli, ::testing::Values("off", "ply", "obj"));
 
 TEST(FanCliSmall, RemeshProcessesAFanWithinTheLimit)
@@ -96,6 +112,23 @@ TEST(FanCliSmall, RemeshProcessesAFanWithinTheLimit)
         EXPECT_NEAR(p.z(), 0.0, 1e-3);
         EXPECT_LE(p.head<2>().norm(), 1.0 + 1e-3);
     }
+}
+
+TEST(FanCliSmall, DistanceAndRenderMeasureAndDrawASmallerFan)
+{
+    // A 2,000-gon (depth 318) is within the work budget: measured exactly (a fan against the
+    // same polygon: every distance 0) and drawn.
+    const test::TempDir dir;
+    const auto input = dir / "fan.off";
+    test::write_polygon_fan_off(input, 2000);
+    const auto distance = run("distance " + quoted(input) + " " + quoted(input) + " --json");
+    ASSERT_EQ(distance.exit_code, 0) << distance.out;
+    const auto json = nlohmann::json::parse(distance.out);
+    EXPECT_LT(json["absolute"]["hausdorff"].get<double>(), 1e-6) << distance.out;
+    const auto image = dir / "fan.png";
+    const auto render = run("-q render " + quoted(input) + " -o " + quoted(image));
+    ASSERT_EQ(render.exit_code, 0) << render.out;
+    EXPECT_TRUE(std::filesystem::exists(image));
 }
 
 TEST(FanCliHierarchy, LodAndInfoReadAHierarchyWhoseBaseIsAFan)

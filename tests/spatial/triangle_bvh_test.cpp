@@ -9,6 +9,7 @@
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 
+#include "support/polygon_fan.h"
 #include "support/thread_counts.h"
 
 #include <gtest/gtest.h>
@@ -16,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <vector>
 
@@ -301,6 +303,72 @@ TEST(TriangleBvh, BatchMatchesSingleWhateverTheThreadCount)
     ASSERT_EQ(distances.size(), queries.size());
     for (std::size_t i = 0; i < queries.size(); ++i)
         EXPECT_EQ(distances[i], bvh.distance(cloud.world(i)));
+}
+
+TEST(TriangleBoxDepth, AnalyticValues)
+{
+    // A 20 x 20 grid of [-1, 1]²: 800 triangles whose boxes are the 0.1 x 0.1 cells, twice
+    // over, in a 2 x 2 box: depth 800 × 0.01 / 4 = 2.
+    constexpr std::uint32_t n = 20;
+    TriMesh grid;
+    for (std::uint32_t j = 0; j <= n; ++j)
+        for (std::uint32_t i = 0; i <= n; ++i)
+            grid.vertices.positions.emplace_back(-1.0F + 2.0F * static_cast<float>(i) / n,
+                                                 -1.0F + 2.0F * static_cast<float>(j) / n, 0.0F);
+    for (std::uint32_t j = 0; j < n; ++j)
+        for (std::uint32_t i = 0; i < n; ++i)
+        {
+            const std::uint32_t v = j * (n + 1) + i;
+            grid.triangles.push_back({v, v + 1, v + n + 2});
+            grid.triangles.push_back({v, v + n + 2, v + n + 1});
+        }
+    EXPECT_NEAR(triangle_box_depth(grid), 2.0, 1e-5);
+
+    // An n-gon fanned from vertex (1, 0): the sliver to the edge at angle φ has a box of area
+    // (1 − cos φ)|sin φ|, whose mean over φ is 2/π; the whole box is 2 x 2, so the depth is
+    // (n − 2)(2/π)/4 = (n − 2)/(2π).
+    for (const std::size_t vertices : {1000U, 100000U})
+    {
+        const double expected = static_cast<double>(vertices - 2) / (2.0 * std::numbers::pi);
+        EXPECT_NEAR(triangle_box_depth(test::polygon_fan_mesh(vertices)), expected,
+                    0.01 * expected);
+    }
+
+    // All triangles on one point: every query tests them all.
+    TriMesh point;
+    point.vertices.positions = {Vec3f(1, 2, 3)};
+    point.triangles = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    EXPECT_EQ(triangle_box_depth(point), 3.0);
+
+    TriMesh bad = point;
+    bad.triangles.push_back({0, 0, 1});
+    EXPECT_THROW((void)triangle_box_depth(bad), InvalidInput);
+}
+
+TEST(TriangleBoxDepth, QueryWorkRefusesOnlyOverlappingSliversAtScale)
+{
+    const TriMesh fan = test::polygon_fan_mesh(100000); // depth 15,915
+    EXPECT_NO_THROW(check_query_work(fan, 1000, "test"));  // 1.6e7 tests
+    EXPECT_NO_THROW(check_query_work(fan, 60000, "test")); // 9.5e8 tests
+    try
+    {
+        check_query_work(fan, 200000, "point-to-mesh distance"); // 3.2e9 tests
+        ADD_FAILURE() << "the 100,000-gon's fan was not refused";
+    }
+    catch (const InvalidInput& e)
+    {
+        const std::string message = e.what();
+        EXPECT_NE(message.find("point-to-mesh distance"), std::string::npos) << message;
+        EXPECT_NE(message.find("15916 of its 99998 triangles"), std::string::npos) << message;
+        EXPECT_NE(message.find("retriangulate"), std::string::npos) << message;
+    }
+    // A larger budget admits it. A 1,000-gon (depth 159) at a million queries is 1.6e8 tests:
+    // within the budget.
+    EXPECT_NO_THROW(check_query_work(fan, 200000, "test", 1e10));
+    EXPECT_NO_THROW(check_query_work(test::polygon_fan_mesh(1000), 1000000, "test"));
+    // Well-shaped meshes are never refused, however many queries.
+    const TriMesh triangle = test::polygon_fan_mesh(3); // depth 1
+    EXPECT_NO_THROW(check_query_work(triangle, std::size_t{1} << 40, "test"));
 }
 
 TEST(TriangleBvh, BadInputIsRejected)
