@@ -347,7 +347,7 @@ TEST(TriangleBoxDepth, AnalyticValues)
 
 TEST(TriangleBoxDepth, QueryWorkRefusesOnlyOverlappingSliversAtScale)
 {
-    const TriMesh fan = test::polygon_fan_mesh(100000); // depth 15,915
+    const TriMesh fan = test::polygon_fan_mesh(100000);    // depth 15,915
     EXPECT_NO_THROW(check_query_work(fan, 1000, "test"));  // 1.6e7 tests
     EXPECT_NO_THROW(check_query_work(fan, 60000, "test")); // 9.5e8 tests
     try
