@@ -141,6 +141,47 @@ std::uint64_t edge_key(const Coord& base, int axis)
 /// faces, each directed with the inside on its right as seen from outside the cube; a face with
 /// two diagonal inside corners is split by the asymptotic decider. Every crossed edge starts one
 /// segment and ends another, so the segments close into loops, which are fanned into triangles.
+/// The key of a cell's own vertex, which triangulate_cell() adds where a loop cannot be cut into
+/// triangles without a chord on an upper face: axis 3 after the cell's lowest corner. It lies on
+/// the zero crossing between two of the cell's corners of opposite sign (cell_vertex_corners).
+std::uint64_t cell_vertex_key(const Coord& cell)
+{
+    return pack(cell) << 2 | 3U;
+}
+
+/// The two corners whose segment holds a cell's own vertex: the first of the cube's four
+/// diagonals (corner c to 7 − c, c = 0 … 3) with one end inside, else the first pair (c, d), c < d,
+/// in order, with one end inside. \pre the corners are not all on one side
+std::pair<int, int> cell_vertex_corners(const std::array<float, 8>& value)
+{
+    const auto inside = [&](int c) {
+        return value[static_cast<std::size_t>(c)] < 0.0F;
+    };
+    for (int c = 0; c < 4; ++c)
+    {
+        if (inside(c) != inside(7 - c))
+        {
+            return {c, 7 - c};
+        }
+    }
+    for (int c = 0; c < 8; ++c)
+    {
+        for (int d = c + 1; d < 8; ++d)
+        {
+            if (inside(c) != inside(d))
+            {
+                return {c, d};
+            }
+        }
+    }
+    return {0, 7};
+}
+
+/// Costs of a loop's chord on a face of the cube (triangulate_cell): on a lower face (its cell
+/// alone draws it), on an upper face (the neighbour across may draw it too).
+constexpr int lower_face_chord = 1;
+constexpr int upper_face_chord = 1000;
+
 void triangulate_cell(const Coord& cell, const std::array<float, 8>& value,
                       std::vector<std::uint64_t>& out)
 {
@@ -235,42 +276,89 @@ void triangulate_cell(const Coord& cell, const std::array<float, 8>& value,
             const auto ue = static_cast<std::size_t>(e);
             return edge_key(corner_of(cell, t.edge_base[ue]), t.edge_axis[ue]);
         };
-        // A chord between two vertices on one face of the cube (two crossings of an ambiguous
-        // face) could be drawn by the neighbouring cell too, giving an edge with four
-        // triangles; clip ears whose chord is not on a face.
-        auto shares_face = [&](int a, int b) {
-            const auto& fa = t.edge_face[static_cast<std::size_t>(a)];
-            const auto& fb = t.edge_face[static_cast<std::size_t>(b)];
-            return fa[0] == fb[0] || fa[0] == fb[1] || fa[1] == fb[0] || fa[1] == fb[1];
-        };
+        // A chord between two vertices on one face of the cube (crossings of an ambiguous face)
+        // could be drawn by the cell across that face too, giving an edge with four triangles.
+        // The loop is triangulated by dynamic programming over its chords: none on a face if
+        // that is possible; else chords on the cube's lower faces only (−x, −y, −z), which the
+        // neighbour across them, whose upper faces they are, never draws; an upper face's chord
+        // only where nothing else triangulates the loop (counted by the caller's check).
         auto emit = [&](int a, int b, int c) {
             out.push_back(key(a));
             out.push_back(key(b));
             out.push_back(key(c));
         };
-        while (n > 3)
-        {
-            std::size_t ear = n;
-            for (std::size_t i = 0; i < n && ear == n; ++i)
+        auto chord_cost = [&](std::size_t i, std::size_t j) {
+            if (j == i + 1 || (i == 0 && j == n - 1))
             {
-                if (!shares_face(loop[(i + n - 1) % n], loop[(i + 1) % n]))
+                return 0; // a side of the loop, not a chord
+            }
+            const auto& fa = t.edge_face[static_cast<std::size_t>(loop[i])];
+            const auto& fb = t.edge_face[static_cast<std::size_t>(loop[j])];
+            int cost = 0;
+            for (const int a : fa)
+            {
+                for (const int b : fb)
                 {
-                    ear = i;
+                    if (a == b)
+                    {
+                        cost = std::max(cost, (a & 1) != 0 ? upper_face_chord : lower_face_chord);
+                    }
                 }
             }
-            if (ear == n)
-            {
-                ear = 0; // no chord avoids the faces; never seen, but stay total
-            }
-            emit(loop[(ear + n - 1) % n], loop[ear], loop[(ear + 1) % n]);
-            std::copy(loop.begin() + static_cast<std::ptrdiff_t>(ear) + 1,
-                      loop.begin() + static_cast<std::ptrdiff_t>(n),
-                      loop.begin() + static_cast<std::ptrdiff_t>(ear));
-            --n;
-        }
-        if (n == 3)
+            return cost;
+        };
+        // best[i][j]: least cost of triangulating loop[i..j] closed by the chord (i, j);
+        // split[i][j]: its apex k (the first of the least).
+        std::array<std::array<int, 12>, 12> best{};
+        std::array<std::array<std::uint8_t, 12>, 12> split{};
+        for (std::size_t length = 2; length < n; ++length)
         {
-            emit(loop[0], loop[1], loop[2]);
+            for (std::size_t i = 0; i + length < n; ++i)
+            {
+                const std::size_t j = i + length;
+                int least = std::numeric_limits<int>::max();
+                for (std::size_t k = i + 1; k < j; ++k)
+                {
+                    const int cost = best[i][k] + best[k][j] + chord_cost(i, k) + chord_cost(k, j);
+                    if (cost < least)
+                    {
+                        least = cost;
+                        split[i][j] = static_cast<std::uint8_t>(k);
+                    }
+                }
+                best[i][j] = least;
+            }
+        }
+        if (n > 3 && best[0][n - 1] >= upper_face_chord)
+        {
+            // Every triangulation of the loop (a tunnel through an ambiguous upper face) draws a
+            // chord the neighbour may draw too: fan it around a vertex of its own inside the
+            // cell instead (on a diagonal of the cube, see cell_vertex_key).
+            const std::uint64_t centre = cell_vertex_key(cell);
+            for (std::size_t i = 0; i < n; ++i)
+            {
+                out.push_back(key(loop[i]));
+                out.push_back(key(loop[(i + 1) % n]));
+                out.push_back(centre);
+            }
+        }
+        else if (n >= 3)
+        {
+            std::array<std::pair<std::uint8_t, std::uint8_t>, 12> pending{};
+            std::size_t top = 0;
+            pending[top++] = {0, static_cast<std::uint8_t>(n - 1)};
+            while (top > 0)
+            {
+                const auto [i, j] = pending[--top];
+                if (j < i + 2)
+                {
+                    continue;
+                }
+                const std::uint8_t k = split[i][j];
+                emit(loop[i], loop[k], loop[j]);
+                pending[top++] = {i, k};
+                pending[top++] = {k, j};
+            }
         }
     }
 }
@@ -720,6 +808,12 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
         sort_unique(frontier);
     }
 
+    if (options.min_defined_corners < 1 || options.min_defined_corners > 8)
+    {
+        throw InvalidInput("marching cubes: min_defined_corners must be 1 to 8, not " +
+                           std::to_string(options.min_defined_corners));
+    }
+    const int min_defined = options.min_defined_corners;
     ProgressReporter progress(options.progress, "marching cubes");
     std::vector<std::uint64_t> surface_cells;
     std::vector<Vec3d> points;
@@ -838,13 +932,14 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
                 {
                     const Coord cell = unpack(wave[w]);
                     int mask = 0;
-                    bool all_defined = true;
+                    int defined_corners = 0;
                     for (int c = 0; c < 8; ++c)
                     {
                         const SparseGrid::Slot s = store.find(corner_of(cell, c));
-                        all_defined = all_defined && (*s.state & defined) != 0;
+                        defined_corners += (*s.state & defined) != 0 ? 1 : 0;
                         mask |= (*s.value < 0.0F ? 1 : 0) << c;
                     }
+                    const bool all_defined = defined_corners == 8;
                     if (mask == 0 || mask == 255)
                     {
                         // A seed whose cell the surface only touches (e.g. at an extreme
@@ -864,7 +959,7 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
                         }
                         continue;
                     }
-                    if (!all_defined)
+                    if (defined_corners < min_defined)
                     {
                         ++undefined_count;
                         continue;
@@ -957,6 +1052,24 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
         const Coord base = unpack(edges[v] >> 2);
         const auto axis = static_cast<std::size_t>(edges[v] & 3);
         Coord tip = base;
+        if (axis == 3)
+        {
+            // A cell's own vertex: on the segment between two of its corners.
+            std::array<float, 8> value{};
+            for (int c = 0; c < 8; ++c)
+            {
+                value[static_cast<std::size_t>(c)] = *store.find(corner_of(base, c)).value;
+            }
+            const auto [from, to] = cell_vertex_corners(value);
+            const Coord a = corner_of(base, from);
+            const Coord b = corner_of(base, to);
+            a_point[v] = grid_point(grid, a);
+            b_point[v] = grid_point(grid, b);
+            lo_f[v] = value[static_cast<std::size_t>(from)];
+            hi_f[v] = value[static_cast<std::size_t>(to)];
+            ++stats.cell_vertices;
+            continue;
+        }
         tip[axis] += 1;
         a_point[v] = grid_point(grid, base);
         b_point[v] = grid_point(grid, tip);

@@ -230,6 +230,38 @@ TEST(MarchingCubes, AmbiguousFacesResolveToAManifold)
     }
 }
 
+TEST(MarchingCubes, TunnelsThroughAmbiguousFacesStayManifold)
+{
+    // Random values at the grid corners themselves (cells of one lattice cell): every one of the
+    // 256 corner patterns occurs, tunnels through ambiguous faces too, where a cell's loop
+    // cannot be cut into triangles without a chord on a face. Cut on a face that the
+    // neighbour's loop also needs, it made an edge of four triangles (found on a noisy scan of
+    // a plate); such a loop is fanned around a vertex inside its cell instead.
+    std::size_t cell_vertices = 0;
+    for (std::uint64_t seed = 1; seed <= 6; ++seed)
+    {
+        const RandomLatticeField field(24, seed);
+        const CellGrid grid = grid_over(field.bounds(), 1.0);
+        const auto result = marching_cubes(field, grid, {.refine_steps = 40});
+        const MeshTopology topo = analyze_topology(result.mesh);
+        EXPECT_GT(topo.faces, 10000U);
+        EXPECT_EQ(topo.non_manifold_edges, 0U) << "seed " << seed;
+        EXPECT_EQ(topo.non_manifold_vertices, 0U) << "seed " << seed;
+        EXPECT_EQ(topo.misoriented_edges, 0U) << "seed " << seed;
+        EXPECT_EQ(topo.degenerate_faces, 0U) << "seed " << seed;
+        cell_vertices += result.stats.cell_vertices;
+        // Every vertex, a cell's own on a diagonal of its cell too, is refined onto the zero set
+        // (within the margin that keeps vertices 1e-4 of a cell off the corners, where the
+        // random values' gradients reach several units).
+        for (std::size_t v = 0; v < result.mesh.vertex_count(); ++v)
+        {
+            const Vec3d p = result.mesh.vertices.world(v);
+            EXPECT_LT(std::abs(field.evaluate(p).value), 1e-3) << "vertex " << v;
+        }
+    }
+    EXPECT_GT(cell_vertices, 0U);
+}
+
 TEST(MarchingCubes, UndefinedCellsLeaveAHole)
 {
     // A sphere whose field is undefined above z = 0.5: the cap is cut away and its rim is the
@@ -261,6 +293,30 @@ TEST(MarchingCubes, UndefinedCellsLeaveAHole)
     {
         ASSERT_LT(result.mesh.vertices.world(v).z(), 0.5);
     }
+
+    // Cells with one defined corner or more (min_defined_corners = 1) reach one cell further:
+    // still a disc, its rim higher, within a cell diagonal of z = 0.5.
+    const auto partial =
+        marching_cubes(field, grid_over(field.bounds(), 0.05), {.min_defined_corners = 1});
+    const MeshTopology partial_topo = analyze_topology(partial.mesh);
+    EXPECT_TRUE(partial_topo.is_oriented_manifold());
+    EXPECT_EQ(partial_topo.boundary_loops, 1U);
+    EXPECT_EQ(partial_topo.euler_characteristic, 1);
+    const auto highest = [](const TriMesh& mesh) {
+        double top = -1.0;
+        for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+        {
+            top = std::max(top, mesh.vertices.world(v).z());
+        }
+        return top;
+    };
+    const double top = highest(partial.mesh);
+    EXPECT_GT(top, highest(result.mesh) + 0.01);
+    EXPECT_LT(top, 0.5 + 0.05 * std::sqrt(3.0) + 1e-6);
+    EXPECT_GT(partial.mesh.face_count(), result.mesh.face_count());
+    EXPECT_THROW(
+        (void)marching_cubes(field, grid_over(field.bounds(), 0.05), {.min_defined_corners = 0}),
+        InvalidInput);
 }
 
 TEST(MarchingCubes, SampledSphereThroughThePointField)

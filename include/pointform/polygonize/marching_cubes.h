@@ -58,6 +58,13 @@ struct MarchingCubesOptions
     int refine_steps = 3;
     /// Store the normalised field gradient at each vertex as its normal.
     bool vertex_normals = true;
+    /// A cell the zero set crosses makes triangles when at least this many of its corners are
+    /// defined (1 to 8); its undefined corners count by their sign (for a PointField, the side of
+    /// the nearest sample's surface). 8, the default: holes in the samples stay open as the
+    /// field has them. A grid coarser than the samples' influence radii (an intermediate mesh
+    /// for the base mesh) has undefined corners next to the surface everywhere; 1 closes the
+    /// surface there and still leaves holes wider than a cell open.
+    int min_defined_corners = 8;
     ProgressCallback progress;
 };
 
@@ -74,6 +81,10 @@ struct MarchingCubesStats
     /// Those of degenerate_triangles that no flip could mend; kept, so the surface stays closed.
     std::size_t degenerate_kept = 0;
     std::size_t split_vertices = 0; ///< copies made where two sheets touched at a vertex
+    /// Vertices inside a cell: where a tunnel through an ambiguous face leaves no way to cut the
+    /// cell's loop into triangles without a chord that the neighbouring cell may draw too, the
+    /// loop is fanned around a vertex of its own, on the zero crossing of a diagonal of the cell.
+    std::size_t cell_vertices = 0;
     bool dense = false; ///< the field gave no seeds, so every cell of the grid was visited
 };
 
@@ -91,7 +102,8 @@ struct MarchingCubesResult
 /// million field evaluations, not 512³. A field without seeds is swept densely.
 ///
 /// Inside is f < 0 (a corner with f = 0 counts as outside). A cell with an undefined corner makes
-/// no triangles, so holes in the samples stay open. Each cell's surface is built from the
+/// no triangles (see MarchingCubesOptions::min_defined_corners), so holes in the samples stay
+/// open. Each cell's surface is built from the
 /// segments the zero set draws on its six faces; a face with two diagonal inside corners is
 /// resolved by the asymptotic decider, which depends only on that face's four values, so the two
 /// cells sharing the face always agree and the mesh is a 2-manifold (with boundary where the
