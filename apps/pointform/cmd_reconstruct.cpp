@@ -51,6 +51,7 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
     std::optional<BaseMeshStats> base_stats;
     std::optional<PickedBaseMesh> picked;
     double cell = 0.0;
+    double coarsening = 1.0;
     std::size_t intermediate_faces = 0;
     ComponentFilterReport debris;
     std::size_t intermediate_vertices = 0;
@@ -65,17 +66,25 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
     else
     {
         cell = options.cell;
+        // The field's cell; without --cell or --resolution, the intermediate mesh's grid is
+        // coarsened where the field's would make more faces than the base mesh needs.
+        IntermediateGrid intermediate{.cell = cell};
         if (options.resolution > 0)
         {
-            cell = cell_for_resolution(input.surfels.bounds(), options.resolution);
+            intermediate.cell = cell_for_resolution(input.surfels.bounds(), options.resolution);
         }
         else if (cell <= 0.0)
         {
-            cell = default_cell_size(field);
+            intermediate = intermediate_grid(field, default_cell_size(field));
         }
+        cell = intermediate.cell;
+        coarsening = intermediate.coarsening;
         const CellGrid grid = grid_over(field.bounds(), cell);
         check_marching_cubes_memory(field, cell);
-        MarchingCubesResult mc = marching_cubes(field, grid, {.progress = progress.callback()});
+        MarchingCubesResult mc =
+            marching_cubes(field, grid,
+                           {.min_defined_corners = intermediate.min_defined_corners,
+                            .progress = progress.callback()});
         timings.lap("marching cubes");
         if (mc.mesh.face_count() == 0)
         {
@@ -93,7 +102,8 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
                                           : default_min_component_samples(field.surfels().size()));
         timings.lap("debris");
         const std::size_t target =
-            base_face_target(options.refine, mc.mesh, default_base_share, input.surfels.size());
+            base_face_target(options.refine, mc.mesh, default_base_share, input.surfels.size(),
+                             coarsening);
         if (options.refine.levels)
         {
             check_refinement_memory(target, static_cast<std::size_t>(*options.refine.levels));
@@ -117,6 +127,7 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
         if (base_stats)
         {
             out["cell"] = cell;
+            out["intermediate_coarsening"] = coarsening;
             out["intermediate_faces"] = intermediate_faces;
             out["intermediate_vertices"] = intermediate_vertices;
             out["degenerate_triangles"] = degenerate_triangles;
@@ -159,7 +170,11 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
     {
         print_row("intermediate mesh",
                   std::to_string(intermediate_faces) + " faces (marching cubes, cell " +
-                      format_number(cell) + ", " + options.fit + " field; degenerate " +
+                      format_number(cell) +
+                      (coarsening > 1.0
+                           ? " = " + format_number(coarsening) + " x the field's, for the base mesh"
+                           : std::string()) +
+                      ", " + options.fit + " field; degenerate " +
                       describe_degenerate(degenerate_triangles, degenerate_kept) + ")");
         print_row("debris", "removed " + std::to_string(debris.removed_components) + " of " +
                                 std::to_string(debris.components) + " components (" +

@@ -268,11 +268,11 @@ CLI::Option* add_base_faces_option(CLI::App& cmd, SemiRegularOptions& options)
 }
 
 std::size_t base_face_target(const SemiRegularOptions& options, const TriMesh& intermediate,
-                             std::size_t share, std::size_t samples)
+                             std::size_t share, std::size_t samples, double coarsening)
 {
     if (!options.base_faces)
     {
-        const std::size_t target = default_base_faces(intermediate, share);
+        const std::size_t target = default_base_faces(intermediate, share, coarsening);
         if (samples == 0 || options.levels || parse_stop_rule(options.stop) != StopRule::Automatic)
         {
             return target;

@@ -58,12 +58,13 @@ CLI::Option* add_base_faces_option(CLI::App& cmd, SemiRegularOptions& options);
 /// \brief The automatic base-face target for `intermediate`: --base-faces (checked: at least 1
 /// and at most the intermediate mesh's faces) or default_base_faces() with `share`; without
 /// --levels and with the automatic stop, that default is fitted to the vertex budget
-/// `samples` (fit_base_faces_to_budget) when `samples` > 0.
+/// `samples` (fit_base_faces_to_budget) when `samples` > 0. `coarsening`: that of the
+/// intermediate mesh's grid (intermediate_grid()).
 /// \throw InvalidInput with the option's name
 [[nodiscard]] std::size_t base_face_target(const SemiRegularOptions& options,
                                            const TriMesh& intermediate,
                                            std::size_t share = default_base_share,
-                                           std::size_t samples = 0);
+                                           std::size_t samples = 0, double coarsening = 1.0);
 
 /// \brief Refuses, before anything is allocated, a level whose F0·4^J faces would not fit in
 /// memory (check_memory(): the cgroup limit or MemAvailable) or in 32-bit indices.

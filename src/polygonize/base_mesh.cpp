@@ -598,10 +598,13 @@ void relax_and_project(const OmMesh& mesh, const Field& field, bool relax, Verte
     state.on_surface = std::move(next_on);
 }
 
-std::size_t default_base_faces(std::size_t faces, std::size_t components, std::size_t share)
+std::size_t default_base_faces(std::size_t faces, std::size_t components, std::size_t share,
+                               double coarsening)
 {
     const std::size_t lower = std::max<std::size_t>(200, 8 * components);
-    return std::min(std::clamp<std::size_t>(faces / share, lower, 20000), faces);
+    const double equivalent = static_cast<double>(faces) * coarsening * coarsening;
+    const auto wanted = static_cast<std::size_t>(std::min(equivalent / static_cast<double>(share), 1e12));
+    return std::min(std::clamp<std::size_t>(wanted, lower, 20000), faces);
 }
 
 std::string describe_topology_change(const MeshTopology& before, const MeshTopology& after)
@@ -638,11 +641,12 @@ std::size_t fit_base_faces_to_budget(std::size_t target, std::size_t vertex_budg
     return std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(fitted)));
 }
 
-std::size_t default_base_faces(const TriMesh& intermediate, std::size_t share)
+std::size_t default_base_faces(const TriMesh& intermediate, std::size_t share, double coarsening)
 {
     PF_ASSERT(share >= 1);
+    PF_ASSERT(coarsening >= 1.0);
     return default_base_faces(intermediate.face_count(), analyze_topology(intermediate).components,
-                              share);
+                              share, coarsening);
 }
 
 MeshTopology check_intermediate_mesh(const TriMesh& intermediate)
@@ -695,7 +699,7 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
     stats.target_faces =
         options.target_faces
             ? *options.target_faces
-            : default_base_faces(stats.input_faces, before.components, default_base_share);
+            : default_base_faces(stats.input_faces, before.components, default_base_share, 1.0);
     if (stats.target_faces == 0)
     {
         throw InvalidInput("base mesh: the target face count must be at least 1, got 0");

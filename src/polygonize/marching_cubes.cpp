@@ -538,6 +538,29 @@ double default_cell_size(const PointField& field)
     return 0.4 * field.median_radius();
 }
 
+double estimate_marching_cubes_faces(double surface_area, double cell)
+{
+    return 3.0 * surface_area / (cell * cell);
+}
+
+IntermediateGrid intermediate_grid(const PointField& field, double cell, double max_faces)
+{
+    if (!(cell > 0.0) || !std::isfinite(cell) || !(max_faces > 0.0) || !std::isfinite(max_faces))
+    {
+        throw InvalidInput("intermediate grid: the cell and the face limit must be positive");
+    }
+    IntermediateGrid out;
+    out.estimated_faces = estimate_marching_cubes_faces(field.estimated_area(), cell);
+    out.cell = cell;
+    if (out.estimated_faces > max_faces)
+    {
+        out.coarsening = std::sqrt(out.estimated_faces / max_faces);
+        out.cell = cell * out.coarsening;
+        out.min_defined_corners = 1;
+    }
+    return out;
+}
+
 double estimate_marching_cubes_bytes(double surface_area, double cell)
 {
     // A surface of area A cuts about 1.5 A / h² cells (the mean of |nx| + |ny| + |nz|); each
@@ -1229,6 +1252,63 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
             const auto it =
                 std::lower_bound(edges.begin(), edges.end(), corners_of_triangles[3 * f + j]);
             mesh.triangles[f][j] = static_cast<std::uint32_t>(it - edges.begin());
+        }
+    }
+    if (options.min_defined_corners < 8 && nv > 0)
+    {
+        // Cells with undefined corners reach past the field's defined region (a hole's rim):
+        // there the triangles with a vertex where the field is undefined are dropped, so holes
+        // stay as the field has them, and the vertices left unused are removed.
+        std::vector<FieldSample> at_vertices(nv);
+        evaluate_near_zero(field, exact_range, points, at_vertices);
+        stats.field_evaluations += nv;
+        std::size_t kept = 0;
+        for (const Triangle& t : mesh.triangles)
+        {
+            if (at_vertices[t[0]].defined && at_vertices[t[1]].defined &&
+                at_vertices[t[2]].defined)
+            {
+                mesh.triangles[kept++] = t;
+            }
+        }
+        stats.undefined_triangles = mesh.triangles.size() - kept;
+        mesh.triangles.resize(kept);
+        if (stats.undefined_triangles > 0)
+        {
+            std::vector<std::uint32_t> remap(nv, std::numeric_limits<std::uint32_t>::max());
+            for (const Triangle& t : mesh.triangles)
+            {
+                for (const std::uint32_t v : t)
+                {
+                    remap[v] = 0;
+                }
+            }
+            std::uint32_t next = 0;
+            for (std::size_t v = 0; v < nv; ++v)
+            {
+                if (remap[v] == 0)
+                {
+                    remap[v] = next;
+                    mesh.vertices.positions[next] = mesh.vertices.positions[v];
+                    if (options.vertex_normals)
+                    {
+                        mesh.vertices.normals[next] = mesh.vertices.normals[v];
+                    }
+                    ++next;
+                }
+            }
+            mesh.vertices.positions.resize(next);
+            if (options.vertex_normals)
+            {
+                mesh.vertices.normals.resize(next);
+            }
+            for (Triangle& t : mesh.triangles)
+            {
+                for (std::uint32_t& v : t)
+                {
+                    v = remap[v];
+                }
+            }
         }
     }
     repair_degenerate_triangles(mesh, grid.cell, stats);

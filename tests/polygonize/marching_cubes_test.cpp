@@ -385,6 +385,64 @@ TEST(MarchingCubes, RemovedCapStaysOpenAtASmallRadiusAndClosesAtALargeOne)
     EXPECT_EQ(closed_topo.euler_characteristic, 2);
 }
 
+TEST(MarchingCubes, IntermediateGridIsCoarsenedToTheFaceLimitAndKeepsHolesOpen)
+{
+    // The estimate 3 A / h² against the mesh at the field's own cell.
+    const PointCloud samples = sample_shape(Shape::Sphere, {.count = 20000, .seed = 8});
+    const PointField field(
+        compute_surfels(samples, {.radius_scale = default_field_radius_scale}).surfels);
+    const double cell = default_cell_size(field);
+    const IntermediateGrid own = intermediate_grid(field, cell);
+    EXPECT_EQ(own.coarsening, 1.0);
+    EXPECT_EQ(own.cell, cell);
+    EXPECT_EQ(own.min_defined_corners, 8);
+    const auto fine = marching_cubes(field, grid_over(field.bounds(), cell));
+    const auto fine_faces = static_cast<double>(fine.mesh.face_count());
+    EXPECT_NEAR(own.estimated_faces, fine_faces, 0.15 * fine_faces);
+
+    // A limit of a sixteenth: a grid four times coarser, whose corners lie beyond the influence
+    // radii, still gives one closed sphere of about that many faces, on the surface.
+    const IntermediateGrid coarse = intermediate_grid(field, cell, own.estimated_faces / 16.0);
+    EXPECT_NEAR(coarse.coarsening, 4.0, 1e-9);
+    EXPECT_LT(coarse.min_defined_corners, 8);
+    const auto mesh = marching_cubes(field, grid_over(field.bounds(), coarse.cell),
+                                     {.min_defined_corners = coarse.min_defined_corners});
+    const MeshTopology topo = analyze_topology(mesh.mesh);
+    EXPECT_TRUE(topo.is_oriented_manifold());
+    EXPECT_TRUE(topo.is_closed());
+    EXPECT_EQ(topo.euler_characteristic, 2);
+    EXPECT_NEAR(static_cast<double>(mesh.mesh.face_count()), fine_faces / 16.0,
+                0.25 * fine_faces / 16.0);
+    for (std::size_t v = 0; v < mesh.mesh.vertex_count(); ++v)
+    {
+        ASSERT_NEAR(mesh.mesh.vertices.world(v).norm(), 1.0, 0.05 * coarse.cell);
+    }
+    // Without the looser corners, the coarse grid's mesh falls apart.
+    const auto strict = marching_cubes(field, grid_over(field.bounds(), coarse.cell));
+    EXPECT_GT(analyze_topology(strict.mesh).boundary_loops, 0U);
+
+    // A sphere without its cap above z = 0.8: the coarse mesh keeps the hole (the triangles
+    // reaching past the field's rim are dropped), within a coarse cell of where the fine one has
+    // it.
+    const PointField capless(capless_sphere(1.5));
+    const double capless_cell = default_cell_size(capless);
+    const IntermediateGrid holed = intermediate_grid(
+        capless, capless_cell, intermediate_grid(capless, capless_cell).estimated_faces / 9.0);
+    const auto open = marching_cubes(capless, grid_over(capless.bounds(), holed.cell),
+                                     {.min_defined_corners = holed.min_defined_corners});
+    const MeshTopology open_topo = analyze_topology(open.mesh);
+    EXPECT_TRUE(open_topo.is_oriented_manifold());
+    EXPECT_EQ(open_topo.boundary_loops, 1U);
+    EXPECT_EQ(open_topo.euler_characteristic, 1);
+    EXPECT_GT(open.stats.undefined_triangles, 0U);
+    const auto& radii = capless.surfels().radii;
+    const double reach = 0.8 + static_cast<double>(*std::max_element(radii.begin(), radii.end()));
+    for (std::size_t v = 0; v < open.mesh.vertex_count(); ++v)
+    {
+        ASSERT_LT(open.mesh.vertices.world(v).z(), reach);
+    }
+}
+
 TEST(MarchingCubes, SameMeshWhateverTheThreadCount)
 {
     const PointCloud samples = sample_shape(Shape::Torus, {.count = 20000, .seed = 2});

@@ -101,9 +101,11 @@ inline constexpr std::size_t default_base_share = 64;
 /// Measured on the sampled bunny (121.8k marching-cubes faces), distance from the samples to M⁰
 /// in % of the bounding-box diagonal, mean (max): faces/16 → 0.06 (0.96), faces/64 → 0.18
 /// (2.3), faces/256 → 0.61 (8.8); /64 keeps the shape of the ears and paws, /256 reduces the
-/// ears to a few triangles.
+/// ears to a few triangles. An intermediate mesh made on a grid coarser than the field's by
+/// `coarsening` (intermediate_grid()) counts as coarsening² times its faces.
 [[nodiscard]] std::size_t default_base_faces(const TriMesh& intermediate,
-                                             std::size_t share = default_base_share);
+                                             std::size_t share = default_base_share,
+                                             double coarsening = 1.0);
 
 /// \brief Moves a base-face target by at most a factor of two so that some refinement level of
 /// it has about `fill` of a vertex budget: the level J nearest to log₄(2·fill·budget / target),
