@@ -101,9 +101,8 @@ void run_reconstruct(const ReconstructOptions& options, const GlobalOptions& glo
             options.min_component_samples ? static_cast<std::size_t>(*options.min_component_samples)
                                           : default_min_component_samples(field.surfels().size()));
         timings.lap("debris");
-        const std::size_t target =
-            base_face_target(options.refine, mc.mesh, default_base_share, input.surfels.size(),
-                             coarsening);
+        const std::size_t target = base_face_target(options.refine, mc.mesh, default_base_share,
+                                                    input.surfels.size(), coarsening);
         if (options.refine.levels)
         {
             check_refinement_memory(target, static_cast<std::size_t>(*options.refine.levels));

@@ -603,7 +603,8 @@ std::size_t default_base_faces(std::size_t faces, std::size_t components, std::s
 {
     const std::size_t lower = std::max<std::size_t>(200, 8 * components);
     const double equivalent = static_cast<double>(faces) * coarsening * coarsening;
-    const auto wanted = static_cast<std::size_t>(std::min(equivalent / static_cast<double>(share), 1e12));
+    const auto wanted =
+        static_cast<std::size_t>(std::min(equivalent / static_cast<double>(share), 1e12));
     return std::min(std::clamp<std::size_t>(wanted, lower, 20000), faces);
 }
 

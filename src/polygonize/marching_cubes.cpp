@@ -1265,8 +1265,7 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
         std::size_t kept = 0;
         for (const Triangle& t : mesh.triangles)
         {
-            if (at_vertices[t[0]].defined && at_vertices[t[1]].defined &&
-                at_vertices[t[2]].defined)
+            if (at_vertices[t[0]].defined && at_vertices[t[1]].defined && at_vertices[t[2]].defined)
             {
                 mesh.triangles[kept++] = t;
             }

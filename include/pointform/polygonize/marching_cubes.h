@@ -60,9 +60,9 @@ inline constexpr double max_intermediate_faces = 640000.0;
 /// simplified from (§5.1, Fig. 5).
 struct IntermediateGrid
 {
-    double cell = 0.0;           ///< the grid's cell
-    double coarsening = 1.0;     ///< cell over the field's cell; 1 keeps the field's own grid
-    int min_defined_corners = 8; ///< for MarchingCubesOptions: 1 on a coarsened grid
+    double cell = 0.0;            ///< the grid's cell
+    double coarsening = 1.0;      ///< cell over the field's cell; 1 keeps the field's own grid
+    int min_defined_corners = 8;  ///< for MarchingCubesOptions: 1 on a coarsened grid
     double estimated_faces = 0.0; ///< faces at the field's cell (estimate_marching_cubes_faces)
 };
 
