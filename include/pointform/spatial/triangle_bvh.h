@@ -133,9 +133,9 @@ private:
 /// crosses, on average: the sum of the triangles' box surface areas over the mesh box's (Cauchy-
 /// Crofton). No hierarchy of axis-aligned boxes can answer a ray or closest-point query on the
 /// mesh with fewer triangle tests, on average, than this. Well-shaped meshes give 2 to 12 (the
-/// Stanford bunny 3.5, a 512-sided cylinder with fan caps 11); a polygon of F + 2 vertices on a circle, fan-triangulated from a corner, F / (2π).
-/// A mesh whose box is a point or a segment (zero area) gives its face count.
-/// \throw InvalidInput if a vertex index is out of range
+/// Stanford bunny 3.5, a 512-sided cylinder with fan caps 11); a polygon of F + 2 vertices on a
+/// circle, fan-triangulated from a corner, F / (2π). A mesh whose box is a point or a segment (zero
+/// area) gives its face count. \throw InvalidInput if a vertex index is out of range
 [[nodiscard]] double triangle_box_depth(const TriMesh& mesh);
 
 /// \brief Refuses, before any work, a batch of `queries` ray or closest-point queries on a mesh
