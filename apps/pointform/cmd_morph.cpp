@@ -57,7 +57,8 @@ void run_morph(const MorphCommandOptions& options, const GlobalOptions& global)
     TerminalProgress progress(!global.quiet && !options.scene.json);
     Timings timings;
     SceneCommandOptions scene = options.scene;
-    scene.far_grid = false; // a morph's surface lies deep inside a member: exact inside values
+    scene.scans.field.far_grid =
+        false; // a morph's surface lies deep inside a member: exact inside values
     SceneArguments arguments(scene, progress.callback());
     const SceneArguments::Loaded from = arguments.load(options.from);
     const SceneArguments::Loaded to = arguments.load(options.to);

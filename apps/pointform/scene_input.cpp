@@ -7,11 +7,11 @@
 #include "pointform/core/memory.h"
 #include "pointform/io/io.h"
 
+#include "options.h"
+
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <sstream>
-#include <system_error>
 #include <utility>
 
 namespace pointform::cli {
@@ -83,12 +83,10 @@ void add_scene_command_options(CLI::App& cmd, SceneCommandOptions& options)
     cmd.add_option("--bounds", options.bounds,
                    "Box to polygonize, xmin,ymin,zmin,xmax,ymax,zmax (default: the scene's "
                    "bounds; required when the scene is unbounded, e.g. a half_space in a union)");
-    cmd.add_option(
-           "--fit", options.fit,
-           "Local surfaces of the scans' fields: quadric, blend, centroid or raw (see `mc`)")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"quadric", "blend", "centroid", "raw"}));
-    add_surfel_input_options(cmd, options.surfels);
+    add_fit_option(cmd, options.scans.field.fit,
+                   "Local surfaces of the scans' fields: quadric, blend, centroid or raw (see "
+                   "`mc`)");
+    add_surfel_input_options(cmd, options.scans.surfels);
     cmd.add_flag("--ascii", options.ascii, "Write ascii PLY instead of binary");
     cmd.add_flag("--json", options.json, "Print the report as JSON");
 }
@@ -107,21 +105,29 @@ const char* to_string(SceneArgumentKind kind)
     return "?";
 }
 
-SceneArguments::SceneArguments(const SceneCommandOptions& options, ProgressCallback progress)
-    : options_(options), progress_(std::move(progress))
+namespace {
+
+ScanOptions with_progress(ScanOptions options, const ProgressCallback& progress)
+{
+    options.surfels.progress = progress;
+    return options;
+}
+
+} // namespace
+
+SceneArguments::SceneArguments(const SceneCommandOptions& options, const ProgressCallback& progress)
+    : scans_(with_progress(options.scans, progress))
 {}
 
 SceneArguments::Loaded SceneArguments::load(const std::string& argument)
 {
     Loaded loaded;
     loaded.kind = classify(argument);
-    ScanLoader loader = [this](const std::string& path) {
-        return load_scan(path);
-    };
+    ScanLoader loader = scans_.loader();
     switch (loaded.kind)
     {
         case SceneArgumentKind::Scan:
-            loaded.field = load_scan(argument);
+            loaded.field = scans_.load(argument);
             break;
         case SceneArgumentKind::SceneFile:
             loaded.field = read_scene(argument, loader).field;
@@ -136,33 +142,6 @@ SceneArguments::Loaded SceneArguments::load(const std::string& argument)
         }
     }
     return loaded;
-}
-
-std::shared_ptr<const Field> SceneArguments::load_scan(const std::string& path)
-{
-    std::error_code error;
-    std::string key = std::filesystem::weakly_canonical(path, error).string();
-    if (error)
-    {
-        key = path;
-    }
-    const auto it = index_.find(key);
-    if (it != index_.end())
-    {
-        return scans_[it->second].field;
-    }
-    SurfelInput input = load_surfels(path, options_.surfels, progress_);
-    LoadedScan scan;
-    scan.path = path;
-    scan.samples = input.surfels.size();
-    scan.estimated_normals = input.estimated_normals;
-    scan.unoriented = input.unoriented;
-    scan.field = std::make_shared<const PointField>(
-        std::move(input.surfels),
-        PointFieldOptions{.fit = parse_plane_fit(options_.fit), .far_grid = options_.far_grid});
-    index_.emplace(key, scans_.size());
-    scans_.push_back(std::move(scan));
-    return scans_.back().field;
 }
 
 SceneGrid choose_scene_grid(const Aabb& field_bounds, const SceneCommandOptions& options,

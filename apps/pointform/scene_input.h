@@ -4,15 +4,13 @@
 #pragma once
 
 #include "pointform/implicit/point_field.h"
+#include "pointform/implicit/scans.h"
 #include "pointform/implicit/scene.h"
 #include "pointform/polygonize/marching_cubes.h"
-
-#include "surfel_input.h"
 
 #include <CLI/CLI.hpp>
 
 #include <cstddef>
-#include <map>
 #include <memory>
 #include <span>
 #include <string>
@@ -26,11 +24,10 @@ struct SceneCommandOptions
     int resolution = 0;
     double cell = 0.0;
     std::string bounds;
-    std::string fit = "quadric";
-    /// Scans answer deep-inside queries from their far grid (PointFieldOptions::far_grid); the
-    /// morph command turns it off, since a morph takes inside values as distances.
-    bool far_grid = true;
-    SurfelInputOptions surfels;
+    /// How scans become fields: their surfels and point field. Scans answer deep-inside queries
+    /// from their far grid (PointFieldOptions::far_grid); the morph command turns it off, since
+    /// a morph takes inside values as distances.
+    ScanOptions scans;
     bool ascii = false;
     bool json = false;
 };
@@ -47,21 +44,12 @@ enum class SceneArgumentKind
 
 [[nodiscard]] const char* to_string(SceneArgumentKind kind);
 
-/// \brief A scan a scene uses, loaded once.
-struct LoadedScan
-{
-    std::string path;
-    std::size_t samples = 0;
-    bool estimated_normals = false;
-    std::size_t unoriented = 0;
-    std::shared_ptr<const PointField> field;
-};
-
-/// \brief Turns scene arguments into fields; scans are shared between the arguments.
+/// \brief Turns scene arguments into fields; scans are shared between the arguments
+/// (ScanLoading).
 class SceneArguments
 {
 public:
-    SceneArguments(const SceneCommandOptions& options, ProgressCallback progress);
+    SceneArguments(const SceneCommandOptions& options, const ProgressCallback& progress);
 
     struct Loaded
     {
@@ -72,15 +60,10 @@ public:
     /// \brief A scan file, a scene file or a scene expression (see SceneArgumentKind).
     [[nodiscard]] Loaded load(const std::string& argument);
 
-    [[nodiscard]] const std::vector<LoadedScan>& scans() const { return scans_; }
+    [[nodiscard]] const std::vector<LoadedScan>& scans() const { return scans_.scans(); }
 
 private:
-    std::shared_ptr<const Field> load_scan(const std::string& path);
-
-    const SceneCommandOptions& options_;
-    ProgressCallback progress_;
-    std::vector<LoadedScan> scans_;
-    std::map<std::string, std::size_t> index_; // canonical path -> scans_
+    ScanLoading scans_;
 };
 
 /// \brief The grid a scene is polygonized on.
