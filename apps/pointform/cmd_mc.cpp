@@ -45,15 +45,8 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
     const PointField field(input.surfels, {.fit = options.fit});
     timings.lap("field");
     const Aabb box = field.bounds();
-    double cell = options.cell;
-    if (options.resolution > 0)
-    {
-        cell = cell_for_resolution(input.surfels.bounds(), options.resolution);
-    }
-    else if (cell <= 0.0)
-    {
-        cell = default_cell_size(field);
-    }
+    const double cell =
+        choose_cell_size(field, input.surfels.bounds(), options.resolution, options.cell);
     const CellGrid grid = grid_over(box, cell);
     check_marching_cubes_memory(field, cell);
     MarchingCubesResult result = marching_cubes(field, grid, {.progress = progress.callback()});

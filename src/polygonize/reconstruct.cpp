@@ -242,11 +242,7 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
     else
     {
         // M0: the simplified marching-cubes mesh (Fig. 5).
-        double cell = options.cell;
-        if (options.resolution > 0)
-            cell = cell_for_resolution(bounds, options.resolution);
-        else if (cell <= 0.0)
-            cell = default_cell_size(field);
+        const double cell = choose_cell_size(field, bounds, options.resolution, options.cell);
         report.cell = cell;
         const CellGrid grid = grid_over(field.bounds(), cell);
         check_marching_cubes_memory(field, cell);

@@ -6,8 +6,10 @@
 #include "pointform/core/progress.h"
 #include "pointform/geometry/point_cloud.h"
 #include "pointform/geometry/tri_mesh.h"
+#include "pointform/hermite/normals.h"
 #include "pointform/hermite/orientation.h"
 #include "pointform/hermite/radius.h"
+#include "pointform/metrics/surface_sampling.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -32,7 +34,7 @@ struct SurfelOptions
 {
     /// Neighbours of each point, besides itself, for PCA and the automatic radius (as CGAL counts
     /// them; Open3D's KNN(k) counts the point itself).
-    std::size_t k = 16;
+    std::size_t k = default_neighbors;
     /// Neighbours a point in the orientation graph; 0 = min(k, 10).
     std::size_t graph_k = 0;
     /// Orientation mode and its parameters.
@@ -78,7 +80,7 @@ void check_surfel_input(const PointCloud& cloud, std::size_t k);
 struct SurfelsFromSamplesOptions
 {
     /// Neighbours of each sample, besides itself, for normals and the automatic radius, ≥ 3.
-    std::size_t k = 16;
+    std::size_t k = default_neighbors;
     /// Factor on the automatic influence radius (distance to the k-th neighbour), > 0; applies
     /// to the radii computed here, not to radii the samples carry.
     double radius_scale = default_field_radius_scale;
@@ -123,9 +125,9 @@ struct SurfelsFromMeshOptions
     /// Area-uniform samples besides the vertices; 0 = as many as the mesh has vertices.
     std::size_t samples = 0;
     /// Seed of the area-uniform samples (sample_surface()).
-    std::uint64_t seed = 1;
+    std::uint64_t seed = SurfaceSamplingOptions{}.seed;
     /// Neighbours of each surfel, besides itself, for its influence radius, ≥ 3.
-    std::size_t k = 16;
+    std::size_t k = default_neighbors;
     /// Factor on the influence radius (distance to the k-th neighbour), > 0.
     double radius_scale = default_field_radius_scale;
 };

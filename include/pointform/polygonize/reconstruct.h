@@ -46,11 +46,11 @@ struct SemiRegularOptions
     /// in memory).
     std::optional<std::size_t> levels;
     /// The rule without `levels`: Automatic or Paper (StopRule); Exact is what `levels` asks.
-    StopRule stop_rule = StopRule::Automatic;
-    Predictor predictor = Predictor::Midpoint;
+    StopRule stop_rule = RefineOptions{}.stop_rule;
+    Predictor predictor = RefineOptions{}.predictor;
     /// Rounds of relaxation per level (§5.2.3), 0 = none.
     int relax_iterations = RefineOptions{}.relax_iterations;
-    Relaxation relaxation = Relaxation::AcrossEdge;
+    Relaxation relaxation = RefineOptions{}.relaxation;
 };
 
 /// \brief A semi-regular mesh and how it was made.
@@ -141,9 +141,9 @@ struct VertexResidual
 struct ReconstructOptions
 {
     /// The local surfaces of the field.
-    PlaneFit fit = PlaneFit::Quadric;
+    PlaneFit fit = PointFieldOptions{}.fit;
     /// Marching cubes: cells along the longest side of the samples' bounding box (≥ 2), or
-    /// else the cell size (> 0), or else (both 0) default_cell_size().
+    /// else the cell size (> 0), or else (both 0) default_cell_size() (choose_cell_size()).
     int resolution = 0;
     double cell = 0.0;
     /// Marching-cubes components that fewer samples are nearest to are removed before the base
@@ -192,7 +192,7 @@ struct RemeshOptions
 {
     /// The mesh's surfels (surfels_from_mesh()).
     SurfelsFromMeshOptions surfels;
-    PlaneFit fit = PlaneFit::Quadric;
+    PlaneFit fit = PointFieldOptions{}.fit;
     /// base_faces unset = a quarter of the input's faces within [200, 20000]
     /// (default_remesh_base_faces()).
     SemiRegularOptions semi_regular;
