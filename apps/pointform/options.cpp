@@ -6,17 +6,44 @@
 #include "pointform/hermite/radius.h"
 #include "pointform/polygonize/refine.h"
 
-#include <map>
 #include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
 
 namespace pointform::cli {
 namespace {
 
-/// Binds an enum option through a CheckedTransformer of its names, showing `value`'s name as the
-/// default.
+template <typename Enum>
+using EnumNames = std::vector<std::pair<std::string, Enum>>;
+
+/// A transform of an enum's names into the values CLI11 assigns (the underlying integers),
+/// refusing every other text, the integers included; "{a,b,c}" in the help.
+template <typename Enum>
+CLI::Validator enum_transform(const EnumNames<Enum>& names)
+{
+    std::string list;
+    for (const auto& [text, item] : names)
+        list += (list.empty() ? "{" : ",") + text;
+    list += "}";
+    return CLI::Validator(
+        [names, list](std::string& text) -> std::string {
+            for (const auto& [name, item] : names)
+                if (name == text)
+                {
+                    text = std::to_string(static_cast<std::underlying_type_t<Enum>>(item));
+                    return {};
+                }
+            return text + " not in " + list;
+        },
+        list);
+}
+
+/// Binds an enum option through enum_transform(), showing `value`'s name as the default.
 template <typename Enum>
 CLI::Option* add_enum_option(CLI::App& cmd, const std::string& name, Enum& value,
-                             const std::map<std::string, Enum>& names, const std::string& help)
+                             const EnumNames<Enum>& names, const std::string& help)
 {
     std::string default_name;
     for (const auto& [text, item] : names)
@@ -27,7 +54,8 @@ CLI::Option* add_enum_option(CLI::App& cmd, const std::string& name, Enum& value
     return cmd
         .add_option_function<Enum>(
             name, [&value](const Enum& parsed) { value = parsed; }, help)
-        ->transform(CLI::CheckedTransformer(names))
+        ->transform(enum_transform(names))
+        ->type_name("TEXT")
         ->default_str(default_name);
 }
 

@@ -2,7 +2,7 @@
 // Copyright (c) 2026 the pointform authors
 
 // The options several subcommands share, each declared once here and bound straight into the
-// library's options structs (enums through CLI::CheckedTransformer), with the library's
+// library's options structs (enums through a transform of their names), with the library's
 // defaults.
 
 #pragma once
