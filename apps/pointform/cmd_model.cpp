@@ -8,6 +8,7 @@
 #include "pointform/io/io.h"
 #include "pointform/polygonize/marching_cubes.h"
 #include "pointform/polygonize/reconstruct.h"
+#include "pointform/polygonize/scene_mesh.h"
 
 #include "common.h"
 #include "options.h"
@@ -28,14 +29,6 @@
 namespace pointform::cli {
 namespace {
 
-/// Levels of `model --semi-regular` without --levels (a modeled surface has no samples over all
-/// of it for the §5.2.4 stop), and the base mesh's share of the marching-cubes faces without
-/// --base-faces: two levels give each base face 16, so the output keeps the marching-cubes
-/// resolution. Coarser base meshes lose the sharp edges of Booleans (on the README's bunny cut,
-/// 1/64 of the faces tore the cut face of the head; 1/16 keeps it).
-constexpr std::size_t default_model_levels = 2;
-constexpr std::size_t default_model_base_share = 16;
-
 struct ModelCommandOptions
 {
     std::string input;
@@ -43,16 +36,7 @@ struct ModelCommandOptions
     SceneCommandOptions scene;
     bool semi_regular = false;
     /// With --semi-regular; its --ascii and --json are the scene's.
-    SemiRegularCommandOptions refine{.semi_regular = {.levels = default_model_levels}};
-};
-
-/// The semi-regular polygonization of `model` (§5 on the scene's field) and how near its
-/// vertices lie to the zero set.
-struct ModelSemiRegular
-{
-    SemiRegularReport report;
-    TriMesh finest; ///< the finest level, as written
-    VertexResidual residual;
+    SemiRegularCommandOptions refine;
 };
 
 nlohmann::json box_json(const Aabb& box)
@@ -70,35 +54,24 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
     const SceneArguments::Loaded scene = arguments.load(options.input);
     timings.lap(arguments.scans().empty() ? "scene" : "scene + surfels");
 
-    const SceneGrid grid =
-        choose_scene_grid(scene.field->bounds(), options.scene, arguments.scans());
-    MarchingCubesResult result =
-        marching_cubes(*scene.field, grid.grid, {.progress = progress.callback()});
-    timings.lap("marching cubes");
-    if (result.mesh.face_count() == 0)
-    {
-        throw Error(
-            "marching cubes made no triangles: the scene's surface does not cross the "
-            "polygonized box, or the field is undefined there (check --bounds, try a "
-            "smaller --cell or a larger --radius-scale)");
-    }
-    std::optional<ModelSemiRegular> semi;
+    SemiRegularCommandOptions refine = options.refine;
+    refine.ascii = options.scene.ascii;
+    SceneMeshOptions mesh_options{.grid = options.scene.grid, .progress = progress.callback()};
     if (options.semi_regular)
     {
-        SemiRegularCommandOptions refine = options.refine;
-        refine.ascii = options.scene.ascii;
-        // No samples cover a modeled surface for the §5.2.4 stop: exactly --levels.
-        SemiRegularReport report =
-            semi_regular_mesh(result.mesh, *scene.field, nullptr, refine.semi_regular,
-                              default_model_base_share, progress.callback());
-        for (const auto& [stage, seconds] : report.stage_seconds)
-        {
-            timings.add(stage, seconds);
-        }
-        TriMesh finest = report.hierarchy.level_mesh(report.hierarchy.finest_level());
-        const VertexResidual residual = field_residual_at_vertices(finest, *scene.field);
-        semi = ModelSemiRegular{std::move(report), std::move(finest), residual};
-        write_semi_regular(options.output, refine, semi->report.hierarchy);
+        mesh_options.semi_regular = refine.semi_regular;
+    }
+    const SceneMeshReport report = scene_mesh(*scene.field, arguments.scans(), mesh_options);
+    for (const auto& [stage, seconds] : report.stage_seconds)
+    {
+        timings.add(stage, seconds);
+    }
+    const SceneGrid& grid = report.grid;
+    const MarchingCubesResult& result = report.marching_cubes;
+    const std::optional<SemiRegularReport>& semi = report.semi_regular;
+    if (semi)
+    {
+        write_semi_regular(options.output, refine, semi->hierarchy);
     }
     else
     {
@@ -107,7 +80,7 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
         });
     }
     timings.lap("write");
-    const TriMesh& written = semi ? semi->finest : result.mesh;
+    const TriMesh& written = report.mesh();
     const MeshTopology topo = analyze_topology(written);
     progress.clear();
 
@@ -134,9 +107,9 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
         if (semi)
         {
             out["marching_cubes_faces"] = result.mesh.face_count();
-            out["base_mesh"] = base_mesh_json(*semi->report.base);
+            out["base_mesh"] = base_mesh_json(*semi->base);
             nlohmann::json levels = nlohmann::json::array();
-            for (const RefineLevelStats& level : semi->report.refinement.levels)
+            for (const RefineLevelStats& level : semi->refinement.levels)
             {
                 levels.push_back({{"level", level.level},
                                   {"faces", level.faces},
@@ -145,8 +118,8 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
                                   {"seconds", level.seconds}});
             }
             out["levels"] = levels;
-            out["max_abs_field_at_vertices"] = semi->residual.max;
-            out["mean_abs_field_at_vertices"] = semi->residual.mean;
+            out["max_abs_field_at_vertices"] = report.residual.max;
+            out["mean_abs_field_at_vertices"] = report.residual.mean;
             if (!options.refine.save_hierarchy.empty())
             {
                 out["hierarchy"] = options.refine.save_hierarchy;
@@ -190,22 +163,21 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
     if (semi)
     {
         print_row("marching cubes", std::to_string(result.mesh.face_count()) + " faces");
-        print_base_mesh(*semi->report.base);
-        for (const RefineLevelStats& level : semi->report.refinement.levels)
+        print_base_mesh(*semi->base);
+        for (const RefineLevelStats& level : semi->refinement.levels)
         {
             print_row("level " + std::to_string(level.level),
                       std::to_string(level.faces) + " faces, " + std::to_string(level.unprojected) +
                           " vertices left unprojected, " + std::to_string(level.folded_faces) +
                           " folded faces");
         }
-        print_row("|f| at the vertices", "max " + format_number(semi->residual.max) + ", mean " +
-                                             format_number(semi->residual.mean) +
+        print_row("|f| at the vertices", "max " + format_number(report.residual.max) + ", mean " +
+                                             format_number(report.residual.mean) +
                                              " (where the field is defined)");
         if (!options.refine.save_hierarchy.empty())
         {
             print_row("hierarchy", options.refine.save_hierarchy + " (" +
-                                       std::to_string(semi->report.hierarchy.level_count()) +
-                                       " levels)");
+                                       std::to_string(semi->hierarchy.level_count()) + " levels)");
         }
     }
     print_row("vertices", std::to_string(written.vertex_count()));
@@ -248,7 +220,7 @@ void register_model(CLI::App& app, const GlobalOptions& global)
     std::vector<CLI::Option*> refine = add_level_options(
         *cmd, options->refine,
         "With --semi-regular: refine exactly to level J (0 = the base mesh only; default " +
-            std::to_string(default_model_levels) + ")");
+            std::to_string(default_scene_levels) + ")");
     refine.push_back(
         add_base_faces_option(*cmd, options->refine.semi_regular)
             ->description(

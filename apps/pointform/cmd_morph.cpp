@@ -70,7 +70,7 @@ void run_morph(const MorphCommandOptions& options, const GlobalOptions& global)
     const Aabb to_box = to.field->bounds();
     box.extend(to_box.min);
     box.extend(to_box.max);
-    const SceneGrid grid = choose_scene_grid(box, options.scene, arguments.scans());
+    const SceneGrid grid = choose_scene_grid(box, options.scene.grid, arguments.scans());
 
     std::vector<MorphStep> steps;
     OutputTransaction written;

@@ -6,13 +6,12 @@
 #include "pointform/implicit/point_field.h"
 #include "pointform/implicit/scans.h"
 #include "pointform/implicit/scene.h"
-#include "pointform/polygonize/marching_cubes.h"
+#include "pointform/polygonize/scene_mesh.h"
 
 #include <CLI/CLI.hpp>
 
 #include <cstddef>
 #include <memory>
-#include <span>
 #include <string>
 #include <vector>
 
@@ -21,9 +20,8 @@ namespace pointform::cli {
 /// \brief The options `pointform model` and `pointform morph` share.
 struct SceneCommandOptions
 {
-    int resolution = 0;
-    double cell = 0.0;
-    std::string bounds;
+    /// --bounds, --cell, --resolution.
+    SceneGridOptions grid;
     /// How scans become fields: their surfels and point field. Scans answer deep-inside queries
     /// from their far grid (PointFieldOptions::far_grid); the morph command turns it off, since
     /// a morph takes inside values as distances.
@@ -65,21 +63,5 @@ public:
 private:
     ScanLoading scans_;
 };
-
-/// \brief The grid a scene is polygonized on.
-struct SceneGrid
-{
-    Aabb box;
-    double cell = 0.0;
-    CellGrid grid;
-};
-
-/// \brief Lays the grid over --bounds or else `field_bounds`, with --cell, --resolution (cells
-/// along the longest side) or the default: 0.4 of the smallest median influence radius of the
-/// scans (default_cell_size), or the longest side / 128 for a scene of primitives only. Refuses
-/// an unbounded or empty box, and a cell that would need more memory than there is.
-[[nodiscard]] SceneGrid choose_scene_grid(const Aabb& field_bounds,
-                                          const SceneCommandOptions& options,
-                                          std::span<const LoadedScan> scans);
 
 } // namespace pointform::cli
