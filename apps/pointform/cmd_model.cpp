@@ -88,7 +88,7 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
     {
         nlohmann::json out;
         out["input"] = options.input;
-        out["input_kind"] = to_string(scene.kind);
+        out["input_kind"] = std::string(to_string(scene.kind));
         out["output"] = options.output;
         nlohmann::json scans = nlohmann::json::array();
         for (const LoadedScan& scan : arguments.scans())
@@ -147,8 +147,8 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
     {
         return;
     }
-    std::printf("%s (%s) -> %s\n", options.input.c_str(), to_string(scene.kind),
-                options.output.c_str());
+    std::printf("%s (%s) -> %s\n", options.input.c_str(),
+                std::string(to_string(scene.kind)).c_str(), options.output.c_str());
     for (const LoadedScan& scan : arguments.scans())
     {
         print_row("scan", scan.path + ": " + std::to_string(scan.samples) + " samples" +

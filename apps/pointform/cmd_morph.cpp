@@ -106,9 +106,9 @@ void run_morph(const MorphCommandOptions& options, const GlobalOptions& global)
     {
         nlohmann::json out;
         out["from"] = options.from;
-        out["from_kind"] = to_string(from.kind);
+        out["from_kind"] = std::string(to_string(from.kind));
         out["to"] = options.to;
-        out["to_kind"] = to_string(to.kind);
+        out["to_kind"] = std::string(to_string(to.kind));
         out["cell"] = grid.cell;
         out["grid_cells"] = grid.grid.cells;
         out["bounds"] = {{"min", {grid.box.min.x(), grid.box.min.y(), grid.box.min.z()}},
@@ -143,8 +143,9 @@ void run_morph(const MorphCommandOptions& options, const GlobalOptions& global)
     {
         return;
     }
-    std::printf("%s (%s) -> %s (%s): %d steps\n", options.from.c_str(), to_string(from.kind),
-                options.to.c_str(), to_string(to.kind), options.steps);
+    std::printf("%s (%s) -> %s (%s): %d steps\n", options.from.c_str(),
+                std::string(to_string(from.kind)).c_str(), options.to.c_str(),
+                std::string(to_string(to.kind)).c_str(), options.steps);
     print_row("cell", format_number(grid.cell) + " (grid " + std::to_string(grid.grid.cells[0]) +
                           " x " + std::to_string(grid.grid.cells[1]) + " x " +
                           std::to_string(grid.grid.cells[2]) + ")");

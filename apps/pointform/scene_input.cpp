@@ -50,23 +50,6 @@ Aabb parse_bounds(const std::string& text)
     return box;
 }
 
-SceneArgumentKind classify(const std::string& argument)
-{
-    if (!looks_like_file(argument))
-    {
-        return SceneArgumentKind::Expression;
-    }
-    try
-    {
-        (void)format_from_extension(argument);
-        return SceneArgumentKind::Scan;
-    }
-    catch (const IoError&)
-    {
-        return SceneArgumentKind::SceneFile;
-    }
-}
-
 } // namespace
 
 void add_scene_command_options(CLI::App& cmd, SceneCommandOptions& options)
@@ -92,20 +75,6 @@ void add_scene_command_options(CLI::App& cmd, SceneCommandOptions& options)
     cmd.add_flag("--json", options.json, "Print the report as JSON");
 }
 
-const char* to_string(SceneArgumentKind kind)
-{
-    switch (kind)
-    {
-        case SceneArgumentKind::Expression:
-            return "expression";
-        case SceneArgumentKind::SceneFile:
-            return "scene file";
-        case SceneArgumentKind::Scan:
-            return "scan";
-    }
-    return "?";
-}
-
 namespace {
 
 ScanOptions with_progress(ScanOptions options, const ProgressCallback& progress)
@@ -119,30 +88,5 @@ ScanOptions with_progress(ScanOptions options, const ProgressCallback& progress)
 SceneArguments::SceneArguments(const SceneCommandOptions& options, const ProgressCallback& progress)
     : scans_(with_progress(options.scans, progress))
 {}
-
-SceneArguments::Loaded SceneArguments::load(const std::string& argument)
-{
-    Loaded loaded;
-    loaded.kind = classify(argument);
-    ScanLoader loader = scans_.loader();
-    switch (loaded.kind)
-    {
-        case SceneArgumentKind::Scan:
-            loaded.field = scans_.load(argument);
-            break;
-        case SceneArgumentKind::SceneFile:
-            loaded.field = read_scene(argument, loader).field;
-            break;
-        case SceneArgumentKind::Expression:
-        {
-            SceneOptions scene_options;
-            scene_options.source_name = "expression";
-            scene_options.load_scan = loader;
-            loaded.field = parse_scene(argument, scene_options).field;
-            break;
-        }
-    }
-    return loaded;
-}
 
 } // namespace pointform::cli

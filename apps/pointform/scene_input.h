@@ -32,16 +32,6 @@ struct SceneCommandOptions
 
 void add_scene_command_options(CLI::App& cmd, SceneCommandOptions& options);
 
-/// \brief How a scene argument was taken.
-enum class SceneArgumentKind
-{
-    Expression, ///< not an existing file: parsed as a scene expression
-    SceneFile,  ///< an existing file whose extension is not a point format
-    Scan,       ///< an existing point or mesh file (.ply, .xyz, .las, ...): its point field
-};
-
-[[nodiscard]] const char* to_string(SceneArgumentKind kind);
-
 /// \brief Turns scene arguments into fields; scans are shared between the arguments
 /// (ScanLoading).
 class SceneArguments
@@ -49,14 +39,13 @@ class SceneArguments
 public:
     SceneArguments(const SceneCommandOptions& options, const ProgressCallback& progress);
 
-    struct Loaded
-    {
-        std::shared_ptr<const Field> field;
-        SceneArgumentKind kind = SceneArgumentKind::Expression;
-    };
+    using Loaded = LoadedScene;
 
-    /// \brief A scan file, a scene file or a scene expression (see SceneArgumentKind).
-    [[nodiscard]] Loaded load(const std::string& argument);
+    /// \brief A scan file, a scene file or a scene expression (load_scene_argument()).
+    [[nodiscard]] Loaded load(const std::string& argument)
+    {
+        return load_scene_argument(argument, scans_);
+    }
 
     [[nodiscard]] const std::vector<LoadedScan>& scans() const { return scans_.scans(); }
 

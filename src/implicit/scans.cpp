@@ -3,6 +3,7 @@
 
 #include "pointform/implicit/scans.h"
 
+#include "pointform/core/error.h"
 #include "pointform/io/io.h"
 
 #include <filesystem>
@@ -39,6 +40,60 @@ ScanLoader ScanLoading::loader()
     return [this](const std::string& path) -> std::shared_ptr<const Field> {
         return load(path);
     };
+}
+
+std::string_view to_string(SceneArgumentKind kind)
+{
+    switch (kind)
+    {
+        case SceneArgumentKind::Expression:
+            return "expression";
+        case SceneArgumentKind::SceneFile:
+            return "scene file";
+        case SceneArgumentKind::Scan:
+            return "scan";
+    }
+    return "?";
+}
+
+namespace {
+
+SceneArgumentKind classify(const std::string& argument)
+{
+    if (!looks_like_file(argument))
+        return SceneArgumentKind::Expression;
+    try
+    {
+        (void)format_from_extension(argument);
+        return SceneArgumentKind::Scan;
+    }
+    catch (const IoError&)
+    {
+        return SceneArgumentKind::SceneFile;
+    }
+}
+
+} // namespace
+
+LoadedScene load_scene_argument(const std::string& argument, ScanLoading& scans)
+{
+    LoadedScene loaded;
+    loaded.kind = classify(argument);
+    switch (loaded.kind)
+    {
+        case SceneArgumentKind::Scan:
+            loaded.field = scans.load(argument);
+            break;
+        case SceneArgumentKind::SceneFile:
+            loaded.field = read_scene(argument, scans.loader()).field;
+            break;
+        case SceneArgumentKind::Expression:
+            loaded.field =
+                parse_scene(argument, {.source_name = "expression", .load_scan = scans.loader()})
+                    .field;
+            break;
+    }
+    return loaded;
 }
 
 } // namespace pointform

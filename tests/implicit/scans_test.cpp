@@ -13,6 +13,8 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <fstream>
+#include <string>
 
 namespace pointform {
 namespace {
@@ -54,6 +56,39 @@ TEST(ScanLoading, ReportsFileErrorsAndBadSamples)
     write_point_cloud(dir / "few.xyz", few);
     EXPECT_THROW((void)scans.load((dir / "few.xyz").string()), InvalidInput);
     EXPECT_TRUE(scans.scans().empty());
+}
+
+TEST(ScanLoading, SceneArgumentsAreScansSceneFilesOrExpressions)
+{
+    test::TempDir dir;
+    write_point_cloud(dir / "ball.ply", sample_shape(Shape::Sphere, {.count = 3000, .seed = 33}));
+    {
+        std::ofstream scene(dir / "cut.pf");
+        scene << "let b = scan(\"ball.ply\")   # relative to this file\n"
+                 "difference(b, sphere([0, 0, 1], 0.5))\n";
+    }
+    ScanLoading scans;
+    const LoadedScene scan = load_scene_argument((dir / "ball.ply").string(), scans);
+    EXPECT_EQ(scan.kind, SceneArgumentKind::Scan);
+    const LoadedScene file = load_scene_argument((dir / "cut.pf").string(), scans);
+    EXPECT_EQ(file.kind, SceneArgumentKind::SceneFile);
+    EXPECT_EQ(scans.scans().size(), 1U); // the scene file's scan is the same file
+    const LoadedScene expression = load_scene_argument("sphere([0, 0, 0], 2)", scans);
+    EXPECT_EQ(expression.kind, SceneArgumentKind::Expression);
+    EXPECT_EQ(to_string(SceneArgumentKind::SceneFile), "scene file");
+    // Inside the ball but in the cut away part: outside the scene.
+    EXPECT_LT(scan.field->evaluate(Vec3d(0, 0, 0.8)).value, 0.0);
+    EXPECT_GT(file.field->evaluate(Vec3d(0, 0, 0.8)).value, 0.0);
+    EXPECT_NEAR(expression.field->evaluate(Vec3d(0, 0, 0)).value, -2.0, 1e-12);
+    try
+    {
+        (void)load_scene_argument("sphre([0, 0, 0], 1)", scans);
+        FAIL() << "a misspelt function was accepted";
+    }
+    catch (const InvalidInput& e)
+    {
+        EXPECT_NE(std::string(e.what()).find("expression:1:1:"), std::string::npos) << e.what();
+    }
 }
 
 } // namespace

@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace pointform {
@@ -64,5 +65,29 @@ private:
     std::vector<LoadedScan> scans_;
     std::map<std::string, std::size_t> index_; // canonical path -> scans_
 };
+
+/// \brief How load_scene_argument() took an argument.
+enum class SceneArgumentKind
+{
+    Expression, ///< not an existing file: parsed as a scene expression
+    SceneFile,  ///< an existing file whose extension is not a point format
+    Scan,       ///< an existing point or mesh file (.ply, .xyz, .las, ...): its point field
+};
+
+[[nodiscard]] std::string_view to_string(SceneArgumentKind kind);
+
+/// \brief A scene argument's field and how it was taken.
+struct LoadedScene
+{
+    std::shared_ptr<const Field> field;
+    SceneArgumentKind kind = SceneArgumentKind::Expression;
+};
+
+/// \brief A scene from one argument, as `pointform model` takes it: the point field of a scan
+/// file (.ply, .xyz, .las, ...), a scene file (read_scene(): any other existing file; its scans
+/// resolve against its folder), or else a scene expression (parse_scene(), named "expression"
+/// in messages). Scans load through `scans`, so arguments share them.
+/// \throw IoError for a file that cannot be read; InvalidInput as parse_scene()
+[[nodiscard]] LoadedScene load_scene_argument(const std::string& argument, ScanLoading& scans);
 
 } // namespace pointform
