@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: MIT
 // Copyright (c) 2026 the pointform authors
 
+#include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 #include "pointform/io/hierarchy.h"
 #include "pointform/io/io.h"
-#include "pointform/spatial/kd_tree.h"
+#include "pointform/metrics/sampling_density.h"
 
 #include "common.h"
 
@@ -24,37 +25,20 @@ struct InfoOptions
     bool json = false;
 };
 
-struct Density
+/// The sampling density (measure_sampling_density()), or zeros for fewer than two distinct
+/// points.
+SamplingDensity sampling_density_of(const PointCloud& cloud, const ProgressCallback& progress)
 {
-    double mean = 0.0;
-    double median = 0.0;
-};
-
-/// Mean and median distance from each point to its nearest other point.
-Density nearest_neighbor_density(const PointCloud& cloud, const ProgressCallback& progress)
-{
-    Density density;
     if (cloud.size() < 2)
-        return density;
-    const KdTree tree(cloud.positions);
-    const KnnTable table = knn_batch(tree, cloud.positions, 2, {.progress = progress});
-    std::vector<double> distances(cloud.size());
-    for (std::size_t i = 0; i < cloud.size(); ++i)
+        return {};
+    try
     {
-        // The nearest is usually the point itself; with duplicates it may be a twin at distance 0.
-        const auto nbrs = table.neighbors(i);
-        const auto d2 = table.distances2(i);
-        const float other = nbrs[0] == i ? d2[1] : d2[0];
-        distances[i] = std::sqrt(static_cast<double>(other));
+        return measure_sampling_density(cloud, progress);
     }
-    double sum = 0.0;
-    for (const double d : distances)
-        sum += d;
-    density.mean = sum / static_cast<double>(distances.size());
-    const auto middle = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
-    std::nth_element(distances.begin(), middle, distances.end());
-    density.median = *middle;
-    return density;
+    catch (const InvalidInput&) // every point coincides
+    {
+        return {};
+    }
 }
 
 nlohmann::json vec_json(const Vec3d& v)
@@ -108,7 +92,7 @@ void run_info(const InfoOptions& options, const GlobalOptions& global)
     const ReadResult read = read_geometry(options.input);
     const PointCloud& cloud = read.points;
     const Aabb box = cloud.bounds();
-    const Density density = nearest_neighbor_density(cloud, progress.callback());
+    const SamplingDensity density = sampling_density_of(cloud, progress.callback());
     progress.clear();
 
     std::vector<std::string> attributes = {"positions"};

@@ -10,6 +10,7 @@
 #include "pointform/polygonize/marching_cubes.h"
 
 #include "common.h"
+#include "options.h"
 #include "output_transaction.h"
 #include "surfel_input.h"
 
@@ -27,8 +28,8 @@ struct McCommandOptions
     std::string output;
     int resolution = 0;
     double cell = 0.0;
-    std::string fit = "quadric";
-    SurfelInputOptions surfels;
+    PlaneFit fit = PlaneFit::Quadric;
+    SurfelsFromSamplesOptions surfels;
     bool ascii = false;
     bool json = false;
 };
@@ -38,21 +39,14 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
     set_thread_count(global.threads);
     TerminalProgress progress(!global.quiet && !options.json);
     Timings timings;
-    SurfelInput input = load_surfels(options.input, options.surfels, progress.callback());
+    SurfelsFromSamples input = load_surfels(options.input, options.surfels, progress.callback());
     timings.lap(input.estimated_normals ? "read + surfels" : "read");
 
-    const PointField field(input.surfels, {.fit = parse_plane_fit(options.fit)});
+    const PointField field(input.surfels, {.fit = options.fit});
     timings.lap("field");
     const Aabb box = field.bounds();
-    double cell = options.cell;
-    if (options.resolution > 0)
-    {
-        cell = cell_for_resolution(input.surfels.bounds(), options.resolution);
-    }
-    else if (cell <= 0.0)
-    {
-        cell = default_cell_size(field);
-    }
+    const double cell =
+        choose_cell_size(field, input.surfels.bounds(), options.resolution, options.cell);
     const CellGrid grid = grid_over(box, cell);
     check_marching_cubes_memory(field, cell);
     MarchingCubesResult result = marching_cubes(field, grid, {.progress = progress.callback()});
@@ -82,7 +76,7 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
         out["output"] = options.output;
         out["samples"] = input.surfels.size();
         out["estimated_normals"] = input.estimated_normals;
-        out["fit"] = options.fit;
+        out["fit"] = std::string(to_string(options.fit));
         out["cell"] = cell;
         out["vertices"] = result.mesh.vertex_count();
         out["faces"] = result.mesh.face_count();
@@ -111,7 +105,7 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
     std::printf("%s -> %s\n", options.input.c_str(), options.output.c_str());
     print_row("samples", std::to_string(input.surfels.size()) +
                              (input.estimated_normals ? " (normals estimated)" : " (surfels)"));
-    print_row("cell", format_number(cell) + " (" + options.fit + " field)");
+    print_row("cell", format_number(cell) + " (" + std::string(to_string(options.fit)) + " field)");
     print_row("vertices", std::to_string(result.mesh.vertex_count()));
     print_row("faces", std::to_string(result.mesh.face_count()));
     print_row("components", std::to_string(topo.components));
@@ -149,12 +143,10 @@ void register_mc(CLI::App& app, const GlobalOptions& global)
                     "0.4 of the median influence radius)")
         ->check(CLI::PositiveNumber)
         ->excludes(resolution);
-    cmd->add_option("--fit", options->fit,
-                    "Local surfaces of the field: quadric (smooth blend of nearby local quadric "
-                    "fits, the most accurate on exact and on noisy samples), blend (of centroid "
-                    "planes), centroid (Hoppe's plane) or raw (the paper's plane)")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"quadric", "blend", "centroid", "raw"}));
+    add_fit_option(*cmd, options->fit,
+                   "Local surfaces of the field: quadric (smooth blend of nearby local quadric "
+                   "fits, the most accurate on exact and on noisy samples), blend (of centroid "
+                   "planes), centroid (Hoppe's plane) or raw (the paper's plane)");
     add_surfel_input_options(*cmd, options->surfels);
     cmd->add_flag("--ascii", options->ascii, "Write ascii PLY instead of binary");
     cmd->add_flag("--json", options->json, "Print the report as JSON");

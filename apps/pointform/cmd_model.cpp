@@ -6,14 +6,16 @@
 #include "pointform/geometry/mesh_topology.h"
 #include "pointform/implicit/scene.h"
 #include "pointform/io/io.h"
-#include "pointform/polygonize/base_mesh.h"
 #include "pointform/polygonize/marching_cubes.h"
-#include "pointform/polygonize/refine.h"
+#include "pointform/polygonize/reconstruct.h"
+#include "pointform/polygonize/scene_mesh.h"
 
 #include "common.h"
+#include "options.h"
 #include "output_transaction.h"
 #include "scene_input.h"
 #include "semi_regular.h"
+#include "surfel_input.h"
 
 #include <nlohmann/json.hpp>
 
@@ -27,75 +29,15 @@
 namespace pointform::cli {
 namespace {
 
-/// Levels of `model --semi-regular` without --levels (a modeled surface has no samples over all
-/// of it for the §5.2.4 stop), and the base mesh's share of the marching-cubes faces without
-/// --base-faces: two levels give each base face 16, so the output keeps the marching-cubes
-/// resolution. Coarser base meshes lose the sharp edges of Booleans (on the README's bunny cut,
-/// 1/64 of the faces tore the cut face of the head; 1/16 keeps it).
-constexpr long long default_model_levels = 2;
-constexpr std::size_t default_model_base_share = 16;
-
 struct ModelCommandOptions
 {
     std::string input;
     std::string output;
     SceneCommandOptions scene;
     bool semi_regular = false;
-    SemiRegularOptions refine; ///< with --semi-regular; its --ascii and --json are the scene's
+    /// With --semi-regular; its --ascii and --json are the scene's.
+    SemiRegularCommandOptions refine;
 };
-
-/// The semi-regular polygonization of `model` (§5 on the scene's field): the marching-cubes mesh
-/// simplified to a base mesh, then refined level by level with every new vertex projected onto
-/// the zero set of the whole scene.
-struct ModelSemiRegular
-{
-    MultiresMesh hierarchy;
-    TriMesh finest; ///< the finest level, as written
-    BaseMeshStats base;
-    std::vector<RefineLevelStats> levels;
-    /// |f| at the output's vertices where the field is defined: how near the zero set they lie.
-    double max_residual = 0.0;
-    double mean_residual = 0.0;
-};
-
-ModelSemiRegular semi_regular_model(const TriMesh& intermediate, const Field& field,
-                                    const SemiRegularOptions& options,
-                                    const ProgressCallback& progress, Timings& timings)
-{
-    const auto levels = static_cast<std::size_t>(options.levels.value_or(default_model_levels));
-    const std::size_t target = base_face_target(options, intermediate, default_model_base_share);
-    check_refinement_memory(target, levels);
-    BaseMeshResult built =
-        build_base_mesh(intermediate, field, {.target_faces = target, .progress = progress});
-    timings.lap("base mesh");
-    ModelSemiRegular out{MultiresMesh(built.mesh), {}, built.stats, {}, 0.0, 0.0};
-    const RefineOptions refine_options = refine_options_of(options, progress);
-    for (std::size_t level = 0; level < levels; ++level)
-    {
-        out.levels.push_back(refine_once(out.hierarchy, field, refine_options));
-    }
-    timings.lap("refinement");
-    out.finest = out.hierarchy.level_mesh(out.hierarchy.finest_level());
-    std::vector<Vec3d> at(out.finest.vertex_count());
-    for (std::size_t v = 0; v < at.size(); ++v)
-    {
-        at[v] = out.finest.vertices.world(v);
-    }
-    std::vector<FieldSample> samples(at.size());
-    field.evaluate(at, samples);
-    std::size_t defined = 0;
-    for (const FieldSample& sample : samples)
-    {
-        if (sample.defined && std::isfinite(sample.value))
-        {
-            out.max_residual = std::max(out.max_residual, std::abs(sample.value));
-            out.mean_residual += std::abs(sample.value);
-            ++defined;
-        }
-    }
-    out.mean_residual = defined > 0 ? out.mean_residual / static_cast<double>(defined) : 0.0;
-    return out;
-}
 
 nlohmann::json box_json(const Aabb& box)
 {
@@ -112,24 +54,23 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
     const SceneArguments::Loaded scene = arguments.load(options.input);
     timings.lap(arguments.scans().empty() ? "scene" : "scene + surfels");
 
-    const SceneGrid grid =
-        choose_scene_grid(scene.field->bounds(), options.scene, arguments.scans());
-    MarchingCubesResult result =
-        marching_cubes(*scene.field, grid.grid, {.progress = progress.callback()});
-    timings.lap("marching cubes");
-    if (result.mesh.face_count() == 0)
-    {
-        throw Error(
-            "marching cubes made no triangles: the scene's surface does not cross the "
-            "polygonized box, or the field is undefined there (check --bounds, try a "
-            "smaller --cell or a larger --radius-scale)");
-    }
-    std::optional<ModelSemiRegular> semi;
+    SemiRegularCommandOptions refine = options.refine;
+    refine.ascii = options.scene.ascii;
+    SceneMeshOptions mesh_options{.grid = options.scene.grid, .progress = progress.callback()};
     if (options.semi_regular)
     {
-        SemiRegularOptions refine = options.refine;
-        refine.ascii = options.scene.ascii;
-        semi = semi_regular_model(result.mesh, *scene.field, refine, progress.callback(), timings);
+        mesh_options.semi_regular = refine.semi_regular;
+    }
+    const SceneMeshReport report = scene_mesh(*scene.field, arguments.scans(), mesh_options);
+    for (const auto& [stage, seconds] : report.stage_seconds)
+    {
+        timings.add(stage, seconds);
+    }
+    const SceneGrid& grid = report.grid;
+    const MarchingCubesResult& result = report.marching_cubes;
+    const std::optional<SemiRegularReport>& semi = report.semi_regular;
+    if (semi)
+    {
         write_semi_regular(options.output, refine, semi->hierarchy);
     }
     else
@@ -139,7 +80,7 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
         });
     }
     timings.lap("write");
-    const TriMesh& written = semi ? semi->finest : result.mesh;
+    const TriMesh& written = report.mesh();
     const MeshTopology topo = analyze_topology(written);
     progress.clear();
 
@@ -147,7 +88,7 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
     {
         nlohmann::json out;
         out["input"] = options.input;
-        out["input_kind"] = to_string(scene.kind);
+        out["input_kind"] = std::string(to_string(scene.kind));
         out["output"] = options.output;
         nlohmann::json scans = nlohmann::json::array();
         for (const LoadedScan& scan : arguments.scans())
@@ -158,7 +99,7 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
                              {"median_radius", scan.field->median_radius()}});
         }
         out["scans"] = scans;
-        out["fit"] = options.scene.fit;
+        out["fit"] = std::string(to_string(options.scene.scans.field.fit));
         out["bounds"] = box_json(grid.box);
         out["cell"] = grid.cell;
         out["grid_cells"] = grid.grid.cells;
@@ -166,9 +107,9 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
         if (semi)
         {
             out["marching_cubes_faces"] = result.mesh.face_count();
-            out["base_mesh"] = base_mesh_json(semi->base);
+            out["base_mesh"] = base_mesh_json(*semi->base);
             nlohmann::json levels = nlohmann::json::array();
-            for (const RefineLevelStats& level : semi->levels)
+            for (const RefineLevelStats& level : semi->refinement.levels)
             {
                 levels.push_back({{"level", level.level},
                                   {"faces", level.faces},
@@ -177,8 +118,8 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
                                   {"seconds", level.seconds}});
             }
             out["levels"] = levels;
-            out["max_abs_field_at_vertices"] = semi->max_residual;
-            out["mean_abs_field_at_vertices"] = semi->mean_residual;
+            out["max_abs_field_at_vertices"] = report.residual.max;
+            out["mean_abs_field_at_vertices"] = report.residual.mean;
             if (!options.refine.save_hierarchy.empty())
             {
                 out["hierarchy"] = options.refine.save_hierarchy;
@@ -206,8 +147,8 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
     {
         return;
     }
-    std::printf("%s (%s) -> %s\n", options.input.c_str(), to_string(scene.kind),
-                options.output.c_str());
+    std::printf("%s (%s) -> %s\n", options.input.c_str(),
+                std::string(to_string(scene.kind)).c_str(), options.output.c_str());
     for (const LoadedScan& scan : arguments.scans())
     {
         print_row("scan", scan.path + ": " + std::to_string(scan.samples) + " samples" +
@@ -222,16 +163,16 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
     if (semi)
     {
         print_row("marching cubes", std::to_string(result.mesh.face_count()) + " faces");
-        print_base_mesh(semi->base);
-        for (const RefineLevelStats& level : semi->levels)
+        print_base_mesh(*semi->base);
+        for (const RefineLevelStats& level : semi->refinement.levels)
         {
             print_row("level " + std::to_string(level.level),
                       std::to_string(level.faces) + " faces, " + std::to_string(level.unprojected) +
                           " vertices left unprojected, " + std::to_string(level.folded_faces) +
                           " folded faces");
         }
-        print_row("|f| at the vertices", "max " + format_number(semi->max_residual) + ", mean " +
-                                             format_number(semi->mean_residual) +
+        print_row("|f| at the vertices", "max " + format_number(report.residual.max) + ", mean " +
+                                             format_number(report.residual.mean) +
                                              " (where the field is defined)");
         if (!options.refine.save_hierarchy.empty())
         {
@@ -279,9 +220,9 @@ void register_model(CLI::App& app, const GlobalOptions& global)
     std::vector<CLI::Option*> refine = add_level_options(
         *cmd, options->refine,
         "With --semi-regular: refine exactly to level J (0 = the base mesh only; default " +
-            std::to_string(default_model_levels) + ")");
+            std::to_string(default_scene_levels) + ")");
     refine.push_back(
-        add_base_faces_option(*cmd, options->refine)
+        add_base_faces_option(*cmd, options->refine.semi_regular)
             ->description(
                 "With --semi-regular: faces of the base mesh (default: the "
                 "marching-cubes mesh's faces / 16, within [max(8 per component, 200), 20000])"));

@@ -57,7 +57,8 @@ void run_morph(const MorphCommandOptions& options, const GlobalOptions& global)
     TerminalProgress progress(!global.quiet && !options.scene.json);
     Timings timings;
     SceneCommandOptions scene = options.scene;
-    scene.far_grid = false; // a morph's surface lies deep inside a member: exact inside values
+    scene.scans.field.far_grid =
+        false; // a morph's surface lies deep inside a member: exact inside values
     SceneArguments arguments(scene, progress.callback());
     const SceneArguments::Loaded from = arguments.load(options.from);
     const SceneArguments::Loaded to = arguments.load(options.to);
@@ -69,7 +70,7 @@ void run_morph(const MorphCommandOptions& options, const GlobalOptions& global)
     const Aabb to_box = to.field->bounds();
     box.extend(to_box.min);
     box.extend(to_box.max);
-    const SceneGrid grid = choose_scene_grid(box, options.scene, arguments.scans());
+    const SceneGrid grid = choose_scene_grid(box, options.scene.grid, arguments.scans());
 
     std::vector<MorphStep> steps;
     OutputTransaction written;
@@ -105,9 +106,9 @@ void run_morph(const MorphCommandOptions& options, const GlobalOptions& global)
     {
         nlohmann::json out;
         out["from"] = options.from;
-        out["from_kind"] = to_string(from.kind);
+        out["from_kind"] = std::string(to_string(from.kind));
         out["to"] = options.to;
-        out["to_kind"] = to_string(to.kind);
+        out["to_kind"] = std::string(to_string(to.kind));
         out["cell"] = grid.cell;
         out["grid_cells"] = grid.grid.cells;
         out["bounds"] = {{"min", {grid.box.min.x(), grid.box.min.y(), grid.box.min.z()}},
@@ -142,8 +143,9 @@ void run_morph(const MorphCommandOptions& options, const GlobalOptions& global)
     {
         return;
     }
-    std::printf("%s (%s) -> %s (%s): %d steps\n", options.from.c_str(), to_string(from.kind),
-                options.to.c_str(), to_string(to.kind), options.steps);
+    std::printf("%s (%s) -> %s (%s): %d steps\n", options.from.c_str(),
+                std::string(to_string(from.kind)).c_str(), options.to.c_str(),
+                std::string(to_string(to.kind)).c_str(), options.steps);
     print_row("cell", format_number(grid.cell) + " (grid " + std::to_string(grid.grid.cells[0]) +
                           " x " + std::to_string(grid.grid.cells[1]) + " x " +
                           std::to_string(grid.grid.cells[2]) + ")");

@@ -7,6 +7,7 @@
 #include "pointform/io/io.h"
 
 #include "common.h"
+#include "options.h"
 #include "output_transaction.h"
 
 #include <nlohmann/json.hpp>
@@ -22,12 +23,8 @@ struct NormalsCommandOptions
 {
     std::string input;
     std::string output;
-    std::size_t k = 16;
-    std::size_t graph_k = 0;
-    double radius_scale = 1.0;
-    std::string radius_regions;
+    SurfelOptions surfels; ///< its orient and orient_target from --orient
     std::string orient = "mst";
-    std::string rule = "hoppe";
     bool ascii = false;
     bool json = false;
 };
@@ -69,14 +66,8 @@ void parse_orient(const std::string& text, SurfelOptions& options)
 void run_normals(const NormalsCommandOptions& options, const GlobalOptions& global)
 {
     set_thread_count(global.threads);
-    SurfelOptions surfel_options{
-        .k = options.k,
-        .graph_k = options.graph_k,
-        .rule = options.rule == "reflection" ? OrientationRule::Reflection : OrientationRule::Hoppe,
-        .radius_scale = options.radius_scale};
+    SurfelOptions surfel_options = options.surfels;
     parse_orient(options.orient, surfel_options);
-    if (!options.radius_regions.empty())
-        surfel_options.radius_regions = read_radius_regions(options.radius_regions);
 
     TerminalProgress progress(!global.quiet && !options.json);
     surfel_options.progress = progress.callback();
@@ -104,7 +95,7 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
         out["input"] = options.input;
         out["output"] = options.output;
         out["points"] = result.surfels.size();
-        out["k"] = options.k;
+        out["k"] = options.surfels.k;
         out["components"] = orientation.components;
         out["flipped"] = orientation.flipped;
         out["degenerate"] = result.degenerate;
@@ -152,30 +143,26 @@ void register_normals(CLI::App& app, const GlobalOptions& global)
                     "Point set or mesh: .ply .xyz .pts .csv .txt .pwn .off .obj .pcd .las")
         ->required();
     cmd->add_option("-o,--output", options->output, "Output surfels (.ply, or .xyz)")->required();
-    cmd->add_option("-k", options->k,
-                    "Neighbours of each point, besides itself, for PCA and the radius")
-        ->capture_default_str()
-        ->check(CLI::Range(3, 1000));
-    cmd->add_option("--graph-k", options->graph_k,
+    add_k_option(*cmd, options->surfels.k,
+                 "Neighbours of each point, besides itself, for PCA and the radius");
+    cmd->add_option("--graph-k", options->surfels.graph_k,
                     "Neighbours a point in the orientation graph (0 = min(k, 10))")
         ->capture_default_str();
-    cmd->add_option("--radius-scale", options->radius_scale,
-                    "Factor on the automatic influence radius (distance to the k-th neighbour)")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    cmd->add_option("--radius-regions", options->radius_regions,
-                    "JSON file of balls and boxes that set the radius: {\"regions\": [{\"ball\": "
-                    "{\"center\": [x,y,z], \"radius\": R}, \"set\": r}, {\"box\": {\"min\": "
-                    "[..], \"max\": [..]}, \"scale\": s}]}");
+    add_radius_scale_option(
+        *cmd, options->surfels.radius_scale,
+        "Factor on the automatic influence radius (distance to the k-th neighbour)");
+    add_radius_regions_option(
+        *cmd, options->surfels.radius_regions,
+        "JSON file of balls and boxes that set the radius: {\"regions\": [{\"ball\": "
+        "{\"center\": [x,y,z], \"radius\": R}, \"set\": r}, {\"box\": {\"min\": "
+        "[..], \"max\": [..]}, \"scale\": s}]}");
     cmd->add_option("--orient", options->orient,
                     "mst (consistent, outward on closed surfaces), none, flip (mst, then "
                     "inward), towards:X,Y,Z (a viewpoint) or along:X,Y,Z (a direction)")
         ->capture_default_str();
-    cmd->add_option("--rule", options->rule,
+    add_rule_option(*cmd, options->surfels.rule,
                     "MST propagation rule: hoppe (robust to noise) or reflection (thin walls "
-                    "and creases in clean data)")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"hoppe", "reflection"}));
+                    "and creases in clean data)");
     cmd->add_flag("--ascii", options->ascii, "Write ascii PLY instead of binary");
     cmd->add_flag("--json", options->json,
                   "Print the report (counts, stage timings, peak memory) as JSON");

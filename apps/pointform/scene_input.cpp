@@ -4,14 +4,13 @@
 #include "scene_input.h"
 
 #include "pointform/core/error.h"
-#include "pointform/core/memory.h"
 #include "pointform/io/io.h"
+
+#include "options.h"
 
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <sstream>
-#include <system_error>
 #include <utility>
 
 namespace pointform::cli {
@@ -51,175 +50,43 @@ Aabb parse_bounds(const std::string& text)
     return box;
 }
 
-SceneArgumentKind classify(const std::string& argument)
-{
-    if (!looks_like_file(argument))
-    {
-        return SceneArgumentKind::Expression;
-    }
-    try
-    {
-        (void)format_from_extension(argument);
-        return SceneArgumentKind::Scan;
-    }
-    catch (const IoError&)
-    {
-        return SceneArgumentKind::SceneFile;
-    }
-}
-
 } // namespace
 
 void add_scene_command_options(CLI::App& cmd, SceneCommandOptions& options)
 {
-    auto* resolution = cmd.add_option("--resolution", options.resolution,
+    auto* resolution = cmd.add_option("--resolution", options.grid.resolution,
                                       "Cells along the longest side of the polygonized box")
                            ->check(CLI::Range(2, 1000000));
-    cmd.add_option("--cell", options.cell,
+    cmd.add_option("--cell", options.grid.cell,
                    "Cell size in the input's units (default: 0.4 of the smallest median "
                    "influence radius of the scans, or the longest side / 128 without scans)")
         ->check(CLI::PositiveNumber)
         ->excludes(resolution);
-    cmd.add_option("--bounds", options.bounds,
-                   "Box to polygonize, xmin,ymin,zmin,xmax,ymax,zmax (default: the scene's "
-                   "bounds; required when the scene is unbounded, e.g. a half_space in a union)");
-    cmd.add_option(
-           "--fit", options.fit,
-           "Local surfaces of the scans' fields: quadric, blend, centroid or raw (see `mc`)")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"quadric", "blend", "centroid", "raw"}));
-    add_surfel_input_options(cmd, options.surfels);
+    cmd.add_option_function<std::string>(
+        "--bounds",
+        [&options](const std::string& text) { options.grid.bounds = parse_bounds(text); },
+        "Box to polygonize, xmin,ymin,zmin,xmax,ymax,zmax (default: the scene's "
+        "bounds; required when the scene is unbounded, e.g. a half_space in a union)");
+    add_fit_option(cmd, options.scans.field.fit,
+                   "Local surfaces of the scans' fields: quadric, blend, centroid or raw (see "
+                   "`mc`)");
+    add_surfel_input_options(cmd, options.scans.surfels);
     cmd.add_flag("--ascii", options.ascii, "Write ascii PLY instead of binary");
     cmd.add_flag("--json", options.json, "Print the report as JSON");
 }
 
-const char* to_string(SceneArgumentKind kind)
+namespace {
+
+ScanOptions with_progress(ScanOptions options, const ProgressCallback& progress)
 {
-    switch (kind)
-    {
-        case SceneArgumentKind::Expression:
-            return "expression";
-        case SceneArgumentKind::SceneFile:
-            return "scene file";
-        case SceneArgumentKind::Scan:
-            return "scan";
-    }
-    return "?";
+    options.surfels.progress = progress;
+    return options;
 }
 
-SceneArguments::SceneArguments(const SceneCommandOptions& options, ProgressCallback progress)
-    : options_(options), progress_(std::move(progress))
+} // namespace
+
+SceneArguments::SceneArguments(const SceneCommandOptions& options, const ProgressCallback& progress)
+    : scans_(with_progress(options.scans, progress))
 {}
-
-SceneArguments::Loaded SceneArguments::load(const std::string& argument)
-{
-    Loaded loaded;
-    loaded.kind = classify(argument);
-    ScanLoader loader = [this](const std::string& path) {
-        return load_scan(path);
-    };
-    switch (loaded.kind)
-    {
-        case SceneArgumentKind::Scan:
-            loaded.field = load_scan(argument);
-            break;
-        case SceneArgumentKind::SceneFile:
-            loaded.field = read_scene(argument, loader).field;
-            break;
-        case SceneArgumentKind::Expression:
-        {
-            SceneOptions scene_options;
-            scene_options.source_name = "expression";
-            scene_options.load_scan = loader;
-            loaded.field = parse_scene(argument, scene_options).field;
-            break;
-        }
-    }
-    return loaded;
-}
-
-std::shared_ptr<const Field> SceneArguments::load_scan(const std::string& path)
-{
-    std::error_code error;
-    std::string key = std::filesystem::weakly_canonical(path, error).string();
-    if (error)
-    {
-        key = path;
-    }
-    const auto it = index_.find(key);
-    if (it != index_.end())
-    {
-        return scans_[it->second].field;
-    }
-    SurfelInput input = load_surfels(path, options_.surfels, progress_);
-    LoadedScan scan;
-    scan.path = path;
-    scan.samples = input.surfels.size();
-    scan.estimated_normals = input.estimated_normals;
-    scan.unoriented = input.unoriented;
-    scan.field = std::make_shared<const PointField>(
-        std::move(input.surfels),
-        PointFieldOptions{.fit = parse_plane_fit(options_.fit), .far_grid = options_.far_grid});
-    index_.emplace(key, scans_.size());
-    scans_.push_back(std::move(scan));
-    return scans_.back().field;
-}
-
-SceneGrid choose_scene_grid(const Aabb& field_bounds, const SceneCommandOptions& options,
-                            std::span<const LoadedScan> scans)
-{
-    SceneGrid out;
-    out.box = options.bounds.empty() ? field_bounds : parse_bounds(options.bounds);
-    if (out.box.is_empty())
-    {
-        throw InvalidInput(
-            "the scene is empty: its bounds are empty (an intersection of shapes "
-            "that do not overlap?)");
-    }
-    if (!out.box.min.allFinite() || !out.box.max.allFinite())
-    {
-        throw InvalidInput(
-            "the scene is unbounded (a half_space that is not intersected with a "
-            "bounded shape): pass --bounds xmin,ymin,zmin,xmax,ymax,zmax, or "
-            "intersect it with a bounded shape");
-    }
-    if (options.cell > 0.0)
-    {
-        out.cell = options.cell;
-    }
-    else if (options.resolution > 0)
-    {
-        out.cell = cell_for_resolution(out.box, options.resolution);
-    }
-    else if (!scans.empty())
-    {
-        out.cell = default_cell_size(*scans.front().field);
-        for (const LoadedScan& scan : scans)
-        {
-            out.cell = std::min(out.cell, default_cell_size(*scan.field));
-        }
-    }
-    else
-    {
-        out.cell = cell_for_resolution(out.box, 128);
-    }
-    out.grid = grid_over(out.box, out.cell);
-    for (const LoadedScan& scan : scans)
-    {
-        check_marching_cubes_memory(*scan.field, out.cell);
-    }
-    if (scans.empty())
-    {
-        // Primitives alone: a convex surface inside the box has at most the box's area, so
-        // take that as the surface the grid follows.
-        const Vec3d size = out.box.size();
-        const double area = 2.0 * (size.x() * size.y() + size.y() * size.z() + size.z() * size.x());
-        char what[96];
-        std::snprintf(what, sizeof what, "marching cubes of the scene at a cell of %g", out.cell);
-        check_memory(estimate_marching_cubes_bytes(area, out.cell), what,
-                     "use a larger --cell or a lower --resolution");
-    }
-    return out;
-}
 
 } // namespace pointform::cli

@@ -4,17 +4,14 @@
 #pragma once
 
 #include "pointform/implicit/point_field.h"
+#include "pointform/implicit/scans.h"
 #include "pointform/implicit/scene.h"
-#include "pointform/polygonize/marching_cubes.h"
-
-#include "surfel_input.h"
+#include "pointform/polygonize/scene_mesh.h"
 
 #include <CLI/CLI.hpp>
 
 #include <cstddef>
-#include <map>
 #include <memory>
-#include <span>
 #include <string>
 #include <vector>
 
@@ -23,80 +20,37 @@ namespace pointform::cli {
 /// \brief The options `pointform model` and `pointform morph` share.
 struct SceneCommandOptions
 {
-    int resolution = 0;
-    double cell = 0.0;
-    std::string bounds;
-    std::string fit = "quadric";
-    /// Scans answer deep-inside queries from their far grid (PointFieldOptions::far_grid); the
-    /// morph command turns it off, since a morph takes inside values as distances.
-    bool far_grid = true;
-    SurfelInputOptions surfels;
+    /// --bounds, --cell, --resolution.
+    SceneGridOptions grid;
+    /// How scans become fields: their surfels and point field. Scans answer deep-inside queries
+    /// from their far grid (PointFieldOptions::far_grid); the morph command turns it off, since
+    /// a morph takes inside values as distances.
+    ScanOptions scans;
     bool ascii = false;
     bool json = false;
 };
 
 void add_scene_command_options(CLI::App& cmd, SceneCommandOptions& options);
 
-/// \brief How a scene argument was taken.
-enum class SceneArgumentKind
-{
-    Expression, ///< not an existing file: parsed as a scene expression
-    SceneFile,  ///< an existing file whose extension is not a point format
-    Scan,       ///< an existing point or mesh file (.ply, .xyz, .las, ...): its point field
-};
-
-[[nodiscard]] const char* to_string(SceneArgumentKind kind);
-
-/// \brief A scan a scene uses, loaded once.
-struct LoadedScan
-{
-    std::string path;
-    std::size_t samples = 0;
-    bool estimated_normals = false;
-    std::size_t unoriented = 0;
-    std::shared_ptr<const PointField> field;
-};
-
-/// \brief Turns scene arguments into fields; scans are shared between the arguments.
+/// \brief Turns scene arguments into fields; scans are shared between the arguments
+/// (ScanLoading).
 class SceneArguments
 {
 public:
-    SceneArguments(const SceneCommandOptions& options, ProgressCallback progress);
+    SceneArguments(const SceneCommandOptions& options, const ProgressCallback& progress);
 
-    struct Loaded
+    using Loaded = LoadedScene;
+
+    /// \brief A scan file, a scene file or a scene expression (load_scene_argument()).
+    [[nodiscard]] Loaded load(const std::string& argument)
     {
-        std::shared_ptr<const Field> field;
-        SceneArgumentKind kind = SceneArgumentKind::Expression;
-    };
+        return load_scene_argument(argument, scans_);
+    }
 
-    /// \brief A scan file, a scene file or a scene expression (see SceneArgumentKind).
-    [[nodiscard]] Loaded load(const std::string& argument);
-
-    [[nodiscard]] const std::vector<LoadedScan>& scans() const { return scans_; }
+    [[nodiscard]] const std::vector<LoadedScan>& scans() const { return scans_.scans(); }
 
 private:
-    std::shared_ptr<const Field> load_scan(const std::string& path);
-
-    const SceneCommandOptions& options_;
-    ProgressCallback progress_;
-    std::vector<LoadedScan> scans_;
-    std::map<std::string, std::size_t> index_; // canonical path -> scans_
+    ScanLoading scans_;
 };
-
-/// \brief The grid a scene is polygonized on.
-struct SceneGrid
-{
-    Aabb box;
-    double cell = 0.0;
-    CellGrid grid;
-};
-
-/// \brief Lays the grid over --bounds or else `field_bounds`, with --cell, --resolution (cells
-/// along the longest side) or the default: 0.4 of the smallest median influence radius of the
-/// scans (default_cell_size), or the longest side / 128 for a scene of primitives only. Refuses
-/// an unbounded or empty box, and a cell that would need more memory than there is.
-[[nodiscard]] SceneGrid choose_scene_grid(const Aabb& field_bounds,
-                                          const SceneCommandOptions& options,
-                                          std::span<const LoadedScan> scans);
 
 } // namespace pointform::cli

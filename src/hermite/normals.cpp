@@ -19,9 +19,9 @@ namespace {
 constexpr double collinear_ratio = 1e-10;
 
 /// fit_plane() on indices known to be in range (a checked neighbour table), at least one.
-PlaneFit fit_unchecked(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices)
+LocalPlane fit_unchecked(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices)
 {
-    PlaneFit fit;
+    LocalPlane fit;
     // Shift by the first point so the sums do not lose precision far from the origin.
     const Vec3d shift = positions[indices[0]].cast<double>();
     Vec3d sum = Vec3d::Zero();
@@ -50,7 +50,7 @@ PlaneFit fit_unchecked(std::span<const Vec3f> positions, std::span<const std::ui
 
 } // namespace
 
-PlaneFit fit_plane(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices)
+LocalPlane fit_plane(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices)
 {
     if (indices.empty())
         throw InvalidInput("fit_plane: no indices");
@@ -83,7 +83,7 @@ Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neigh
                                            " of row " + std::to_string(i) +
                                            " is out of range for " +
                                            std::to_string(positions.size()) + " points");
-                const PlaneFit fit = fit_unchecked(positions, row);
+                const LocalPlane fit = fit_unchecked(positions, row);
                 result.normals[i] = fit.normal.cast<float>();
                 degenerate[i] = fit.degenerate ? 1 : 0;
             }

@@ -89,6 +89,8 @@ PointCloud sample_surface(const TriMesh& mesh, const SurfaceSamplingOptions& opt
     PointCloud cloud;
     cloud.origin = mesh.vertices.origin;
     cloud.positions.resize(options.count);
+    if (options.normals)
+        cloud.normals.resize(options.count);
     parallel_blocks(options.count, sample_block, [&](std::size_t begin, std::size_t end) {
         std::mt19937_64 rng(mix(options.seed ^ mix(begin / sample_block)));
         for (std::size_t i = begin; i < end; ++i)
@@ -107,18 +109,40 @@ PointCloud sample_surface(const TriMesh& mesh, const SurfaceSamplingOptions& opt
             const Vec3d c = mesh.vertices.positions[t[2]].cast<double>();
             const Vec3d p = (1.0 - r1) * a + r1 * (1.0 - r2) * b + r1 * r2 * c;
             cloud.positions[i] = p.cast<float>();
+            if (options.normals)
+                cloud.normals[i] = (b - a).cross(c - a).normalized().cast<float>();
         }
     });
 
     if (options.include_vertices)
     {
         std::vector<bool> used(mesh.vertex_count(), false);
+        std::vector<Vec3d> vertex_normals(options.normals ? mesh.vertex_count() : 0, Vec3d::Zero());
         for (const Triangle& t : mesh.triangles)
+        {
             for (const std::uint32_t v : t)
                 used[v] = true;
+            if (options.normals)
+            {
+                const Vec3d a = mesh.vertices.positions[t[0]].cast<double>();
+                const Vec3d cross = (mesh.vertices.positions[t[1]].cast<double>() - a)
+                                        .cross(mesh.vertices.positions[t[2]].cast<double>() - a);
+                for (const std::uint32_t v : t)
+                    vertex_normals[v] += cross; // |cross| is twice the area: area-weighted
+            }
+        }
         for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
             if (used[v])
+            {
                 cloud.positions.push_back(mesh.vertices.positions[v]);
+                if (options.normals)
+                {
+                    const double norm = vertex_normals[v].norm();
+                    cloud.normals.push_back(norm > 0.0
+                                                ? Vec3f((vertex_normals[v] / norm).cast<float>())
+                                                : Vec3f::Zero());
+                }
+            }
     }
     return cloud;
 }

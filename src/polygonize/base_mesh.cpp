@@ -14,6 +14,7 @@
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 #include "pointform/io/io.h"
+#include "pointform/metrics/quality.h"
 #include "pointform/polygonize/projection.h"
 #include "pointform/spatial/kd_tree.h"
 
@@ -146,17 +147,7 @@ constexpr double outward_factor = 4.0;
 /// Smallest interior angle of triangle abc, radians; 0 for a degenerate one.
 double min_angle(const Vec3d& a, const Vec3d& b, const Vec3d& c)
 {
-    const auto angle = [](const Vec3d& u, const Vec3d& v) {
-        return std::atan2(u.cross(v).norm(), u.dot(v));
-    };
-    const Vec3d ab = b - a;
-    const Vec3d bc = c - b;
-    const Vec3d ca = a - c;
-    if (ab.squaredNorm() == 0.0 || bc.squaredNorm() == 0.0 || ca.squaredNorm() == 0.0)
-    {
-        return 0.0;
-    }
-    return std::min({angle(ab, Vec3d(-ca)), angle(bc, Vec3d(-ab)), angle(ca, Vec3d(-bc))});
+    return triangle_min_angle(a, b, c);
 }
 
 std::array<Vec3d, 3> face_points(const OmMesh& mesh, OmMesh::FaceHandle f)
@@ -839,40 +830,23 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
             std::max(stats.max_vertex_move, (state.position[i] - decimated[i]).norm());
     }
     out.triangles.reserve(mesh.n_faces());
-    std::size_t below_20 = 0;
-    std::size_t off_boundary = 0;
-    std::size_t off_boundary_below_20 = 0;
-    double angle_sum = 0.0;
-    stats.min_angle_degrees = 180.0;
     for (const auto f : mesh.faces())
     {
         Triangle t{};
-        bool on_boundary = false;
         int i = 0;
         for (const auto v : mesh.fv_range(f))
         {
             t[static_cast<std::size_t>(i++)] = static_cast<std::uint32_t>(v.idx());
-            on_boundary = on_boundary || mesh.is_boundary(v);
         }
         out.triangles.push_back(t);
-        const double angle = min_angle(out.vertices.positions[t[0]].cast<double>(),
-                                       out.vertices.positions[t[1]].cast<double>(),
-                                       out.vertices.positions[t[2]].cast<double>()) /
-                             degrees;
-        stats.min_angle_degrees = std::min(stats.min_angle_degrees, angle);
-        angle_sum += angle;
-        below_20 += angle < 20.0 ? 1 : 0;
-        off_boundary += on_boundary ? 0 : 1;
-        off_boundary_below_20 += !on_boundary && angle < 20.0 ? 1 : 0;
     }
-    const auto share = [](std::size_t part, std::size_t whole) {
-        return whole == 0 ? 0.0 : static_cast<double>(part) / static_cast<double>(whole);
-    };
+    const AngleQuality angles = angle_quality(out);
     stats.faces = out.face_count();
     stats.vertices = out.vertex_count();
-    stats.mean_min_angle_degrees = share(1, stats.faces) * angle_sum;
-    stats.share_below_20_degrees = share(below_20, stats.faces);
-    stats.share_below_20_degrees_off_boundary = share(off_boundary_below_20, off_boundary);
+    stats.min_angle_degrees = angles.min_degrees;
+    stats.mean_min_angle_degrees = angles.mean_min_degrees;
+    stats.share_below_20_degrees = angles.sliver_share;
+    stats.share_below_20_degrees_off_boundary = angles.interior_sliver_share;
     stats.topology_after = analyze_topology(out);
     stats.topology_change = describe_topology_change(before, stats.topology_after);
     stats.topology_kept = stats.topology_change.empty();

@@ -561,6 +561,13 @@ IntermediateGrid intermediate_grid(const PointField& field, double cell, double 
     return out;
 }
 
+double choose_cell_size(const PointField& field, const Aabb& bounds, int resolution, double cell)
+{
+    if (resolution > 0)
+        return cell_for_resolution(bounds, resolution);
+    return cell > 0.0 ? cell : default_cell_size(field);
+}
+
 double estimate_marching_cubes_bytes(double surface_area, double cell)
 {
     // A surface of area A cuts about 1.5 A / h² cells (the mean of |nx| + |ny| + |nz|); each

@@ -720,39 +720,6 @@ std::string_view to_string(StopRule rule)
     return "auto";
 }
 
-double estimate_sampling_density(const PointCloud& samples)
-{
-    if (samples.size() < 2)
-        throw InvalidInput("sampling density: need at least 2 samples, got " +
-                           std::to_string(samples.size()));
-    const KdTree tree(samples.positions);
-    // At most about 100k queries, evenly spread over the samples (deterministic stride).
-    const std::size_t stride = std::max<std::size_t>(1, samples.size() / 100000);
-    const std::size_t queries = (samples.size() + stride - 1) / stride;
-    const std::size_t k = std::min<std::size_t>(8, samples.size());
-    std::vector<double> nearest(queries, -1.0);
-    parallel_blocks(queries, 1024, [&](std::size_t begin, std::size_t end) {
-        std::vector<std::uint32_t> indices(k);
-        std::vector<float> d2(k);
-        for (std::size_t q = begin; q < end; ++q)
-        {
-            const std::size_t found = tree.knn(samples.positions[q * stride], k, indices, d2);
-            for (std::size_t i = 0; i < found; ++i)
-                if (d2[i] > 0.0F)
-                {
-                    nearest[q] = std::sqrt(static_cast<double>(d2[i]));
-                    break;
-                }
-        }
-    });
-    nearest.erase(std::remove(nearest.begin(), nearest.end(), -1.0), nearest.end());
-    if (nearest.empty())
-        throw InvalidInput("sampling density: the samples are all coincident");
-    const auto middle = nearest.begin() + static_cast<std::ptrdiff_t>(nearest.size() / 2);
-    std::nth_element(nearest.begin(), middle, nearest.end());
-    return *middle;
-}
-
 RefineLevelStats refine_once(MultiresMesh& mesh, const Field& field, const RefineOptions& options,
                              const PointCloud* samples)
 {
@@ -871,10 +838,18 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
     check_options(options);
     if (mesh.level_count() == 0)
         throw InvalidInput("refine: the hierarchy is empty");
-    if (samples.empty())
-        throw InvalidInput("refine: no samples to measure the Hausdorff distance from");
     RefineReport report;
     report.stop_rule = options.stop_rule;
+    if (samples.empty())
+    {
+        if (options.stop_rule != StopRule::Exact)
+            throw InvalidInput("refine: no samples to measure the Hausdorff distance from");
+        // Exactly to max_level with nothing to measure (a modeled surface).
+        while (mesh.finest_level() < options.max_level)
+            report.levels.push_back(refine_once(mesh, field, options));
+        report.stop = RefineStop::LevelCap;
+        return report;
+    }
     report.sampling_density = options.sampling_density > 0.0 ? options.sampling_density
                                                              : estimate_sampling_density(samples);
     const Distances initial = distances_from(

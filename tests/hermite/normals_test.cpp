@@ -32,7 +32,7 @@ TEST(FitPlane, RecoversTiltedPlaneExactly)
             indices.push_back(static_cast<std::uint32_t>(points.size()));
             points.push_back((Vec3d(1.0, 2.0, 3.0) + 0.1 * a * u + 0.07 * b * v).cast<float>());
         }
-    const PlaneFit fit = fit_plane(points, indices);
+    const LocalPlane fit = fit_plane(points, indices);
     EXPECT_FALSE(fit.degenerate);
     EXPECT_NEAR(std::abs(fit.normal.dot(n)), 1.0, 1e-6);
     EXPECT_NEAR((fit.centroid - Vec3d(1.0, 2.0, 3.0)).norm(), 0.0, 1e-6);

@@ -94,6 +94,28 @@ TEST(SurfaceSampling, VerticesAreAppendedWhenAsked)
     EXPECT_EQ(only_vertices.size(), 6U);
 }
 
+TEST(SurfaceSampling, NormalsOfTheTrianglesAndAreaWeightedAtVertices)
+{
+    // An icosphere (outward triangles): every random sample's normal is its triangle's, within
+    // the angle a facet makes with the radius; every vertex normal is the area-weighted mean,
+    // close to the radius there. The positions are those sampled without normals.
+    const TriMesh sphere = test::icosphere(3);
+    const SurfaceSamplingOptions plain{.count = 2000, .seed = 9, .include_vertices = true};
+    SurfaceSamplingOptions with_normals = plain;
+    with_normals.normals = true;
+    const PointCloud samples = sample_surface(sphere, with_normals);
+    ASSERT_EQ(samples.normals.size(), samples.size());
+    EXPECT_EQ(samples.positions, sample_surface(sphere, plain).positions);
+    for (std::size_t i = 0; i < samples.size(); ++i)
+    {
+        const Vec3d n = samples.normals[i].cast<double>();
+        const Vec3d radial = samples.positions[i].cast<double>().normalized();
+        EXPECT_NEAR(n.norm(), 1.0, 1e-6);
+        // Facets of a level-3 icosphere span about 4.6°; vertex normals are within a degree.
+        EXPECT_GT(n.dot(radial), i < 2000 ? std::cos(0.1) : std::cos(0.02)) << i;
+    }
+}
+
 TEST(SurfaceSampling, ZeroAreaTrianglesGetNoSamples)
 {
     TriMesh mesh = two_triangles();

@@ -15,7 +15,7 @@
 namespace pointform {
 
 /// \brief Least-squares plane through a set of points.
-struct PlaneFit
+struct LocalPlane
 {
     Vec3d centroid = Vec3d::Zero();
     Vec3d normal = Vec3d::Zero(); ///< unit; zero when the points span no plane
@@ -38,15 +38,19 @@ struct PlaneFit
 /// \param positions  N points
 /// \param indices    the subset to fit, each < N; at least one
 /// \throw InvalidInput if `indices` is empty or one is out of range
-[[nodiscard]] PlaneFit fit_plane(std::span<const Vec3f> positions,
-                                 std::span<const std::uint32_t> indices);
+[[nodiscard]] LocalPlane fit_plane(std::span<const Vec3f> positions,
+                                   std::span<const std::uint32_t> indices);
+
+/// \brief The neighbours of each point, besides itself, that Level 1 → 2 uses by default: for
+/// its normal (PCA), and for its automatic influence radius (the distance to the k-th).
+inline constexpr std::size_t default_neighbors = 16;
 
 /// \brief Options for estimate_normals.
 struct NormalOptions
 {
     /// Neighbours in each fit besides the point itself. 16 suits most scans; raise it for
     /// noisy data. Must be less than the number of points.
-    std::size_t k = 16;
+    std::size_t k = default_neighbors;
     /// Optional progress report.
     ProgressCallback progress;
 };

@@ -14,13 +14,24 @@
 
 namespace pointform {
 
+/// \brief The factor on the automatic influence radius (§4.1) of surfels made for their own sake
+/// (compute_surfels(), `pointform normals`): the k-th neighbour's distance as it is.
+inline constexpr double default_radius_scale = 1.0;
+
+/// \brief The factor on the automatic influence radius (§4.1) of surfels that a field is built
+/// from (surfels_from_samples(), surfels_from_mesh(); `mc`, `model`, `reconstruct`, `remesh`):
+/// at 1 irregularly sampled scans keep pinholes between clusters; 1.5 closes those and leaves
+/// real holes open.
+inline constexpr double default_field_radius_scale = 1.5;
+
 /// \brief Automatic influence radius (§4.1): for every point, the radius of the smallest ball
 /// centred at it that holds its k nearest neighbours (the distance to the k-th), times `scale`.
 /// \param neighbors  an N by k table with squared distances
 /// \param scale      user factor, > 0; 1 closes gaps up to about one sampling step, larger values
 ///                   close larger holes in the field
 /// \throw InvalidInput if scale is not positive and finite
-[[nodiscard]] std::vector<float> influence_radii(const KnnTable& neighbors, double scale = 1.0);
+[[nodiscard]] std::vector<float> influence_radii(const KnnTable& neighbors,
+                                                 double scale = default_radius_scale);
 
 /// \brief A user region that sets the influence radius of the samples inside it (§4.1,
 /// interactive). Coordinates are world coordinates in the input's units.

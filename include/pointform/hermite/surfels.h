@@ -5,10 +5,14 @@
 
 #include "pointform/core/progress.h"
 #include "pointform/geometry/point_cloud.h"
+#include "pointform/geometry/tri_mesh.h"
+#include "pointform/hermite/normals.h"
 #include "pointform/hermite/orientation.h"
 #include "pointform/hermite/radius.h"
+#include "pointform/metrics/surface_sampling.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -30,7 +34,7 @@ struct SurfelOptions
 {
     /// Neighbours of each point, besides itself, for PCA and the automatic radius (as CGAL counts
     /// them; Open3D's KNN(k) counts the point itself).
-    std::size_t k = 16;
+    std::size_t k = default_neighbors;
     /// Neighbours a point in the orientation graph; 0 = min(k, 10).
     std::size_t graph_k = 0;
     /// Orientation mode and its parameters.
@@ -40,7 +44,7 @@ struct SurfelOptions
     /// Orientation propagation rule (MST modes).
     OrientationRule rule = OrientationRule::Hoppe;
     /// Factor on the automatic influence radius (§4.1), > 0.
-    double radius_scale = 1.0;
+    double radius_scale = default_radius_scale;
     /// User regions that set the radius (§4.1, interactive), applied after the automatic one.
     std::vector<RadiusRegion> radius_regions;
     /// Optional progress report.
@@ -71,5 +75,80 @@ void check_surfel_input(const PointCloud& cloud, std::size_t k);
 /// \throw InvalidInput as check_surfel_input, or for non-positive radius_scale
 [[nodiscard]] SurfelResult compute_surfels(const PointCloud& cloud,
                                            const SurfelOptions& options = {});
+
+/// \brief Options of surfels_from_samples(): samples of any kind to the surfels of a field.
+struct SurfelsFromSamplesOptions
+{
+    /// Neighbours of each sample, besides itself, for normals and the automatic radius, ≥ 3.
+    std::size_t k = default_neighbors;
+    /// Factor on the automatic influence radius (distance to the k-th neighbour), > 0; applies
+    /// to the radii computed here, not to radii the samples carry.
+    double radius_scale = default_field_radius_scale;
+    /// User regions that set the computed radii (§4.1), applied after the automatic one.
+    std::vector<RadiusRegion> radius_regions;
+    /// Estimate and orient normals even if the samples have them.
+    bool reestimate = false;
+    ProgressCallback progress;
+};
+
+/// \brief The surfels of surfels_from_samples() and what was done to make them.
+struct SurfelsFromSamples
+{
+    /// Oriented unit normals and radii; the samples without a usable normal left out.
+    PointCloud surfels;
+    /// Normals were estimated and oriented here (the samples had none, or reestimate).
+    bool estimated_normals = false;
+    /// Radii were computed here (normals estimated, or the samples had no radius).
+    bool estimated_radii = false;
+    /// When normals were estimated: the orientation's components and flipped normals
+    /// (OrientedNormals), and the samples whose neighbourhood was degenerate.
+    std::size_t components = 0;
+    std::size_t flipped = 0;
+    std::size_t degenerate = 0;
+    /// Samples left out for want of a usable normal: ones that could not be oriented, or given
+    /// normals that are zero or not finite.
+    std::size_t unoriented = 0;
+};
+
+/// \brief Samples of any kind to the surfels of a field (Level 1 or 2 → 2): raw points get
+/// normals estimated and oriented and radii computed (compute_surfels()); points with normals
+/// keep them and get automatic radii if they have none. Samples without a usable normal
+/// (zero, non-finite, or unorientable) are dropped and counted.
+/// \throw InvalidInput as check_surfel_input(), for a radius_scale not positive and finite, or
+///        when fewer than k + 1 samples with a usable normal are left
+[[nodiscard]] SurfelsFromSamples surfels_from_samples(
+    PointCloud samples, const SurfelsFromSamplesOptions& options = {});
+
+/// \brief Options of surfels_from_mesh().
+struct SurfelsFromMeshOptions
+{
+    /// Area-uniform samples besides the vertices; 0 = as many as the mesh has vertices.
+    std::size_t samples = 0;
+    /// Seed of the area-uniform samples (sample_surface()).
+    std::uint64_t seed = SurfaceSamplingOptions{}.seed;
+    /// Neighbours of each surfel, besides itself, for its influence radius, ≥ 3.
+    std::size_t k = default_neighbors;
+    /// Factor on the influence radius (distance to the k-th neighbour), > 0.
+    double radius_scale = default_field_radius_scale;
+};
+
+/// \brief The surfels of a mesh (remeshing, §6: the mesh as Level 2).
+struct SurfelsFromMesh
+{
+    PointCloud surfels;
+    /// Surfels at the mesh's vertices (area-weighted vertex normals), and area-uniform ones
+    /// (their triangle's normal), in that order in `surfels`.
+    std::size_t vertex_surfels = 0;
+    std::size_t area_surfels = 0;
+};
+
+/// \brief A triangle mesh to surfels (§6): every vertex a triangle uses with its area-weighted
+/// normal (left out where that normal vanishes), then `samples` area-uniform samples
+/// (sample_surface()) with their triangle's normal; radii from the distance to the k-th
+/// neighbour times radius_scale. The result does not depend on the thread count.
+/// \throw InvalidInput for a mesh without triangles or area, an index out of range, a
+///        radius_scale not positive and finite, or k + 1 or fewer surfels
+[[nodiscard]] SurfelsFromMesh surfels_from_mesh(const TriMesh& mesh,
+                                                const SurfelsFromMeshOptions& options = {});
 
 } // namespace pointform

@@ -37,11 +37,6 @@ enum class PlaneFit
 [[nodiscard]] PlaneFit parse_plane_fit(std::string_view text);
 [[nodiscard]] std::string_view to_string(PlaneFit fit);
 
-/// \brief The factor on the automatic influence radius (§4.1) that commands building a field use
-/// by default: at 1 (the k-th neighbour's distance) irregularly sampled scans keep pinholes
-/// between clusters; 1.5 closes those and leaves real holes open.
-inline constexpr double default_field_radius_scale = 1.5;
-
 struct PointFieldOptions
 {
     PlaneFit fit = PlaneFit::Quadric;

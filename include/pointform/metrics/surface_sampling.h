@@ -23,6 +23,10 @@ struct SurfaceSamplingOptions
     /// Also append every vertex that a triangle uses (after the random samples), so that
     /// corners and sharp features are measured exactly, as MeshLab's Metro does.
     bool include_vertices = false;
+    /// Also give every sample a unit normal: a random sample its triangle's, a vertex the
+    /// area-weighted mean of the normals of the triangles around it (zero where those have no
+    /// area, or cancel out).
+    bool normals = false;
 };
 
 /// \brief Samples a triangle mesh uniformly by area.
@@ -34,7 +38,7 @@ struct SurfaceSamplingOptions
 /// number of threads.
 /// \param mesh  V vertices and F >= 1 triangles of positive total area
 /// \return count random samples followed (if include_vertices) by the used vertices in index
-///         order; the cloud has the mesh's origin and no attributes
+///         order; the cloud has the mesh's origin and no attributes but the normals asked for
 /// \throw InvalidInput if the mesh has no triangles or zero total area, an index is out of range
 ///        or a position is not finite
 [[nodiscard]] PointCloud sample_surface(const TriMesh& mesh,

@@ -37,6 +37,11 @@ class PointField;
 /// (0.4 of the median radius), so a clean scan comes out closed.
 [[nodiscard]] double default_cell_size(const PointField& field);
 
+/// \brief The cell of marching cubes on a point field: `resolution` cells along the longest side
+/// of `bounds` when `resolution` > 0, else `cell` when > 0, else default_cell_size(field).
+[[nodiscard]] double choose_cell_size(const PointField& field, const Aabb& bounds, int resolution,
+                                      double cell);
+
 /// \brief About how many bytes marching cubes needs on a point field at this cell size (the
 /// cells on a surface of the field's estimated area, with their corner values, triangles and
 /// vertices).

@@ -7,6 +7,7 @@
 #include "pointform/geometry/multires_mesh.h"
 #include "pointform/geometry/point_cloud.h"
 #include "pointform/implicit/field.h"
+#include "pointform/metrics/sampling_density.h"
 
 #include <cstddef>
 #include <optional>
@@ -125,7 +126,8 @@ struct RefineOptions
     /// than this factor per level are the field's noise; in (0, 1).
     double noise_decay = 0.5;
     /// refine(): stop once the one-sided Hausdorff distance from the samples to M^J is below
-    /// this, in world units (§5.2.4). 0 = estimate_sampling_density(samples).
+    /// this, in world units (§5.2.4). 0 = estimate_sampling_density(samples)
+    /// (pointform/metrics/sampling_density.h).
     double sampling_density = 0.0;
     /// refine(), StopRule::Paper: also stop when a level lowers the Hausdorff distance by less than
     /// this fraction of the previous level's: the samples that stay far are where no refinement
@@ -229,12 +231,6 @@ struct RefineReport
     RefineStop stop = RefineStop::LevelCap;
 };
 
-/// \brief The sampling density of a point set, the threshold of the stopping criterion
-/// (§5.2.4): the median, over the samples, of the distance to the nearest other sample (world
-/// units); coincident duplicates are skipped (the distance to the nearest distinct sample).
-/// \throw InvalidInput if the cloud has fewer than 2 distinct points
-[[nodiscard]] double estimate_sampling_density(const PointCloud& samples);
-
 /// \brief One refinement M^J → M^(J+1) of the finest level (§5.2).
 ///
 /// 1. Split: every face 1-to-4 (MultiresMesh::split); the new vertex of edge e starts at the
@@ -270,8 +266,10 @@ RefineLevelStats refine_once(MultiresMesh& mesh, const Field& field,
 /// \brief Refines the finest level until options.stop_rule says stop (StopRule), at most to
 /// options.max_level. Checks the rule on the starting level first, so a hierarchy that already
 /// fits is left as it is. A level that stalls is measured, removed again and reported in
-/// RefineReport::dropped.
-/// \throw InvalidInput as refine_once(), or if `samples` is empty
+/// RefineReport::dropped. With StopRule::Exact, `samples` may be empty: then it refines to
+/// max_level measuring nothing (no distances, no sampling density, as refine_once() without
+/// samples), e.g. on a modeled surface.
+/// \throw InvalidInput as refine_once(), or if `samples` is empty and the rule is not Exact
 /// \throw Cancelled if the progress callback asks to stop
 RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& samples,
                     const RefineOptions& options = {});

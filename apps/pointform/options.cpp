@@ -1,0 +1,214 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "options.h"
+
+#include "pointform/hermite/radius.h"
+#include "pointform/polygonize/refine.h"
+
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace pointform::cli {
+namespace {
+
+template <typename Enum>
+using EnumNames = std::vector<std::pair<std::string, Enum>>;
+
+/// A transform of an enum's names into the values CLI11 assigns (the underlying integers),
+/// refusing every other text, the integers included; "{a,b,c}" in the help.
+template <typename Enum>
+CLI::Validator enum_transform(const EnumNames<Enum>& names)
+{
+    std::string list;
+    for (const auto& [text, item] : names)
+        list += (list.empty() ? "{" : ",") + text;
+    list += "}";
+    return CLI::Validator(
+        [names, list](std::string& text) -> std::string {
+            for (const auto& [name, item] : names)
+                if (name == text)
+                {
+                    text = std::to_string(static_cast<std::underlying_type_t<Enum>>(item));
+                    return {};
+                }
+            return text + " not in " + list;
+        },
+        list);
+}
+
+/// Binds an enum option through enum_transform(), showing `value`'s name as the default.
+template <typename Enum>
+CLI::Option* add_enum_option(CLI::App& cmd, const std::string& name, Enum& value,
+                             const EnumNames<Enum>& names, const std::string& help)
+{
+    std::string default_name;
+    for (const auto& [text, item] : names)
+        if (item == value)
+            default_name = text;
+    // Bound through a function: CLI11 would otherwise look for the enum's to_string(), which
+    // the library's overloads answer with a string_view.
+    return cmd
+        .add_option_function<Enum>(
+            name, [&value](const Enum& parsed) { value = parsed; }, help)
+        ->transform(enum_transform(names))
+        ->type_name("TEXT")
+        ->default_str(default_name);
+}
+
+/// --levels: a whole number from 0 to max_exact_levels.
+CLI::Validator levels_range()
+{
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            long long value = 0;
+            try
+            {
+                std::size_t used = 0;
+                value = std::stoll(text, &used);
+                if (used != text.size())
+                    return "--levels must be an integer, not '" + text + "'";
+            }
+            catch (const std::exception&)
+            {
+                return "--levels must be an integer, not '" + text + "'";
+            }
+            if (value < 0 || value > static_cast<long long>(max_exact_levels))
+                return "--levels must be between 0 and " + std::to_string(max_exact_levels) +
+                       " (each level has 4 times the faces of the one below: level 8 has 65536 "
+                       "times the base mesh's), not " +
+                       text;
+            return {};
+        },
+        "0.." + std::to_string(max_exact_levels));
+}
+
+/// --base-faces: a whole number, at least 1.
+CLI::Validator at_least_one_face()
+{
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            try
+            {
+                std::size_t used = 0;
+                if (std::stoll(text, &used) >= 1 && used == text.size())
+                    return {};
+            }
+            catch (const std::exception&)
+            {}
+            return "--base-faces must be a whole number of faces, at least 1, not '" + text + "'";
+        },
+        "N >= 1");
+}
+
+} // namespace
+
+CLI::Option* add_k_option(CLI::App& cmd, std::size_t& k, const std::string& help)
+{
+    return cmd.add_option("-k", k, help)->capture_default_str()->check(CLI::Range(3, 1000));
+}
+
+CLI::Option* add_radius_scale_option(CLI::App& cmd, double& scale, const std::string& help)
+{
+    return cmd.add_option("--radius-scale", scale, help)
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+}
+
+CLI::Option* add_radius_regions_option(CLI::App& cmd, std::vector<RadiusRegion>& regions,
+                                       const std::string& help)
+{
+    return cmd.add_option_function<std::string>(
+        "--radius-regions",
+        [&regions](const std::string& path) { regions = read_radius_regions(path); }, help);
+}
+
+CLI::Option* add_fit_option(CLI::App& cmd, PlaneFit& fit, const std::string& help)
+{
+    return add_enum_option(cmd, "--fit", fit,
+                           {{"quadric", PlaneFit::Quadric},
+                            {"blend", PlaneFit::Blend},
+                            {"centroid", PlaneFit::Centroid},
+                            {"raw", PlaneFit::Raw}},
+                           help);
+}
+
+CLI::Option* add_rule_option(CLI::App& cmd, OrientationRule& rule, const std::string& help)
+{
+    return add_enum_option(
+        cmd, "--rule", rule,
+        {{"hoppe", OrientationRule::Hoppe}, {"reflection", OrientationRule::Reflection}}, help);
+}
+
+void add_surfel_input_options(CLI::App& cmd, SurfelsFromSamplesOptions& options)
+{
+    add_k_option(cmd, options.k,
+                 "Neighbours of each point, besides itself, for normals and the radius");
+    add_radius_scale_option(cmd, options.radius_scale,
+                            "Factor on the automatic influence radius (distance to the k-th "
+                            "neighbour); larger values close larger holes");
+    add_radius_regions_option(
+        cmd, options.radius_regions,
+        "JSON file of balls and boxes that set the radius (see `pointform normals`)");
+    cmd.add_flag("--reestimate", options.reestimate,
+                 "Estimate and orient normals even if the input has them");
+}
+
+std::vector<CLI::Option*> add_level_options(CLI::App& cmd, SemiRegularCommandOptions& options,
+                                            const std::string& levels_help)
+{
+    SemiRegularOptions& semi = options.semi_regular;
+    std::vector<CLI::Option*> added;
+    added.push_back(cmd.add_option("--levels", semi.levels, levels_help)->check(levels_range()));
+    added.push_back(add_enum_option(
+        cmd, "--predictor", semi.predictor,
+        {{"midpoint", Predictor::Midpoint}, {"butterfly", Predictor::Butterfly}},
+        "Where a new edge vertex starts before its projection onto the surface: midpoint, or "
+        "butterfly (the displaced butterfly subdivision)"));
+    added.push_back(
+        cmd.add_option("--relax", semi.relax_iterations,
+                       "Rounds of tangential relaxation of the new vertices per level (§5.2.3), "
+                       "each followed by their re-projection; 0 keeps the projected predictions")
+            ->capture_default_str()
+            ->check(CLI::Range(0, 10)));
+    added.push_back(add_enum_option(
+        cmd, "--relaxation", semi.relaxation,
+        {{"across", Relaxation::AcrossEdge}, {"umbrella", Relaxation::Umbrella}},
+        "Which part of the umbrella move relaxation makes: across (the part across the parent "
+        "edge, which keeps the split ratio) or umbrella (all of it, as in the paper)"));
+    added.push_back(cmd.add_option("--save-hierarchy", options.save_hierarchy,
+                                   "Also write every level as a hierarchy file (.pfh; extract "
+                                   "levels with `pointform lod`)"));
+    return added;
+}
+
+void add_refine_options(CLI::App& cmd, SemiRegularCommandOptions& options)
+{
+    add_level_options(cmd, options,
+                      "Refine exactly to level J (0 = the base mesh only); default: until the "
+                      "--stop rule says so (at most level " +
+                          std::to_string(default_max_level) + ")");
+    add_enum_option(cmd, "--stop", options.semi_regular.stop_rule,
+                    {{"auto", StopRule::Automatic}, {"paper", StopRule::Paper}},
+                    "When refinement stops without --levels: auto (the default: while the next "
+                    "level would move the mesh by more than a tenth of the field's residual at "
+                    "the samples, and would have no more vertices than there are samples) or "
+                    "paper (§5.2.4: until the largest distance from a sample is below the "
+                    "sampling density)");
+    cmd.add_flag("--ascii", options.ascii, "Write ascii PLY instead of binary");
+    cmd.add_flag("--json", options.json, "Print the report as JSON");
+}
+
+CLI::Option* add_base_faces_option(CLI::App& cmd, SemiRegularOptions& options)
+{
+    return cmd
+        .add_option("--base-faces", options.base_faces,
+                    "Faces of the automatic base mesh (default: the intermediate mesh's faces / "
+                    "64, within [200, 20000])")
+        ->check(at_least_one_face());
+}
+
+} // namespace pointform::cli

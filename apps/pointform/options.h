@@ -1,0 +1,64 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+// The options several subcommands share, each declared once here and bound straight into the
+// library's options structs (enums through a transform of their names), with the library's
+// defaults.
+
+#pragma once
+
+#include "pointform/hermite/orientation.h"
+#include "pointform/hermite/surfels.h"
+#include "pointform/implicit/point_field.h"
+#include "pointform/polygonize/reconstruct.h"
+
+#include <CLI/CLI.hpp>
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace pointform::cli {
+
+/// -k: neighbours of each point, besides itself (3 to 1000).
+CLI::Option* add_k_option(CLI::App& cmd, std::size_t& k, const std::string& help);
+
+/// --radius-scale: the factor on the automatic influence radius (> 0).
+CLI::Option* add_radius_scale_option(CLI::App& cmd, double& scale, const std::string& help);
+
+/// --radius-regions FILE: read into `regions` (read_radius_regions()) as the command line is
+/// parsed.
+CLI::Option* add_radius_regions_option(CLI::App& cmd, std::vector<RadiusRegion>& regions,
+                                       const std::string& help);
+
+/// --fit quadric|blend|centroid|raw.
+CLI::Option* add_fit_option(CLI::App& cmd, PlaneFit& fit, const std::string& help);
+
+/// --rule hoppe|reflection.
+CLI::Option* add_rule_option(CLI::App& cmd, OrientationRule& rule, const std::string& help);
+
+/// -k, --radius-scale, --radius-regions and --reestimate of the commands that turn samples
+/// into a field (surfels_from_samples()).
+void add_surfel_input_options(CLI::App& cmd, SurfelsFromSamplesOptions& options);
+
+/// What reconstruct, remesh and `model --semi-regular` share besides the library's options.
+struct SemiRegularCommandOptions
+{
+    SemiRegularOptions semi_regular;
+    std::string save_hierarchy;
+    bool ascii = false;
+    bool json = false;
+};
+
+/// Adds --levels (with `levels_help`), --predictor, --relax, --relaxation and --save-hierarchy.
+/// \return the options added
+std::vector<CLI::Option*> add_level_options(CLI::App& cmd, SemiRegularCommandOptions& options,
+                                            const std::string& levels_help);
+
+/// Adds add_level_options(), --stop, --ascii and --json.
+void add_refine_options(CLI::App& cmd, SemiRegularCommandOptions& options);
+
+/// Adds --base-faces. \return the option, for excludes()
+CLI::Option* add_base_faces_option(CLI::App& cmd, SemiRegularOptions& options);
+
+} // namespace pointform::cli

@@ -1,0 +1,134 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+// surfels_from_samples() and surfels_from_mesh(): the one way from samples of any kind, or from
+// a mesh, to the surfels of a field.
+
+#include "pointform/core/error.h"
+#include "pointform/hermite/radius.h"
+#include "pointform/hermite/surfels.h"
+#include "pointform/metrics/surface_sampling.h"
+#include "pointform/spatial/kd_tree.h"
+
+#include <cmath>
+#include <string>
+#include <utility>
+
+namespace pointform {
+namespace {
+
+/// Removes the samples without a usable normal (zero or not finite): they carry no plane.
+/// \return how many were removed
+std::size_t drop_unoriented(PointCloud& cloud)
+{
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+    {
+        const float norm = cloud.normals[i].norm();
+        if (!(norm > 0.5F) || !std::isfinite(norm))
+            continue;
+        cloud.positions[kept] = cloud.positions[i];
+        cloud.normals[kept] = cloud.normals[i];
+        if (cloud.has_colors())
+            cloud.colors[kept] = cloud.colors[i];
+        if (cloud.has_radii())
+            cloud.radii[kept] = cloud.radii[i];
+        ++kept;
+    }
+    const std::size_t dropped = cloud.size() - kept;
+    cloud.positions.resize(kept);
+    cloud.normals.resize(kept);
+    if (cloud.has_colors())
+        cloud.colors.resize(kept);
+    if (cloud.has_radii())
+        cloud.radii.resize(kept);
+    return dropped;
+}
+
+void check_radius_scale(double scale)
+{
+    if (!(scale > 0.0) || !std::isfinite(scale))
+        throw InvalidInput("radius scale must be positive and finite");
+}
+
+/// Automatic radii: the distance to the k-th neighbour times `scale`.
+std::vector<float> automatic_radii(const PointCloud& cloud, std::size_t k, double scale)
+{
+    const KdTree tree(cloud.positions);
+    const KnnTable knn = knn_batch(tree, cloud.positions, k + 1);
+    return influence_radii(knn, scale);
+}
+
+} // namespace
+
+SurfelsFromSamples surfels_from_samples(PointCloud samples,
+                                        const SurfelsFromSamplesOptions& options)
+{
+    check_radius_scale(options.radius_scale);
+    SurfelsFromSamples out;
+    if (!samples.has_normals() || options.reestimate)
+    {
+        samples.normals.clear();
+        samples.radii.clear();
+        SurfelResult result = compute_surfels(samples, {.k = options.k,
+                                                        .radius_scale = options.radius_scale,
+                                                        .radius_regions = options.radius_regions,
+                                                        .progress = options.progress});
+        out.surfels = std::move(result.surfels);
+        out.estimated_normals = true;
+        out.estimated_radii = true;
+        out.components = result.orientation.components;
+        out.flipped = result.orientation.flipped;
+        out.degenerate = result.degenerate;
+        out.unoriented = result.orientation.unoriented.size();
+        drop_unoriented(out.surfels);
+        return out;
+    }
+    check_surfel_input(samples, options.k);
+    out.unoriented = drop_unoriented(samples);
+    if (samples.size() <= options.k)
+        throw InvalidInput(std::to_string(out.unoriented) +
+                           " samples have a zero or non-finite normal, and too few usable ones "
+                           "are left; orient the samples (pointform normals) or estimate their "
+                           "normals again (--reestimate)");
+    if (!samples.has_radii())
+    {
+        samples.radii = automatic_radii(samples, options.k, options.radius_scale);
+        samples.radii = apply_radius_regions(samples.positions, samples.origin,
+                                             std::move(samples.radii), options.radius_regions);
+        out.estimated_radii = true;
+    }
+    out.surfels = std::move(samples);
+    return out;
+}
+
+SurfelsFromMesh surfels_from_mesh(const TriMesh& mesh, const SurfelsFromMeshOptions& options)
+{
+    check_radius_scale(options.radius_scale);
+    if (options.k < 3)
+        throw InvalidInput("surfels from a mesh: k must be at least 3, not " +
+                           std::to_string(options.k));
+    const std::size_t count = options.samples > 0 ? options.samples : mesh.vertex_count();
+    // The vertices first, with their area-weighted normals; then the area-uniform samples.
+    PointCloud vertices = sample_surface(
+        mesh, {.count = 0, .seed = options.seed, .include_vertices = true, .normals = true});
+    PointCloud area = sample_surface(mesh, {.count = count, .seed = options.seed, .normals = true});
+    SurfelsFromMesh out;
+    out.surfels.origin = mesh.vertices.origin;
+    drop_unoriented(vertices);
+    out.vertex_surfels = vertices.size();
+    out.area_surfels = area.size();
+    out.surfels.positions = std::move(vertices.positions);
+    out.surfels.normals = std::move(vertices.normals);
+    out.surfels.positions.insert(out.surfels.positions.end(), area.positions.begin(),
+                                 area.positions.end());
+    out.surfels.normals.insert(out.surfels.normals.end(), area.normals.begin(), area.normals.end());
+    if (out.surfels.size() <= options.k)
+        throw InvalidInput("surfels from a mesh: too few vertices and samples (" +
+                           std::to_string(out.surfels.size()) +
+                           ") for k = " + std::to_string(options.k));
+    out.surfels.radii = automatic_radii(out.surfels, options.k, options.radius_scale);
+    return out;
+}
+
+} // namespace pointform

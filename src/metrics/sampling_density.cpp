@@ -1,0 +1,70 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/metrics/sampling_density.h"
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+#include "pointform/spatial/kd_tree.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pointform {
+
+SamplingDensity measure_sampling_density(const PointCloud& samples,
+                                         const ProgressCallback& progress)
+{
+    if (samples.size() < 2)
+        throw InvalidInput("sampling density: need at least 2 samples, got " +
+                           std::to_string(samples.size()));
+    const KdTree tree(samples.positions);
+    // At most max_sampling_density_queries, evenly spread over the samples (fixed stride).
+    const std::size_t stride =
+        std::max<std::size_t>(1, samples.size() / max_sampling_density_queries);
+    const std::size_t queries = (samples.size() + stride - 1) / stride;
+    const std::size_t k = std::min<std::size_t>(8, samples.size());
+    std::vector<double> nearest(queries, -1.0);
+    ProgressReporter reporter(progress, "sampling density");
+    parallel_blocks(
+        queries, 1024,
+        [&](std::size_t begin, std::size_t end) {
+            std::vector<std::uint32_t> indices(k);
+            std::vector<float> d2(k);
+            for (std::size_t q = begin; q < end; ++q)
+            {
+                const std::size_t found = tree.knn(samples.positions[q * stride], k, indices, d2);
+                for (std::size_t i = 0; i < found; ++i)
+                    if (d2[i] > 0.0F)
+                    {
+                        nearest[q] = std::sqrt(static_cast<double>(d2[i]));
+                        break;
+                    }
+            }
+        },
+        &reporter);
+    reporter.finish();
+    nearest.erase(std::remove(nearest.begin(), nearest.end(), -1.0), nearest.end());
+    if (nearest.empty())
+        throw InvalidInput("sampling density: the samples are all coincident");
+    SamplingDensity out;
+    out.measured = nearest.size();
+    double sum = 0.0;
+    for (const double d : nearest)
+        sum += d;
+    out.mean = sum / static_cast<double>(nearest.size());
+    const auto middle = nearest.begin() + static_cast<std::ptrdiff_t>(nearest.size() / 2);
+    std::nth_element(nearest.begin(), middle, nearest.end());
+    out.median = *middle;
+    return out;
+}
+
+double estimate_sampling_density(const PointCloud& samples)
+{
+    return measure_sampling_density(samples).median;
+}
+
+} // namespace pointform

@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/core/error.h"
+#include "pointform/geometry/shapes.h"
+#include "pointform/hermite/surfels.h"
+
+#include "support/test_meshes.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace pointform {
+namespace {
+
+/// Share of the normals within `degrees` of the outward radius of the unit sphere.
+double outward_share(const PointCloud& cloud, double degrees)
+{
+    std::size_t good = 0;
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+    {
+        const Vec3d radial = cloud.positions[i].cast<double>().normalized();
+        good += cloud.normals[i].cast<double>().dot(radial) >
+                std::cos(degrees * std::numbers::pi / 180.0);
+    }
+    return static_cast<double>(good) / static_cast<double>(cloud.size());
+}
+
+TEST(SurfelsFromSamples, RawPointsGetOrientedNormalsAndFieldRadii)
+{
+    PointCloud points = sample_shape(Shape::Sphere, {.count = 5000, .seed = 21});
+    points.normals.clear();
+    const SurfelsFromSamples out = surfels_from_samples(points);
+    EXPECT_TRUE(out.estimated_normals);
+    EXPECT_TRUE(out.estimated_radii);
+    EXPECT_EQ(out.components, 1U);
+    EXPECT_EQ(out.unoriented, 0U);
+    ASSERT_EQ(out.surfels.size(), points.size());
+    EXPECT_GT(outward_share(out.surfels, 10.0), 0.99);
+    // The field's radius scale: 1.5 times compute_surfels()' radius at its default of 1.
+    const SurfelResult plain = compute_surfels(points);
+    for (std::size_t i = 0; i < points.size(); i += 97)
+        EXPECT_FLOAT_EQ(out.surfels.radii[i],
+                        static_cast<float>(default_field_radius_scale) * plain.surfels.radii[i]);
+}
+
+TEST(SurfelsFromSamples, GivenNormalsAreKeptAndRadiiComputedOnlyWhenMissing)
+{
+    const PointCloud oriented = sample_shape(Shape::Sphere, {.count = 3000, .seed = 22});
+    const SurfelsFromSamples out = surfels_from_samples(oriented, {.radius_scale = 2.0});
+    EXPECT_FALSE(out.estimated_normals);
+    EXPECT_TRUE(out.estimated_radii);
+    EXPECT_EQ(out.surfels.normals, oriented.normals);
+    ASSERT_EQ(out.surfels.radii.size(), oriented.size());
+    for (const float r : out.surfels.radii)
+        EXPECT_GT(r, 0.0F);
+
+    PointCloud with_radii = oriented;
+    with_radii.radii.assign(with_radii.size(), 0.125F);
+    const SurfelsFromSamples kept = surfels_from_samples(with_radii);
+    EXPECT_FALSE(kept.estimated_radii);
+    EXPECT_EQ(kept.surfels.radii, with_radii.radii);
+
+    // reestimate: the given (here inverted) normals play no part.
+    PointCloud inverted = oriented;
+    for (auto& n : inverted.normals)
+        n = -n;
+    const SurfelsFromSamples again = surfels_from_samples(inverted, {.reestimate = true});
+    EXPECT_TRUE(again.estimated_normals);
+    EXPECT_GT(outward_share(again.surfels, 10.0), 0.99);
+}
+
+TEST(SurfelsFromSamples, UnusableNormalsAreDroppedAndCounted)
+{
+    PointCloud cloud = sample_shape(Shape::Sphere, {.count = 2000, .seed = 23});
+    cloud.colors.assign(cloud.size(), Color{1, 2, 3});
+    cloud.normals[5] = Vec3f::Zero();
+    cloud.normals[17] = Vec3f(std::numeric_limits<float>::quiet_NaN(), 0.0F, 1.0F);
+    cloud.normals[900] = Vec3f(std::numeric_limits<float>::infinity(), 0.0F, 0.0F);
+    const Vec3f after = cloud.positions[6];
+    const SurfelsFromSamples out = surfels_from_samples(cloud);
+    EXPECT_EQ(out.unoriented, 3U);
+    ASSERT_EQ(out.surfels.size(), cloud.size() - 3);
+    EXPECT_EQ(out.surfels.colors.size(), out.surfels.size());
+    EXPECT_EQ(out.surfels.positions[5], after); // order kept, the bad one left out
+    for (const Vec3f& n : out.surfels.normals)
+        EXPECT_NEAR(n.norm(), 1.0F, 1e-5F);
+
+    // Too few usable normals left for k.
+    for (std::size_t i = 10; i < cloud.size(); ++i)
+        cloud.normals[i] = Vec3f::Zero();
+    EXPECT_THROW((void)surfels_from_samples(cloud), InvalidInput);
+    EXPECT_THROW((void)surfels_from_samples(sample_shape(Shape::Sphere, {.count = 100}),
+                                            {.radius_scale = 0.0}),
+                 InvalidInput);
+}
+
+TEST(SurfelsFromMesh, VerticesThenAreaSamplesWithOutwardNormals)
+{
+    const TriMesh sphere = test::icosphere(3);
+    const SurfelsFromMesh out =
+        surfels_from_mesh(sphere, {.samples = 4000, .seed = 5, .radius_scale = 1.5});
+    EXPECT_EQ(out.vertex_surfels, sphere.vertex_count());
+    EXPECT_EQ(out.area_surfels, 4000U);
+    ASSERT_EQ(out.surfels.size(), sphere.vertex_count() + 4000U);
+    ASSERT_EQ(out.surfels.radii.size(), out.surfels.size());
+    for (std::size_t v = 0; v < sphere.vertex_count(); ++v)
+        EXPECT_EQ(out.surfels.positions[v], sphere.vertices.positions[v]);
+    EXPECT_GT(outward_share(out.surfels, 6.0), 0.999);
+    for (const float r : out.surfels.radii)
+        EXPECT_GT(r, 0.0F);
+    // Deterministic, and the default count is the vertex count.
+    EXPECT_EQ(surfels_from_mesh(sphere, {.samples = 4000, .seed = 5}).surfels.positions,
+              out.surfels.positions);
+    EXPECT_EQ(surfels_from_mesh(sphere).area_surfels, sphere.vertex_count());
+}
+
+TEST(SurfelsFromMesh, RejectsWhatCarriesNoSurface)
+{
+    EXPECT_THROW((void)surfels_from_mesh(TriMesh{}), InvalidInput);
+    TriMesh flat = test::icosphere(1);
+    for (auto& p : flat.vertices.positions)
+        p = Vec3f::Zero();
+    EXPECT_THROW((void)surfels_from_mesh(flat), InvalidInput);
+    // One triangle: 3 vertices and 3 samples are too few for k = 16.
+    TriMesh one;
+    one.vertices.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0)};
+    one.triangles = {{0, 1, 2}};
+    EXPECT_THROW((void)surfels_from_mesh(one), InvalidInput);
+    EXPECT_THROW((void)surfels_from_mesh(test::icosphere(2), {.k = 2}), InvalidInput);
+}
+
+} // namespace
+} // namespace pointform

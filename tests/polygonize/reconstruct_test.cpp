@@ -1,0 +1,158 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/polygonize/reconstruct.h"
+
+#include "pointform/core/error.h"
+#include "pointform/geometry/mesh_topology.h"
+#include "pointform/geometry/shapes.h"
+#include "pointform/hermite/surfels.h"
+#include "pointform/implicit/primitives.h"
+#include "pointform/polygonize/marching_cubes.h"
+
+#include "support/test_meshes.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace pointform {
+namespace {
+
+double sphere_error(const TriMesh& mesh)
+{
+    double error = 0.0;
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+        error = std::max(error, std::abs(mesh.vertices.world(v).norm() - 1.0));
+    return error;
+}
+
+PointCloud sphere_surfels(std::size_t count)
+{
+    PointCloud raw = sample_shape(Shape::Sphere, {.count = count, .seed = 41});
+    raw.normals.clear();
+    return surfels_from_samples(std::move(raw)).surfels;
+}
+
+TEST(Reconstruct, SampledSphereStopsByTheRuleWithinTheBudgetOnTheSphere)
+{
+    const ReconstructReport report = reconstruct(sphere_surfels(20000));
+    const SemiRegularReport& semi = report.semi_regular;
+    const MultiresMesh& hierarchy = semi.hierarchy;
+    ASSERT_TRUE(semi.base.has_value());
+    EXPECT_TRUE(semi.base->topology_kept);
+    EXPECT_TRUE(semi.measured);
+    EXPECT_FALSE(semi.exact_levels);
+    EXPECT_EQ(semi.level_cap, default_max_level);
+    EXPECT_EQ(semi.sample_count, 20000U);
+    // The automatic rule stops within the vertex budget (the samples).
+    EXPECT_LE(hierarchy.vertex_count(), 20000U);
+    EXPECT_EQ(semi.refinement.levels.size(), hierarchy.finest_level());
+    EXPECT_GE(hierarchy.finest_level(), 1U);
+    const TriMesh finest = hierarchy.level_mesh(hierarchy.finest_level());
+    const MeshTopology topo = analyze_topology(finest);
+    EXPECT_TRUE(topo.is_closed());
+    EXPECT_EQ(topo.euler_characteristic, 2);
+    EXPECT_LT(sphere_error(finest), semi.refinement.sampling_density);
+    // Every stage reported, in order.
+    ASSERT_EQ(report.stage_seconds.size(), 5U);
+    EXPECT_EQ(report.stage_seconds.front().first, "field");
+    EXPECT_EQ(report.stage_seconds.back().first, "refinement");
+    EXPECT_GT(report.intermediate_faces, semi.base->faces);
+}
+
+TEST(Reconstruct, ExactLevelsAndTheBaseFaceTarget)
+{
+    ReconstructOptions options;
+    options.semi_regular.levels = 2;
+    options.semi_regular.base_faces = 150;
+    const ReconstructReport report = reconstruct(sphere_surfels(8000), options);
+    const SemiRegularReport& semi = report.semi_regular;
+    EXPECT_TRUE(semi.exact_levels);
+    EXPECT_EQ(semi.hierarchy.finest_level(), 2U);
+    EXPECT_EQ(semi.refinement.stop, RefineStop::LevelCap);
+    EXPECT_EQ(semi.base->target_faces, 150U);
+    EXPECT_EQ(semi.hierarchy.face_count(2), 16 * semi.hierarchy.face_count(0));
+
+    ReconstructOptions too_deep;
+    too_deep.semi_regular.levels = max_exact_levels + 1;
+    EXPECT_THROW((void)reconstruct(sphere_surfels(2000), too_deep), InvalidInput);
+    ReconstructOptions too_many;
+    too_many.semi_regular.base_faces = 100000000;
+    EXPECT_THROW((void)reconstruct(sphere_surfels(2000), too_many), InvalidInput);
+}
+
+TEST(Reconstruct, PaperRuleDropsAStalledLevelAndTheMemoryCapHolds)
+{
+    // Outliers far off the sphere keep the Hausdorff distance from falling: under the paper's
+    // rule a level that lowers it by less than 5% is measured and not kept.
+    PointCloud surfels = sphere_surfels(6000);
+    for (std::size_t i = 0; i < 5; ++i)
+    {
+        surfels.positions.push_back(Vec3f(0.0F, 0.0F, 1.3F + 0.01F * static_cast<float>(i)));
+        surfels.normals.emplace_back(0.0F, 0.0F, 1.0F);
+        surfels.radii.push_back(0.001F);
+    }
+    ReconstructOptions options;
+    options.semi_regular.stop_rule = StopRule::Paper;
+    options.min_component_samples = 0;
+    const ReconstructReport report = reconstruct(std::move(surfels), options);
+    const SemiRegularReport& semi = report.semi_regular;
+    EXPECT_EQ(semi.refinement.stop, RefineStop::Stalled);
+    ASSERT_TRUE(semi.refinement.dropped.has_value());
+    EXPECT_EQ(semi.refinement.dropped->level, semi.hierarchy.finest_level() + 1);
+
+    EXPECT_EQ(affordable_level(100, 3), 3U);
+    // 2^32 faces do not fit in 32-bit indices, whatever the memory.
+    EXPECT_LT(affordable_level(std::size_t{1} << 20, 8), 6U);
+    EXPECT_THROW(check_refinement_memory(std::size_t{1} << 20, 8), InvalidInput);
+}
+
+TEST(SemiRegularMesh, WithoutSamplesRefinesExactlyToTheLevels)
+{
+    // A modeled surface: the marching-cubes mesh of an exact sphere, no samples.
+    const auto sphere = make_sphere(Vec3d::Zero(), 1.0);
+    const MarchingCubesResult mc = marching_cubes(*sphere, grid_over(sphere->bounds(), 0.05));
+    SemiRegularOptions options;
+    options.levels = 2;
+    const SemiRegularReport report = semi_regular_mesh(mc.mesh, *sphere, nullptr, options, 16);
+    EXPECT_FALSE(report.measured);
+    EXPECT_EQ(report.hierarchy.finest_level(), 2U);
+    EXPECT_EQ(report.refinement.levels.size(), 2U);
+    EXPECT_FALSE(report.refinement.levels[0].hausdorff.has_value());
+    const TriMesh finest = report.hierarchy.level_mesh(2);
+    const VertexResidual residual = field_residual_at_vertices(finest, *sphere);
+    EXPECT_EQ(residual.defined, finest.vertex_count());
+    EXPECT_LT(residual.max, 1e-3);
+    EXPECT_LT(sphere_error(finest), 1e-3);
+    // Without samples the levels are needed.
+    EXPECT_THROW((void)semi_regular_mesh(mc.mesh, *sphere, nullptr, {}, 16), InvalidInput);
+}
+
+TEST(Remesh, AnIcosphereBecomesASemiRegularMeshOnIt)
+{
+    const TriMesh input = test::icosphere(4); // 5120 faces
+    RemeshOptions options;
+    options.semi_regular.levels = 1;
+    const RemeshReport report = remesh(input, options);
+    const SemiRegularReport& semi = report.semi_regular;
+    EXPECT_EQ(report.vertex_surfels, input.vertex_count());
+    EXPECT_EQ(report.area_surfels, input.vertex_count());
+    EXPECT_EQ(semi.base->target_faces, default_remesh_base_faces(input));
+    EXPECT_EQ(default_remesh_base_faces(input), 1280U);
+    const TriMesh finest = semi.hierarchy.level_mesh(1);
+    EXPECT_TRUE(analyze_topology(finest).is_closed());
+    // Within the chord error of the input's facets (edge ~0.08: sagitta ~1e-3).
+    EXPECT_LT(sphere_error(finest), 3e-3);
+
+    TriMesh open = input;
+    open.triangles.pop_back();
+    open.triangles.push_back(open.triangles.front()); // a duplicated face: not a manifold
+    EXPECT_THROW(check_remesh_input(open), InvalidInput);
+    EXPECT_THROW((void)remesh(open, options), InvalidInput);
+    EXPECT_THROW(check_remesh_input(TriMesh{}), InvalidInput);
+}
+
+} // namespace
+} // namespace pointform
