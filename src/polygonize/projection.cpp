@@ -160,4 +160,27 @@ std::optional<Vec3d> project_to_zero(const Field& field, const Vec3d& p, const V
     return std::nullopt;
 }
 
+std::optional<Vec3d> newton_to_zero(const Field& field, const Vec3d& p, double max_distance)
+{
+    if (!p.allFinite() || !(max_distance > 0.0) || !std::isfinite(max_distance))
+        return std::nullopt;
+    const double tolerance = 1e-7 * max_distance;
+    Vec3d q = p;
+    for (int step = 0; step < 16; ++step)
+    {
+        const FieldSample s = field.evaluate(q);
+        if (!std::isfinite(s.value) || !s.gradient.allFinite())
+            return std::nullopt;
+        if (s.defined && std::abs(s.value) <= tolerance)
+            return q;
+        const double g2 = s.gradient.squaredNorm();
+        if (!(g2 > 0.0))
+            return std::nullopt;
+        q -= (s.value / g2) * s.gradient;
+        if ((q - p).norm() > max_distance)
+            return std::nullopt;
+    }
+    return std::nullopt;
+}
+
 } // namespace pointform

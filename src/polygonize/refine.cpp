@@ -498,7 +498,22 @@ std::vector<Triangle> refine_split_level(MultiresMesh& mesh, MultiresMesh::Split
                 used_ven[j] = hit ? 1 : 0;
             }
         });
-        for (int fallback = 0; fallback < 2; ++fallback)
+        // Still folded: the nearest point of f = 0 by Newton steps from the prediction (a
+        // midpoint that cuts a crease's corner lies inside; put back there, it stays a spike).
+        std::vector<std::optional<Vec3d>> nearest(added);
+        {
+            find_folds(level, x, face_normal, options.fold_cosine, folded);
+            const std::vector<std::uint32_t> still = vertices_of_folds(level, folded);
+            parallel_blocks(still.size(), 64, [&](std::size_t begin, std::size_t end) {
+                for (std::size_t m = begin; m < end; ++m)
+                {
+                    const std::uint32_t j = still[m];
+                    if (const auto hit = newton_to_zero(field, origin + prediction[j], reach[j]))
+                        nearest[j] = *hit - origin;
+                }
+            });
+        }
+        for (int fallback = 0; fallback < 3; ++fallback)
         {
             find_folds(level, x, face_normal, options.fold_cosine, folded);
             std::vector<std::uint32_t> still = vertices_of_folds(level, folded);
@@ -510,7 +525,20 @@ std::vector<Triangle> refine_split_level(MultiresMesh& mesh, MultiresMesh::Split
                 {
                     const auto [h1, h2] = level.halfedges[j];
                     const Vec3d midpoint = 0.5 * (x[level.from(h1)] + x[level.to(h1)]);
-                    const Vec3d target = fallback == 0 ? prediction[j] : midpoint;
+                    if (fallback == 0 && !nearest[j])
+                        continue;
+                    if (fallback == 0)
+                    {
+                        if (new_positions[j] != *nearest[j])
+                        {
+                            new_positions[j] = *nearest[j];
+                            state[j] = State::Projected;
+                            used_ven[j] = 0;
+                            changed = true;
+                        }
+                        continue;
+                    }
+                    const Vec3d target = fallback == 1 ? prediction[j] : midpoint;
                     if (new_positions[j] != target)
                     {
                         new_positions[j] = target;

@@ -172,6 +172,27 @@ TEST(Projection, FindsTheNearestOutwardCrossing)
                  InvalidInput);
 }
 
+TEST(Projection, NewtonReachesTheNearestZero)
+{
+    // On a sphere's distance field one step lands on the radial point.
+    const auto sphere = make_sphere(Vec3d::Zero(), 1.0);
+    const Vec3d p(0.5, 0.3, 0.1);
+    const auto hit = newton_to_zero(*sphere, p, 1.0);
+    ASSERT_TRUE(hit);
+    EXPECT_NEAR(hit->norm(), 1.0, 1e-7);
+    EXPECT_NEAR(hit->normalized().dot(p.normalized()), 1.0, 1e-12);
+    // Inside a box next to its edge x = y = 1 (a crease's corner cut by a midpoint): the nearest
+    // face, not the corner along the diagonal.
+    const auto box = make_box(Vec3d(-1, -1, -1), Vec3d(1, 1, 1));
+    const auto face = newton_to_zero(*box, Vec3d(0.9, 0.8, 0.0), 0.5);
+    ASSERT_TRUE(face);
+    EXPECT_NEAR(face->x(), 1.0, 1e-7);
+    EXPECT_NEAR(face->y(), 0.8, 1e-7);
+    EXPECT_FALSE(newton_to_zero(*sphere, Vec3d(0, 0, 3), 0.5)); // farther than the reach
+    EXPECT_FALSE(newton_to_zero(*sphere, Vec3d(0, 0, 3), 0.0));
+    EXPECT_FALSE(newton_to_zero(*sphere, Vec3d::Constant(std::nan("")), 1.0));
+}
+
 TEST(Refine, OctahedronOnAnalyticSphere)
 {
     const auto sphere = make_sphere(Vec3d::Zero(), 1.0);

@@ -49,4 +49,12 @@ struct ProjectionOptions
                                                    const Vec3d& direction, double max_distance,
                                                    const ProjectionOptions& options);
 
+/// \brief A point of f = 0 near p by Newton steps along the gradient, q ← q − f(q) ∇f / |∇f|²
+/// (where the field is undefined its value and gradient still say which way the surface is,
+/// see FieldSample): for a point whose projection along a direction fails or folds, e.g. a
+/// midpoint that cuts a crease's corner. nullopt unless, within 16 steps, a defined sample with
+/// |f| ≤ 1e-7 · max_distance is reached no farther than max_distance from p.
+[[nodiscard]] std::optional<Vec3d> newton_to_zero(const Field& field, const Vec3d& p,
+                                                  double max_distance);
+
 } // namespace pointform
