@@ -52,7 +52,7 @@ std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions)
                         static_cast<std::uint32_t>(i)};
         }
     });
-    std::sort(keyed.begin(), keyed.end());
+    parallel_sort(keyed); // keys paired with their index: a strict order, std::sort's result
     for (std::size_t j = 0; j < keyed.size(); ++j)
         order[j] = keyed[j].second;
     return order;

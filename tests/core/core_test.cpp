@@ -12,8 +12,10 @@
 #include <atomic>
 #include <chrono>
 #include <numeric>
+#include <random>
 #include <stdexcept>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace pointform {
@@ -112,6 +114,38 @@ TEST(ParallelBlocks, RethrowsTheFirstFailingBlock)
         EXPECT_TRUE(what == "block 300" || what == "block 7000") << what;
     }
     set_thread_count(0);
+}
+
+TEST(ParallelSort, GivesStdSortsResultWhateverTheThreadCount)
+{
+    // Keys with many repeats, paired with their index (a strict order), in pieces of more than
+    // 65,536: 1 thread sorts 4 pieces, 3 threads 8, then merges them.
+    std::mt19937_64 rng(5);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> items(300001);
+    for (std::size_t i = 0; i < items.size(); ++i)
+        items[i] = {static_cast<std::uint32_t>(rng() % 1000), static_cast<std::uint32_t>(i)};
+    auto expected = items;
+    std::sort(expected.begin(), expected.end());
+    for (const int threads : {1, 2, 3})
+    {
+        set_thread_count(threads);
+        reset_parallel_stats();
+        auto sorted = items;
+        parallel_sort(sorted);
+        EXPECT_EQ(sorted, expected) << threads << " threads";
+        EXPECT_GE(parallel_stats().multi_block_loops, 1U);
+    }
+    set_thread_count(0);
+    // A descending order through the comparator, and inputs too small to split.
+    auto descending = items;
+    parallel_sort(descending, std::greater<>{});
+    EXPECT_TRUE(std::is_sorted(descending.begin(), descending.end(), std::greater<>{}));
+    std::vector<int> small = {3, 1, 2};
+    parallel_sort(small);
+    EXPECT_EQ(small, (std::vector<int>{1, 2, 3}));
+    std::vector<int> empty;
+    parallel_sort(empty);
+    EXPECT_TRUE(empty.empty());
 }
 
 TEST(Progress, ReportsMonotonicFractionsAndCancels)

@@ -3,9 +3,13 @@
 
 #pragma once
 
+#include <algorithm>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <iterator>
+#include <vector>
 
 namespace pointform {
 class ProgressReporter;
@@ -33,6 +37,49 @@ void set_thread_count(int threads);
 void parallel_blocks(std::size_t n, std::size_t block,
                      const std::function<void(std::size_t, std::size_t)>& body,
                      ProgressReporter* progress = nullptr);
+
+/// \brief Sorts `items` by `less` in parallel: a power of two of pieces (about four per thread,
+/// at least 65,536 items each) sorted at once, then merged in pairs, round by round, each
+/// round's merges at once. For a strict total order (no two items equivalent, e.g. keys paired
+/// with their index) the result is std::sort's, whatever the thread count. Needs one buffer of
+/// items.size().
+template <class T, class Less = std::less<>>
+void parallel_sort(std::vector<T>& items, Less less = {})
+{
+    constexpr std::size_t min_piece = std::size_t{1} << 16;
+    const std::size_t n = items.size();
+    const auto wanted = static_cast<std::size_t>(4 * std::max(1, thread_count()));
+    const std::size_t pieces = std::bit_floor(std::clamp<std::size_t>(n / min_piece, 1, wanted));
+    if (pieces <= 1)
+    {
+        std::sort(items.begin(), items.end(), less);
+        return;
+    }
+    const std::size_t piece = (n + pieces - 1) / pieces;
+    const auto at = [&items](std::size_t i) {
+        return items.begin() + static_cast<std::ptrdiff_t>(i);
+    };
+    parallel_blocks(pieces, 1, [&](std::size_t first, std::size_t last) {
+        for (std::size_t p = first; p < last; ++p)
+            std::sort(at(std::min(n, p * piece)), at(std::min(n, (p + 1) * piece)), less);
+    });
+    std::vector<T> buffer(n);
+    for (std::size_t width = piece; width < n; width *= 2)
+    {
+        const std::size_t pairs = (n + 2 * width - 1) / (2 * width);
+        parallel_blocks(pairs, 1, [&](std::size_t first, std::size_t last) {
+            for (std::size_t q = first; q < last; ++q)
+            {
+                const std::size_t lo = q * 2 * width;
+                const std::size_t mid = std::min(n, lo + width);
+                const std::size_t hi = std::min(n, lo + 2 * width);
+                std::merge(at(lo), at(mid), at(mid), at(hi),
+                           buffer.begin() + static_cast<std::ptrdiff_t>(lo), less);
+            }
+        });
+        items.swap(buffer);
+    }
+}
 
 /// \brief What parallel_blocks has run since the process started or since the last
 /// reset_parallel_stats(), counted by every call from every thread.
