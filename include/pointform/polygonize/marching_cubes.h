@@ -78,7 +78,7 @@ struct IntermediateGrid
 /// The base mesh only needs the intermediate mesh's shape and topology at the base mesh's
 /// scale, and refinement projects every finer vertex onto the field itself, so the fine
 /// marching-cubes mesh is never built (on a clean 1M-sample blobby, whose field's mesh has
-/// 1.68M faces: marching cubes, debris and decimation 20.0 s → 5.3 s, and closed where the
+/// 1.68M faces: marching cubes, debris and decimation 20.1 s → 8.4 s, and closed where the
 /// field's own grid left 2 pinholes at concave creases).
 /// \throw InvalidInput if the cell or max_faces is not positive and finite
 [[nodiscard]] IntermediateGrid intermediate_grid(const PointField& field, double cell,
