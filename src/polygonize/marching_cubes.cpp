@@ -1270,11 +1270,12 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
         evaluate_near_zero(field, exact_range, points, at_vertices);
         stats.field_evaluations += nv;
         std::size_t kept = 0;
-        for (const Triangle& t : mesh.triangles)
+        for (const Triangle& tri : mesh.triangles)
         {
-            if (at_vertices[t[0]].defined && at_vertices[t[1]].defined && at_vertices[t[2]].defined)
+            if (at_vertices[tri[0]].defined && at_vertices[tri[1]].defined &&
+                at_vertices[tri[2]].defined)
             {
-                mesh.triangles[kept++] = t;
+                mesh.triangles[kept++] = tri;
             }
         }
         stats.undefined_triangles = mesh.triangles.size() - kept;
@@ -1282,9 +1283,9 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
         if (stats.undefined_triangles > 0)
         {
             std::vector<std::uint32_t> remap(nv, std::numeric_limits<std::uint32_t>::max());
-            for (const Triangle& t : mesh.triangles)
+            for (const Triangle& tri : mesh.triangles)
             {
-                for (const std::uint32_t v : t)
+                for (const std::uint32_t v : tri)
                 {
                     remap[v] = 0;
                 }
@@ -1308,9 +1309,9 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
             {
                 mesh.vertices.normals.resize(next);
             }
-            for (Triangle& t : mesh.triangles)
+            for (Triangle& tri : mesh.triangles)
             {
-                for (std::uint32_t& v : t)
+                for (std::uint32_t& v : tri)
                 {
                     v = remap[v];
                 }
