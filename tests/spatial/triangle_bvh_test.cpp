@@ -119,6 +119,24 @@ std::vector<Vec3d> random_queries(std::size_t n, double spread, std::uint64_t se
     return queries;
 }
 
+/// An n x n grid of the square [-1, 1]² at z = 0, two triangles a cell.
+TriMesh grid_plane(std::uint32_t n)
+{
+    TriMesh mesh;
+    for (std::uint32_t j = 0; j <= n; ++j)
+        for (std::uint32_t i = 0; i <= n; ++i)
+            mesh.vertices.positions.emplace_back(-1.0F + 2.0F * static_cast<float>(i) / n,
+                                                 -1.0F + 2.0F * static_cast<float>(j) / n, 0.0F);
+    for (std::uint32_t j = 0; j < n; ++j)
+        for (std::uint32_t i = 0; i < n; ++i)
+        {
+            const std::uint32_t v = j * (n + 1) + i;
+            mesh.triangles.push_back({v, v + 1, v + n + 2});
+            mesh.triangles.push_back({v, v + n + 2, v + n + 1});
+        }
+    return mesh;
+}
+
 TEST(ClosestPointOnTriangle, EveryRegion)
 {
     const Vec3d a(0, 0, 0);
@@ -205,19 +223,7 @@ TEST(TriangleBvh, GridPlaneAnalyticDistances)
 {
     // A 20 x 20 grid of the square [-1, 1]² at z = 0: distance is |z| above it and the distance
     // to the square's border beyond it.
-    constexpr std::uint32_t n = 20;
-    TriMesh mesh;
-    for (std::uint32_t j = 0; j <= n; ++j)
-        for (std::uint32_t i = 0; i <= n; ++i)
-            mesh.vertices.positions.emplace_back(-1.0F + 2.0F * static_cast<float>(i) / n,
-                                                 -1.0F + 2.0F * static_cast<float>(j) / n, 0.0F);
-    for (std::uint32_t j = 0; j < n; ++j)
-        for (std::uint32_t i = 0; i < n; ++i)
-        {
-            const std::uint32_t v = j * (n + 1) + i;
-            mesh.triangles.push_back({v, v + 1, v + n + 2});
-            mesh.triangles.push_back({v, v + n + 2, v + n + 1});
-        }
+    const TriMesh mesh = grid_plane(20);
     const TriangleBvh bvh(mesh);
     std::mt19937_64 rng(3);
     std::uniform_real_distribution<double> uni(-3.0, 3.0);
@@ -309,19 +315,7 @@ TEST(TriangleBoxDepth, AnalyticValues)
 {
     // A 20 x 20 grid of [-1, 1]²: 800 triangles whose boxes are the 0.1 x 0.1 cells, twice
     // over, in a 2 x 2 box: depth 800 × 0.01 / 4 = 2.
-    constexpr std::uint32_t n = 20;
-    TriMesh grid;
-    for (std::uint32_t j = 0; j <= n; ++j)
-        for (std::uint32_t i = 0; i <= n; ++i)
-            grid.vertices.positions.emplace_back(-1.0F + 2.0F * static_cast<float>(i) / n,
-                                                 -1.0F + 2.0F * static_cast<float>(j) / n, 0.0F);
-    for (std::uint32_t j = 0; j < n; ++j)
-        for (std::uint32_t i = 0; i < n; ++i)
-        {
-            const std::uint32_t v = j * (n + 1) + i;
-            grid.triangles.push_back({v, v + 1, v + n + 2});
-            grid.triangles.push_back({v, v + n + 2, v + n + 1});
-        }
+    const TriMesh grid = grid_plane(20);
     EXPECT_NEAR(triangle_box_depth(grid), 2.0, 1e-5);
 
     // An n-gon fanned from vertex (1, 0): the sliver to the edge at angle φ has a box of area
