@@ -294,7 +294,7 @@ py::array world_positions(const PointCloud& cloud)
     for (std::size_t i = 0; i < cloud.size(); ++i)
         world[i] = cloud.world(i);
     const auto n = static_cast<py::ssize_t>(world.size());
-    return owning_array<double>(std::move(world), {n, 3});
+    return owning_array<double>(std::move(world), {n, 3}, true);
 }
 
 py::tuple bounds_tuple(const PointCloud& cloud)

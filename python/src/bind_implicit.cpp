@@ -45,12 +45,12 @@ py::tuple evaluate(const FieldHandle& self, const py::object& points_object, boo
             defined[i] = samples[i].defined ? 1 : 0;
         }
     }
-    py::array values_array = owning_array<double>(std::move(values), {m});
-    py::array gradients_array = owning_array<double>(std::move(gradients), {m, 3});
+    py::array values_array = owning_array<double>(std::move(values), {m}, true);
+    py::array gradients_array = owning_array<double>(std::move(gradients), {m, 3}, true);
     if (!with_defined)
         return py::make_tuple(values_array, gradients_array);
     py::array defined_array =
-        owning_array<std::uint8_t>(std::move(defined), {m}).attr("view")("bool");
+        owning_array<std::uint8_t>(std::move(defined), {m}, true).attr("view")("bool");
     return py::make_tuple(values_array, gradients_array, defined_array);
 }
 

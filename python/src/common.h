@@ -30,7 +30,8 @@ namespace py = pybind11;
 /// \brief A read-only numpy array over `data` (C order, `shape`), kept alive by `owner`: no
 /// copy. An empty shape gets a fresh empty array.
 template <class T>
-py::array readonly_view(const T* data, std::vector<py::ssize_t> shape, py::handle owner)
+py::array readonly_view(const T* data, std::vector<py::ssize_t> shape, py::handle owner,
+                        bool writeable = false)
 {
     std::vector<py::ssize_t> strides(shape.size());
     py::ssize_t stride = sizeof(T);
@@ -40,19 +41,23 @@ py::array readonly_view(const T* data, std::vector<py::ssize_t> shape, py::handl
         stride *= shape[i];
     }
     py::array out(py::dtype::of<T>(), shape, strides, data, owner);
-    py::detail::array_proxy(out.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+    if (!writeable)
+        py::detail::array_proxy(out.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
     return out;
 }
 
-/// \brief A read-only numpy array of Scalar that owns `values` (moved into a capsule, no copy):
-/// for results computed on demand. T is Scalar or a packed vector of Scalars (Vec3d).
+/// \brief A numpy array of Scalar that owns `values` (moved into a capsule, no copy): for
+/// results computed on demand, the caller's to keep (writeable) or the owner's (read-only). T is
+/// Scalar or a packed vector of Scalars (Vec3d).
 template <class Scalar, class T>
-py::array owning_array(std::vector<T> values, std::vector<py::ssize_t> shape)
+py::array owning_array(std::vector<T> values, std::vector<py::ssize_t> shape,
+                       bool writeable = false)
 {
     static_assert(sizeof(T) % sizeof(Scalar) == 0);
     auto* heap = new std::vector<T>(std::move(values));
     py::capsule owner(heap, [](void* p) { delete static_cast<std::vector<T>*>(p); });
-    return readonly_view(reinterpret_cast<const Scalar*>(heap->data()), std::move(shape), owner);
+    return readonly_view(reinterpret_cast<const Scalar*>(heap->data()), std::move(shape), owner,
+                         writeable);
 }
 
 /// \brief An N by 3 array of 3-vectors of T (Eigen vectors or std::array), as a view.
