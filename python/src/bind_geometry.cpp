@@ -91,8 +91,13 @@ void read_rows(const py::array& a, const char* name, const Vec3d& origin, Out* o
             throw InvalidInput(std::string(name) + "[" + std::to_string(i) +
                                "] is not finite: " + row_text(v[0], v[1], v[2]));
         using T = typename Out::Scalar;
-        out[i] = Out(static_cast<T>(v[0] - origin.x()), static_cast<T>(v[1] - origin.y()),
-                     static_cast<T>(v[2] - origin.z()));
+        const Out row(static_cast<T>(v[0] - origin.x()), static_cast<T>(v[1] - origin.y()),
+                      static_cast<T>(v[2] - origin.z()));
+        if (!row.allFinite())
+            throw InvalidInput(std::string(name) + "[" + std::to_string(i) +
+                               "] = " + row_text(v[0], v[1], v[2]) +
+                               " is out of the float32 range relative to the origin");
+        out[i] = row;
     }
 }
 

@@ -18,12 +18,12 @@ void bind_hermite(py::module_& m)
         "surfels",
         [](const std::shared_ptr<PointCloud>& cloud, std::size_t k, double radius_scale,
            bool reestimate) {
-            SurfelsFromSamples result;
-            {
-                py::gil_scoped_release release;
-                result = surfels_from_samples(
-                    *cloud, {.k = k, .radius_scale = radius_scale, .reestimate = reestimate});
-            }
+            SurfelsFromSamples result = run_interruptible([&](const ProgressCallback& progress) {
+                return surfels_from_samples(*cloud, {.k = k,
+                                                     .radius_scale = radius_scale,
+                                                     .reestimate = reestimate,
+                                                     .progress = progress});
+            });
             py::dict report;
             report["estimated_normals"] = result.estimated_normals;
             report["estimated_radii"] = result.estimated_radii;

@@ -114,15 +114,15 @@ void bind_metrics(py::module_& m)
             const Shape shape_a = shape_from(a, "a");
             const Shape shape_b = shape_from(b, "b");
             const auto sample_total = static_cast<std::size_t>(samples);
-            DistanceComparison result;
-            {
-                py::gil_scoped_release release;
-                result = compare(*shape_a.mesh, *shape_b.mesh,
-                                 {.samples = sample_total,
-                                  .seed = seed,
-                                  .include_vertices = true,
-                                  .fscore_thresholds = fscore});
-            }
+            const DistanceComparison result =
+                run_interruptible([&](const ProgressCallback& progress) {
+                    return compare(*shape_a.mesh, *shape_b.mesh,
+                                   {.samples = sample_total,
+                                    .seed = seed,
+                                    .include_vertices = true,
+                                    .fscore_thresholds = fscore,
+                                    .progress = progress});
+                });
             py::dict out;
             out["a"] = shape_dict(shape_a, sample_total);
             out["b"] = shape_dict(shape_b, sample_total);

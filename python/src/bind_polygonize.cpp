@@ -379,12 +379,13 @@ void bind_polygonize(py::module_& m)
             const SurfelsFromSamplesOptions surfel_options{.k = non_negative(k, "k"),
                                                            .radius_scale = radius_scale};
             SurfelsFromSamples input;
-            ReconstructReport report;
-            {
-                py::gil_scoped_release release;
-                input = surfels_from_samples(*cloud, surfel_options);
-                report = reconstruct(std::move(input.surfels), options);
-            }
+            ReconstructReport report = run_interruptible([&](const ProgressCallback& progress) {
+                SurfelsFromSamplesOptions with_progress = surfel_options;
+                with_progress.progress = progress;
+                input = surfels_from_samples(*cloud, with_progress);
+                options.progress = progress;
+                return reconstruct(std::move(input.surfels), options);
+            });
             py::dict out = semi_regular_dict(report.semi_regular);
             out["estimated_normals"] = input.estimated_normals;
             out["surfels"] = py::dict(
@@ -457,11 +458,10 @@ void bind_polygonize(py::module_& m)
                                .seed = seed,
                                .k = non_negative(k, "k"),
                                .radius_scale = radius_scale};
-            RemeshReport report;
-            {
-                py::gil_scoped_release release;
-                report = remesh(*mesh, options);
-            }
+            RemeshReport report = run_interruptible([&](const ProgressCallback& progress) {
+                options.progress = progress;
+                return remesh(*mesh, options);
+            });
             py::dict out = semi_regular_dict(report.semi_regular);
             out["vertex_surfels"] = report.vertex_surfels;
             out["area_surfels"] = report.area_surfels;
@@ -518,17 +518,18 @@ void bind_polygonize(py::module_& m)
             }
             else if (levels || base_faces)
                 throw InvalidInput("levels and base_faces need semi_regular=True");
-            ScanLoading scans(ScanOptions{.field = {.fit = parse_plane_fit(fit)}});
-            std::shared_ptr<TriMesh> mesh;
-            {
-                py::gil_scoped_release release;
+            const PlaneFit plane_fit = parse_plane_fit(fit);
+            return run_interruptible([&](const ProgressCallback& progress) {
+                ScanOptions scan_options{.field = {.fit = plane_fit}};
+                scan_options.surfels.progress = progress;
+                ScanLoading scans(scan_options);
                 const LoadedScene scene = load_scene_argument(expression_or_file, scans);
+                options.progress = progress;
                 SceneMeshReport report = scene_mesh(*scene.field, scans.scans(), options);
-                mesh = std::make_shared<TriMesh>(report.semi_regular
+                return std::make_shared<TriMesh>(report.semi_regular
                                                      ? std::move(report.finest)
                                                      : std::move(report.marching_cubes.mesh));
-            }
-            return mesh;
+            });
         },
         py::arg("expression_or_file"), py::kw_only(), py::arg("resolution") = 0,
         py::arg("cell") = 0.0, py::arg("bounds") = py::none(), py::arg("fit") = "quadric",

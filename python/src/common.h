@@ -7,6 +7,8 @@
 
 #pragma once
 
+#include "pointform/core/error.h"
+#include "pointform/core/progress.h"
 #include "pointform/core/types.h"
 #include "pointform/geometry/multires_mesh.h"
 #include "pointform/geometry/point_cloud.h"
@@ -15,12 +17,15 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <span>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace pointform::python {
@@ -58,6 +63,42 @@ py::array owning_array(std::vector<T> values, std::vector<py::ssize_t> shape,
     py::capsule owner(heap, [](void* p) { delete static_cast<std::vector<T>*>(p); });
     return readonly_view(reinterpret_cast<const Scalar*>(heap->data()), std::move(shape), owner,
                          writeable);
+}
+
+/// \brief Runs `work(progress)` with the GIL released, where `progress` is a ProgressCallback
+/// for the library's options that lets Ctrl-C stop the work: when the library reports progress
+/// from the calling thread (signals reach Python's main thread only), it takes the GIL and runs
+/// Python's signal handlers; a KeyboardInterrupt asks the library to stop (it throws Cancelled)
+/// and is raised once the work has unwound. Results do not depend on it.
+template <class Work>
+auto run_interruptible(Work&& work)
+{
+    auto interrupted = std::make_shared<std::atomic<bool>>(false);
+    const std::thread::id caller = std::this_thread::get_id();
+    ProgressCallback progress = [interrupted, caller](std::string_view, double) {
+        if (std::this_thread::get_id() != caller)
+            return true;
+        const py::gil_scoped_acquire gil;
+        if (PyErr_CheckSignals() != 0)
+        {
+            PyErr_Clear();
+            interrupted->store(true);
+            return false;
+        }
+        return true;
+    };
+    try
+    {
+        const py::gil_scoped_release release;
+        return work(progress);
+    }
+    catch (const Cancelled&)
+    {
+        if (!interrupted->load())
+            throw;
+        PyErr_SetNone(PyExc_KeyboardInterrupt);
+        throw py::error_already_set();
+    }
 }
 
 /// \brief An N by 3 array of 3-vectors of T (Eigen vectors or std::array), as a view.

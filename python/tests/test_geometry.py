@@ -92,6 +92,7 @@ def test_mesh():
         (np.array([["a", "b", "c"]]), "real numbers"),
         ("not an array", "real numbers"),
         (np.zeros((4, 3), dtype=bool), "real numbers"),
+        (np.array([[0, 0, 0], [1e39, 0, 0]]), r"positions\[1\] .* out of the float32 range"),
     ],
 )
 def test_bad_positions(positions, message):

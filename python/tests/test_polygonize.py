@@ -178,3 +178,18 @@ def test_bad_reconstruct_input(sphere_cloud, tmp_path):
     not_pfh.write_bytes(b"hello")
     with pytest.raises(pointform.IoError, match="not a pointform hierarchy|x.pfh"):
         pointform.load_hierarchy(not_pfh)
+
+
+def test_ctrl_c_stops_a_long_call():
+    import os
+    import signal
+
+    cloud = pointform.PointCloud(sphere_points(80000))
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        pointform.reconstruct(cloud, levels=3)  # about 2.4 s uninterrupted on 2 cores
+    timer.join()
+    assert time.perf_counter() - start < 3.0
+    assert pointform.reconstruct(cloud, levels=0).level_count == 1  # still usable
