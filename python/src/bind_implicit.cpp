@@ -85,8 +85,9 @@ void bind_implicit(py::module_& m)
         .def("evaluate", &evaluate, py::arg("points"), py::kw_only(), py::arg("defined") = false,
              "evaluate(points, *, defined=False) -> (values, gradients[, defined])\n\n"
              "The field at M points (an M by 3 real array in world units; a float64 "
-             "C-contiguous array is used in place, others are converted once): values (M,) "
-             "float64 and gradients (M, 3) float64, and with defined=True an (M,) bool array "
+             "C-contiguous array is used in place, others are converted once): new arrays of "
+             "values (M,) float64 and gradients (M, 3) float64, and with defined=True an (M,) "
+             "bool array "
              "telling where a sample's influence reaches (elsewhere the value is the signed "
              "distance to the nearest sample's surface). The same values whatever the thread "
              "count. Raises InvalidInput for a wrong shape or non-finite points.")

@@ -122,7 +122,8 @@ PYBIND11_MODULE(_pointform, m)
             pointform::set_thread_count(threads);
         },
         pybind11::arg("threads"),
-        "set_thread_count(threads): threads for later parallel loops; 0 = all cores (or "
+        "set_thread_count(threads): threads for the parallel loops of later calls made from "
+        "this Python thread (OpenMP keeps the setting per thread); 0 = all cores (or "
         "OMP_NUM_THREADS). Results do not depend on it.");
     pf::bind_geometry(m);
     pf::bind_io(m);
