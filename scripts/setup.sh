@@ -12,9 +12,10 @@ packages=(
   libembree-dev libstb-dev libopenmesh-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format
+  python3 python3-dev python3-numpy python3-pybind11 python3-pytest
 )
 case "${1:-}" in
-  --peers) packages+=(python3 python3-numpy python3-open3d libcgal-dev libtbb-dev time) ;;
+  --peers) packages+=(python3-open3d libcgal-dev libtbb-dev time) ;;
   --fuzz) packages+=(clang-14 libclang-rt-14-dev libomp-14-dev) ;;
   "") ;;
   *) echo "setup: unknown option $1 (expected --peers or --fuzz)" >&2; exit 2 ;;

@@ -3,6 +3,9 @@
 # Builds and runs the whole test suite.
 #   bash scripts/test.sh         release build (build/release)
 #   bash scripts/test.sh asan    AddressSanitizer + UndefinedBehaviorSanitizer build (build/asan)
+# The release build also runs the Python package's pytest suite (python/tests) with Debian's
+# /usr/bin/python3; the asan build has no Python module (an instrumented extension cannot load
+# into an uninstrumented interpreter).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset="${1:-release}"
@@ -11,3 +14,6 @@ bash scripts/setup.sh
 cmake --preset "$preset"
 cmake --build --preset "$preset"
 ctest --preset "$preset"
+if [[ $preset == release ]]; then
+  /usr/bin/python3 -m pytest -q python/tests
+fi

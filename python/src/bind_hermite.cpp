@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/hermite/surfels.h"
+
+#include "common.h"
+
+#include <memory>
+
+namespace pointform::python {
+
+void bind_hermite(py::module_& m)
+{
+    m.attr("default_neighbors") = default_neighbors;
+    m.attr("default_radius_scale") = default_field_radius_scale;
+
+    m.def(
+        "surfels",
+        [](const std::shared_ptr<PointCloud>& cloud, std::size_t k, double radius_scale,
+           bool reestimate) {
+            SurfelsFromSamples result = run_interruptible([&](const ProgressCallback& progress) {
+                return surfels_from_samples(*cloud, {.k = k,
+                                                     .radius_scale = radius_scale,
+                                                     .reestimate = reestimate,
+                                                     .progress = progress});
+            });
+            py::dict report;
+            report["estimated_normals"] = result.estimated_normals;
+            report["estimated_radii"] = result.estimated_radii;
+            report["components"] = result.components;
+            report["flipped"] = result.flipped;
+            report["degenerate"] = result.degenerate;
+            report["unoriented"] = result.unoriented;
+            return py::make_tuple(std::make_shared<PointCloud>(std::move(result.surfels)), report);
+        },
+        py::arg("cloud"), py::kw_only(), py::arg("k") = default_neighbors,
+        py::arg("radius_scale") = default_field_radius_scale, py::arg("reestimate") = false,
+        "surfels(cloud, *, k=16, radius_scale=1.5, reestimate=False) -> (PointCloud, dict)\n\n"
+        "Samples to the oriented surfels of a field (Level 1 or 2 -> 2, paper §4): raw points "
+        "get PCA normals of their k nearest neighbours, oriented consistently in every "
+        "connected component (minimum spanning tree), and influence radii (radius_scale times "
+        "the distance to the k-th neighbour); points with normals keep them (unless "
+        "reestimate) and get radii if they have none. Samples without a usable normal are left "
+        "out and counted. Returns the surfels (same origin) and a report: estimated_normals, "
+        "estimated_radii, components, flipped, degenerate, unoriented. What `pointform "
+        "reconstruct` does to its input. Raises InvalidInput for fewer than k + 1 usable "
+        "points, all coincident or collinear points, or k < 3 or a radius_scale not positive.");
+
+    m.def(
+        "surfels_from_mesh",
+        [](const std::shared_ptr<TriMesh>& mesh, std::size_t samples, std::uint64_t seed,
+           std::size_t k, double radius_scale) {
+            SurfelsFromMesh result;
+            {
+                py::gil_scoped_release release;
+                result = surfels_from_mesh(
+                    *mesh,
+                    {.samples = samples, .seed = seed, .k = k, .radius_scale = radius_scale});
+            }
+            py::dict report;
+            report["vertex_surfels"] = result.vertex_surfels;
+            report["area_surfels"] = result.area_surfels;
+            return py::make_tuple(std::make_shared<PointCloud>(std::move(result.surfels)), report);
+        },
+        py::arg("mesh"), py::kw_only(), py::arg("samples") = 0,
+        py::arg("seed") = SurfelsFromMeshOptions{}.seed, py::arg("k") = default_neighbors,
+        py::arg("radius_scale") = default_field_radius_scale,
+        "surfels_from_mesh(mesh, *, samples=0, seed=1, k=16, radius_scale=1.5) -> (PointCloud, "
+        "dict)\n\n"
+        "A mesh to surfels (remeshing, paper §6): its vertices with area-weighted normals, then "
+        "`samples` area-uniform samples (0 = as many as it has vertices) with their triangle's "
+        "normal; radii from the k-th neighbour. Report: vertex_surfels, area_surfels.");
+}
+
+} // namespace pointform::python

@@ -1,0 +1,173 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+// What the bind_<module>.cpp files share: numpy views of library storage (read-only, owned by
+// the Python object that owns the storage), numpy inputs converted in one pass, and the
+// Python-side objects that are not library types (Hierarchy).
+
+#pragma once
+
+#include "pointform/core/error.h"
+#include "pointform/core/progress.h"
+#include "pointform/core/types.h"
+#include "pointform/geometry/multires_mesh.h"
+#include "pointform/geometry/point_cloud.h"
+#include "pointform/geometry/tri_mesh.h"
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <span>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace pointform::python {
+
+namespace py = pybind11;
+
+/// \brief A read-only numpy array over `data` (C order, `shape`), kept alive by `owner`: no
+/// copy. An empty shape gets a fresh empty array.
+template <class T>
+py::array readonly_view(const T* data, std::vector<py::ssize_t> shape, py::handle owner,
+                        bool writeable = false)
+{
+    std::vector<py::ssize_t> strides(shape.size());
+    py::ssize_t stride = sizeof(T);
+    for (std::size_t i = shape.size(); i-- > 0;)
+    {
+        strides[i] = stride;
+        stride *= shape[i];
+    }
+    py::array out(py::dtype::of<T>(), shape, strides, data, owner);
+    if (!writeable)
+        py::detail::array_proxy(out.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+    return out;
+}
+
+/// \brief A numpy array of Scalar that owns `values` (moved into a capsule, no copy): for
+/// results computed on demand, the caller's to keep (writeable) or the owner's (read-only). T is
+/// Scalar or a packed vector of Scalars (Vec3d).
+template <class Scalar, class T>
+py::array owning_array(std::vector<T> values, std::vector<py::ssize_t> shape,
+                       bool writeable = false)
+{
+    static_assert(sizeof(T) % sizeof(Scalar) == 0);
+    auto* heap = new std::vector<T>(std::move(values));
+    py::capsule owner(heap, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+    return readonly_view(reinterpret_cast<const Scalar*>(heap->data()), std::move(shape), owner,
+                         writeable);
+}
+
+/// \brief Runs `work(progress)` with the GIL released, where `progress` is a ProgressCallback
+/// for the library's options that lets Ctrl-C stop the work: when the library reports progress
+/// from the calling thread (signals reach Python's main thread only), it takes the GIL and runs
+/// Python's signal handlers; a KeyboardInterrupt asks the library to stop (it throws Cancelled)
+/// and is raised once the work has unwound. Results do not depend on it.
+template <class Work>
+auto run_interruptible(Work&& work)
+{
+    auto interrupted = std::make_shared<std::atomic<bool>>(false);
+    const std::thread::id caller = std::this_thread::get_id();
+    ProgressCallback progress = [interrupted, caller](std::string_view, double) {
+        if (std::this_thread::get_id() != caller)
+            return true;
+        const py::gil_scoped_acquire gil;
+        if (PyErr_CheckSignals() != 0)
+        {
+            PyErr_Clear();
+            interrupted->store(true);
+            return false;
+        }
+        return true;
+    };
+    try
+    {
+        const py::gil_scoped_release release;
+        return work(progress);
+    }
+    catch (const Cancelled&)
+    {
+        if (!interrupted->load())
+            throw;
+        PyErr_SetNone(PyExc_KeyboardInterrupt);
+        throw py::error_already_set();
+    }
+}
+
+/// \brief An N by 3 array of 3-vectors of T (Eigen vectors or std::array), as a view.
+template <class T, class V>
+py::array rows3_view(const std::vector<V>& rows, py::handle owner)
+{
+    static_assert(sizeof(V) == 3 * sizeof(T), "rows must be three packed scalars");
+    return readonly_view(reinterpret_cast<const T*>(rows.data()),
+                         {static_cast<py::ssize_t>(rows.size()), 3}, owner);
+}
+
+/// \brief Positions (or normals) from an N by 3 array of any real dtype and memory order, in
+/// one pass: a float32 C-contiguous array is copied as it is into the library's storage; others
+/// are converted element by element. With `origin` the values are taken relative to it (in
+/// double precision, then rounded to float).
+/// \throw InvalidInput naming `name` for a wrong shape or dtype, no rows (unless allow_empty), a
+///        non-finite value, or a row count other than `rows` (when given)
+std::vector<Vec3f> vec3f_rows(const py::handle& array, const char* name,
+                              std::optional<std::size_t> rows = std::nullopt,
+                              const Vec3d& origin = Vec3d::Zero(), bool allow_empty = false);
+
+/// \brief Query points from an M by 3 array, in double precision: a float64 C-contiguous array
+/// is used in place (no copy, `storage` untouched); others are converted once into `storage`.
+/// \throw InvalidInput as vec3f_rows()
+std::span<const Vec3d> vec3d_rows(const py::array& array, const char* name,
+                                  std::vector<Vec3d>& storage);
+
+/// \brief The first row of an N by 3 real array, in double precision (for the origin).
+Vec3d first_row(const py::handle& array, const char* name);
+
+/// \brief A numpy array (or anything numpy.asarray takes) as a py::array, without copying.
+py::array as_array(const py::handle& object, const char* name);
+
+/// \brief A point cloud from numpy arrays (the PointCloud constructor).
+PointCloud make_cloud(const py::handle& positions, const py::handle& normals,
+                      const py::handle& colors, const py::handle& radii, const py::handle& origin);
+
+/// \brief Triangles from an F by 3 integer array, each index below `vertices`.
+std::vector<Triangle> triangles_from(const py::handle& faces, std::size_t vertices);
+
+/// \brief A multiresolution hierarchy as Python sees it: the MultiresMesh, the report of how it
+/// was made (a dict; None when loaded from a file), and the per-level faces and world positions,
+/// made on first use and kept so that the arrays handed out stay views.
+struct Hierarchy
+{
+    MultiresMesh mesh;
+    py::object report = py::none();
+
+    std::mutex cache_mutex;
+    std::vector<std::optional<std::vector<Triangle>>> faces;
+    std::optional<std::vector<Vec3d>> world;
+
+    explicit Hierarchy(MultiresMesh m, py::object r = py::none())
+        : mesh(std::move(m)), report(std::move(r)), faces(mesh.level_count())
+    {}
+    /// \throw InvalidInput for a level that does not exist (negative ones count from the end)
+    [[nodiscard]] std::size_t level_index(long long level) const;
+};
+
+/// \brief The faces of a hierarchy's level and the world positions, computed once (the GIL
+/// released while they are made).
+const std::vector<Triangle>& hierarchy_faces(Hierarchy& h, std::size_t level);
+const std::vector<Vec3d>& hierarchy_world(Hierarchy& h);
+
+void bind_geometry(py::module_& m);
+void bind_io(py::module_& m);
+void bind_hermite(py::module_& m);
+void bind_implicit(py::module_& m);
+void bind_polygonize(py::module_& m);
+void bind_metrics(py::module_& m);
+
+} // namespace pointform::python

@@ -1,0 +1,82 @@
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 the pointform authors
+"""surfels and surfels_from_mesh: geometric truth on a sphere, bit for bit the CLI's."""
+
+import numpy as np
+import pytest
+
+import pointform
+from conftest import BUNNY_SCAN, SPOT, run_cli, sphere_points
+
+
+def test_surfels_of_a_sphere_point_outwards_with_radii(sphere_cloud):
+    surfels, report = pointform.surfels(sphere_cloud, k=12)
+    assert report["estimated_normals"] and report["estimated_radii"]
+    assert report["components"] == 1 and report["unoriented"] == 0
+    assert len(surfels) == len(sphere_cloud)
+    p = surfels.world()
+    n = surfels.normals.astype(np.float64)
+    assert np.allclose(np.linalg.norm(n, axis=1), 1.0, atol=1e-5)
+    # PCA normals of 2000 samples of the unit sphere: within a few degrees of the radial direction.
+    cosine = np.sum(n * p, axis=1) / np.linalg.norm(p, axis=1)
+    assert cosine.min() > np.cos(np.radians(5.0))
+    spacing = np.sqrt(4.0 * np.pi / len(p))  # about the distance between neighbours
+    assert np.all(surfels.radii > 0.5 * spacing) and np.all(surfels.radii < 10 * spacing)
+    assert np.array_equal(surfels.positions, sphere_cloud.positions)
+
+
+def test_given_normals_are_kept_and_unusable_ones_dropped():
+    p = sphere_points(500)
+    n = p.copy()
+    n[:3] = 0.0  # zero normals cannot be used
+    surfels, report = pointform.surfels(pointform.PointCloud(p, normals=n))
+    assert not report["estimated_normals"] and report["estimated_radii"]
+    assert report["unoriented"] == 3 and len(surfels) == 497
+    again, report = pointform.surfels(pointform.PointCloud(p, normals=-p), reestimate=True)
+    assert report["estimated_normals"] and report["flipped"] >= 0
+    assert np.min(np.sum(again.normals * again.world(), axis=1)) > 0.9  # outward, not -p
+
+
+def test_surfels_are_bit_for_bit_the_clis(tmp_path, bunny_points):
+    out = tmp_path / "surfels.ply"
+    run_cli("normals", BUNNY_SCAN, "-o", out, "--radius-scale", 1.0, "-q")
+    cli = pointform.read(out)
+    surfels, report = pointform.surfels(bunny_points, radius_scale=1.0)
+    assert report["unoriented"] == 0
+    assert np.array_equal(surfels.origin, cli.origin)
+    assert np.array_equal(surfels.positions, cli.positions)
+    assert np.array_equal(surfels.radii, cli.radii)
+    # Reading normalises normals again (a last-bit change), so compare the files written.
+    ours = tmp_path / "ours.ply"
+    pointform.write(ours, surfels)
+    assert ours.read_bytes() == out.read_bytes()
+
+
+def test_surfels_do_not_depend_on_threads(bunny_points):
+    pointform.set_thread_count(1)
+    try:
+        one, _ = pointform.surfels(bunny_points)
+    finally:
+        pointform.set_thread_count(0)
+    many, _ = pointform.surfels(bunny_points)
+    assert np.array_equal(one.normals, many.normals) and np.array_equal(one.radii, many.radii)
+
+
+def test_surfels_from_mesh():
+    mesh = pointform.read_mesh(SPOT)
+    surfels, report = pointform.surfels_from_mesh(mesh, samples=1000)
+    assert report["area_surfels"] == 1000
+    assert report["vertex_surfels"] + report["area_surfels"] == len(surfels)
+    assert surfels.normals is not None and np.all(surfels.radii > 0)
+
+
+def test_bad_surfel_input():
+    with pytest.raises(pointform.InvalidInput, match="k"):
+        pointform.surfels(pointform.PointCloud(sphere_points(10)), k=16)
+    line = np.stack([np.linspace(0, 1, 50)] * 3, axis=1)
+    with pytest.raises(ValueError, match="line|collinear"):
+        pointform.surfels(pointform.PointCloud(line))
+    with pytest.raises(ValueError, match="radius"):
+        pointform.surfels(pointform.PointCloud(sphere_points(100)), radius_scale=-1.0)
+    with pytest.raises(TypeError):
+        pointform.surfels(np.zeros((100, 3)))  # a PointCloud is needed

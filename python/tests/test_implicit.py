@@ -1,0 +1,77 @@
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 the pointform authors
+"""Field and scene: signed distances checked against the analytic sphere."""
+
+import numpy as np
+import pytest
+
+import pointform
+from conftest import sphere_points
+
+
+def radial_queries(radii, n=200):
+    directions = sphere_points(n, seed=3)
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    return np.concatenate([r * directions for r in radii]), directions
+
+
+def test_point_field_of_a_sphere_is_its_signed_distance(sphere_surfels):
+    field = pointform.Field(sphere_surfels, fit="quadric")
+    points, directions = radial_queries([0.95, 1.0, 1.05])
+    values, gradients = field.evaluate(points)
+    assert values.shape == (600,) and gradients.shape == (600, 3)
+    expected = np.linalg.norm(points, axis=1) - 1.0
+    # 2000 samples of the unit sphere (spacing about 0.08): the quadric fit is within 1e-3.
+    assert np.max(np.abs(values - expected)) < 1e-3
+    cosine = np.sum(gradients * np.tile(directions, (3, 1)), axis=1) / np.linalg.norm(gradients, axis=1)
+    assert cosine.min() > 0.99
+    assert 0.02 < field.median_radius < 0.3
+
+
+def test_every_fit_and_defined(sphere_surfels):
+    inside_far = np.array([[0.0, 0.0, 0.0], [3.0, 0.0, 0.0]])
+    for fit in ("raw", "centroid", "blend", "quadric"):
+        field = pointform.Field(sphere_surfels, fit=fit)
+        values, _, defined = field.evaluate(inside_far, defined=True)
+        assert defined.dtype == bool and not defined.any()  # beyond every influence radius
+        assert values[0] < -0.9 and values[1] > 1.9  # inside negative, outside positive
+    with pytest.raises(pointform.InvalidInput, match="fit|plane"):
+        pointform.Field(sphere_surfels, fit="cubic")
+
+
+def test_query_dtypes_and_orders_give_the_same_values(sphere_surfels):
+    field = pointform.Field(sphere_surfels)
+    points, _ = radial_queries([0.97, 1.02], n=50)
+    points32 = points.astype(np.float32)
+    reference, reference_gradients = field.evaluate(points32.astype(np.float64))
+    for variant in (points32, np.asfortranarray(points32.astype(np.float64)),
+                    points32.astype(np.float64)[:, ::-1][:, ::-1], points32.tolist()):
+        values, gradients = field.evaluate(variant)
+        assert np.array_equal(values, reference)
+        assert np.array_equal(gradients, reference_gradients)
+    values, gradients = field.evaluate(np.zeros((0, 3)))
+    assert values.shape == (0,) and gradients.shape == (0, 3)
+
+
+def test_bad_queries_and_fields(sphere_surfels, sphere_cloud):
+    field = pointform.Field(sphere_surfels)
+    with pytest.raises(pointform.InvalidInput, match=r"points\[1\] is not finite"):
+        field.evaluate(np.array([[0.0, 0.0, 0.0], [np.nan, 0.0, 0.0]]))
+    with pytest.raises(ValueError, match="N by 3"):
+        field.evaluate(np.zeros((4, 4)))
+    with pytest.raises(ValueError, match="normals|radii"):
+        pointform.Field(sphere_cloud)  # no normals or radii
+
+
+def test_scene_fields_are_exact():
+    field = pointform.scene("sphere([0, 0, 0], 1)")
+    points, _ = radial_queries([0.5, 1.0, 2.0], n=20)
+    values, gradients = field.evaluate(points)
+    assert np.allclose(values, np.linalg.norm(points, axis=1) - 1.0, rtol=0, atol=1e-12)
+    lo, hi = field.bounds()
+    assert np.all(lo <= -1.0) and np.all(hi >= 1.0)
+    assert field.median_radius is None
+    with pytest.raises(pointform.InvalidInput, match="expression:1:"):
+        pointform.scene("sphere([0, 0, 0], 1")
+    with pytest.raises(pointform.InvalidInput, match="did you mean 'sphere'"):
+        pointform.scene("spher([0, 0, 0], 1)")

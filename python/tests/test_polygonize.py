@@ -1,0 +1,195 @@
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 the pointform authors
+"""reconstruct, remesh, model and Hierarchy: bit for bit the CLI's, GIL released."""
+
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import pointform
+from conftest import BUNNY_SCAN, BUNNY_SMALL, SPOT, run_cli, sphere_points
+
+
+@pytest.fixture(scope="module")
+def cli_bunny(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("cli")
+    mesh, hierarchy = folder / "bunny.ply", folder / "bunny.pfh"
+    report = run_cli("reconstruct", BUNNY_SCAN, "-o", mesh, "--save-hierarchy", hierarchy,
+                     "--json", json_output=True)
+    return mesh, hierarchy, report
+
+
+@pytest.fixture(scope="module")
+def bunny(bunny_points):
+    return pointform.reconstruct(bunny_points)
+
+
+def test_reconstruct_is_bit_for_bit_the_clis(cli_bunny, bunny, tmp_path):
+    cli_mesh_path, cli_hierarchy_path, cli_report = cli_bunny
+    cli_mesh = pointform.read_mesh(cli_mesh_path)
+    finest = bunny.level_mesh(bunny.finest_level)
+    assert np.array_equal(finest.vertices, cli_mesh.vertices)
+    assert np.array_equal(finest.faces, cli_mesh.faces)
+    vertices, faces = bunny.level(-1)
+    assert np.array_equal(faces, cli_mesh.faces)
+    assert np.array_equal(vertices.astype(np.float32), cli_mesh.world().astype(np.float32))
+    # The whole hierarchy: the same .pfh bytes.
+    ours = tmp_path / "ours.pfh"
+    bunny.save(ours)
+    assert ours.read_bytes() == cli_hierarchy_path.read_bytes()
+    # Every per-level figure the CLI reports (timings aside).
+    report = bunny.report
+    assert report["stop"] == cli_report["stop"] and report["stop_rule"] == cli_report["stop_rule"]
+    assert len(report["levels"]) == len(cli_report["levels"]) == bunny.level_count
+    for ours_level, cli_level in zip(report["levels"], cli_report["levels"]):
+        for key, value in cli_level.items():
+            if key != "seconds":
+                assert ours_level[key] == value, key
+    for key in ("sampling_density", "diagonal", "samples", "finest_level", "faces", "vertices",
+                "intermediate_faces", "cell", "paper_rule_level", "vertex_budget"):
+        assert report[key] == cli_report[key], key
+    for key, value in cli_report["base_mesh"].items():
+        if key != "seconds":
+            assert report["base_mesh"][key] == value, key
+
+
+def test_hierarchy_levels_are_nested_views(bunny, tmp_path):
+    assert bunny.level_count == bunny.finest_level + 1 >= 2
+    v0, f0 = bunny.level(0)
+    v1, f1 = bunny.level(1)
+    assert v0.dtype == np.float64 and f0.dtype == np.uint32
+    assert np.array_equal(v1[: len(v0)], v0)  # V^0 is a prefix of V^1
+    assert len(f1) == 4 * len(f0) and f1.max() < len(v1) and f0.max() < len(v0)
+    assert bunny.face_count(1) == len(f1) and bunny.vertex_count(0) == len(v0)
+    again, faces_again = bunny.level(1)
+    assert np.shares_memory(v1, again) and np.shares_memory(f1, faces_again)
+    assert np.shares_memory(v0, v1)  # both views of the same positions
+    assert not v1.flags.writeable and not f1.flags.writeable
+    assert np.array_equal(bunny.base_faces, f0)
+    assert list(bunny.level_offsets) == [0] + [bunny.vertex_count(i) for i in range(bunny.level_count)]
+    edges = bunny.parent_edges
+    assert edges.shape == (bunny.vertex_count(bunny.finest_level) - len(v0), 2)
+    # A new vertex of level 1 lies near the midpoint of its parent edge (it was projected from it).
+    a, b = edges[0]
+    edge = np.linalg.norm(v0[a] - v0[b])
+    assert np.linalg.norm(v1[len(v0)] - 0.5 * (v0[a] + v0[b])) < edge
+    path = tmp_path / "h.pfh"
+    pointform.write(path, bunny)
+    loaded = pointform.load_hierarchy(path)
+    assert loaded.report is None and loaded.level_count == bunny.level_count
+    assert np.array_equal(loaded.positions, bunny.positions)
+    assert np.array_equal(loaded.level(-1)[1], bunny.level(-1)[1])
+    with pytest.raises(pointform.InvalidInput, match="level 9 does not exist"):
+        bunny.level(9)
+
+
+def test_reconstruct_levels_geometric_truth():
+    cloud = pointform.PointCloud(sphere_points(3000))
+    hierarchy = pointform.reconstruct(cloud, levels=2)
+    assert hierarchy.level_count == 3 and hierarchy.report["stop"] == "levels"
+    vertices, faces = hierarchy.level(2)
+    radius = np.linalg.norm(vertices, axis=1)
+    assert np.max(np.abs(radius - 1.0)) < 0.01  # on the unit sphere within 1% of its radius
+    a, b, c = (vertices[faces[:, i]] for i in range(3))
+    volume = np.sum(np.einsum("ij,ij->i", a, np.cross(b, c))) / 6.0
+    assert abs(volume - 4.0 / 3.0 * np.pi) < 0.03 * 4.0 / 3.0 * np.pi  # outward, closed
+
+
+def test_gil_is_released_while_two_reconstructions_run(bunny_points):
+    serial = pointform.reconstruct(bunny_points, levels=1)
+    barrier = threading.Barrier(2)
+    intervals, results = [None, None], [None, None]
+
+    def work(i):
+        barrier.wait()
+        start = time.perf_counter()
+        results[i] = pointform.reconstruct(bunny_points, levels=1)
+        intervals[i] = (start, time.perf_counter())
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(2)]
+    ticks = []
+    for t in threads:
+        t.start()
+    while any(t.is_alive() for t in threads):
+        ticks.append(time.perf_counter())  # runs only while no thread holds the GIL
+        time.sleep(0.002)
+    for t in threads:
+        t.join()
+    both_start = max(start for start, _ in intervals)
+    first_end = min(end for _, end in intervals)
+    assert first_end > both_start, "the two calls did not overlap in time"
+    during = [t for t in ticks if both_start < t < first_end]
+    # Both threads were inside reconstruct at once (for about a second) and the main thread kept
+    # running Python meanwhile: a call that held the GIL would leave no tick in that window.
+    assert len(during) >= 10, f"{len(during)} ticks in {first_end - both_start:.3f} s of overlap"
+    for result in results:
+        assert np.array_equal(result.positions, serial.positions)
+        assert np.array_equal(result.level(-1)[1], serial.level(-1)[1])
+
+
+def test_model_is_the_clis(tmp_path):
+    cli_path = tmp_path / "cli.ply"
+    run_cli("model", "sphere([0, 0, 0], 1)", "-o", cli_path, "--resolution", 24, "-q")
+    mesh = pointform.model("sphere([0, 0, 0], 1)", resolution=24)
+    ours = tmp_path / "ours.ply"
+    pointform.write(ours, mesh)
+    assert ours.read_bytes() == cli_path.read_bytes()
+    radius = np.linalg.norm(mesh.world(), axis=1)
+    assert np.max(np.abs(radius - 1.0)) < 0.01
+    semi = pointform.model("sphere([0, 0, 0], 1)", resolution=24, semi_regular=True, levels=1)
+    run_cli("model", "sphere([0, 0, 0], 1)", "-o", cli_path, "--resolution", 24,
+            "--semi-regular", "--levels", 1, "-q")
+    pointform.write(ours, semi)
+    assert ours.read_bytes() == cli_path.read_bytes()
+    with pytest.raises(pointform.InvalidInput, match="bounds|unbounded"):
+        pointform.model("half_space([0, 0, 0], [0, 0, 1])")
+    with pytest.raises(pointform.InvalidInput, match="levels"):
+        pointform.model("sphere([0, 0, 0], 1)", levels=2)
+
+
+def test_remesh_is_the_clis(tmp_path):
+    cli_path = tmp_path / "cli.ply"
+    run_cli("remesh", SPOT, "-o", cli_path, "--levels", 1, "-q")
+    hierarchy = pointform.remesh(pointform.read_mesh(SPOT), levels=1)
+    ours = tmp_path / "ours.ply"
+    pointform.write(ours, hierarchy.level_mesh(-1))
+    assert ours.read_bytes() == cli_path.read_bytes()
+    assert hierarchy.report["vertex_surfels"] > 0
+    with pytest.raises(pointform.InvalidInput, match="manifold"):
+        pointform.remesh(pointform.read_mesh(BUNNY_SMALL))
+
+
+def test_bad_reconstruct_input(sphere_cloud, tmp_path):
+    with pytest.raises(pointform.InvalidInput, match="levels must not be negative"):
+        pointform.reconstruct(sphere_cloud, levels=-1)
+    with pytest.raises(ValueError, match="levels|8"):
+        pointform.reconstruct(sphere_cloud, levels=9)
+    with pytest.raises(ValueError, match="base_faces|face"):
+        pointform.reconstruct(sphere_cloud, base_faces=0)
+    with pytest.raises(ValueError, match="stop rule"):
+        pointform.reconstruct(sphere_cloud, stop_rule="never")
+    with pytest.raises(ValueError, match="resolution"):
+        pointform.reconstruct(sphere_cloud, resolution=1)
+    with pytest.raises(ValueError):
+        pointform.reconstruct(pointform.PointCloud(sphere_points(5)))
+    not_pfh = tmp_path / "x.pfh"
+    not_pfh.write_bytes(b"hello")
+    with pytest.raises(pointform.IoError, match="not a pointform hierarchy|x.pfh"):
+        pointform.load_hierarchy(not_pfh)
+
+
+def test_ctrl_c_stops_a_long_call():
+    import os
+    import signal
+
+    cloud = pointform.PointCloud(sphere_points(80000))
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        pointform.reconstruct(cloud, levels=3)  # about 2.4 s uninterrupted on 2 cores
+    timer.join()
+    assert time.perf_counter() - start < 3.0
+    assert pointform.reconstruct(cloud, levels=0).level_count == 1  # still usable
