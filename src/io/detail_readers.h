@@ -90,7 +90,11 @@ public:
     {}
 
     [[nodiscard]] std::size_t offset() const { return offset_; }
-    [[nodiscard]] std::size_t remaining() const { return bytes_.size() - offset_; }
+    /// Bytes after the offset; 0 once a seek() has gone past the end.
+    [[nodiscard]] std::size_t remaining() const
+    {
+        return offset_ <= bytes_.size() ? bytes_.size() - offset_ : 0;
+    }
     [[nodiscard]] const char* data() const { return bytes_.data() + offset_; }
     [[nodiscard]] const std::filesystem::path& path() const { return *path_; }
 
@@ -125,6 +129,7 @@ public:
         offset_ += static_cast<std::size_t>(n);
     }
 
+    /// Moves to `offset`, which may lie past the end: the next require() then fails as truncated.
     void seek(std::size_t offset) { offset_ = offset; }
 
 private:

@@ -263,6 +263,14 @@ TEST(LasErrors, Truncated)
     const auto header_only = dir / "header.las";
     write_file(header_only, bytes.substr(0, 150));
     expect_io_error([&] { (void)read_geometry(header_only); }, header_only, "truncated");
+
+    // A LAS 1.4 header that claims its full 375 bytes in a file of 229: the 64-bit point count
+    // at byte 247 lies past the end (found by the readers' fuzzer: a read out of bounds).
+    const auto short14 = dir / "short14.las";
+    std::string v14 = make_las({.minor = 4, .format = 6, .legacy_count = false}, {}, {});
+    ASSERT_GE(v14.size(), 375U);
+    write_file(short14, v14.substr(0, 229));
+    expect_io_error([&] { (void)read_geometry(short14); }, short14, "truncated");
 }
 
 TEST(LasErrors, CompressedLaz)
