@@ -4,6 +4,7 @@
 #include "pointform/polygonize/components.h"
 
 #include "pointform/core/disjoint_sets.h"
+#include "pointform/geometry/mesh_topology.h"
 #include "pointform/spatial/triangle_bvh.h"
 
 #include <algorithm>
@@ -68,44 +69,10 @@ ComponentFilterReport remove_unsupported_components(TriMesh& mesh, const PointCl
     if (report.removed_components == 0)
         return report;
 
-    std::vector<std::uint32_t> remap(nv, none);
-    std::vector<Triangle> triangles;
-    triangles.reserve(mesh.face_count());
+    std::vector<std::uint8_t> keep_face(mesh.face_count());
     for (std::size_t f = 0; f < mesh.face_count(); ++f)
-        if (keep[face_component[f]] != 0)
-        {
-            triangles.push_back(mesh.triangles[f]);
-            for (const std::uint32_t v : mesh.triangles[f])
-                remap[v] = 0;
-        }
-        else
-            ++report.removed_faces;
-    PointCloud& vertices = mesh.vertices;
-    std::uint32_t next = 0;
-    for (std::size_t v = 0; v < nv; ++v)
-        if (remap[v] != none)
-        {
-            remap[v] = next;
-            vertices.positions[next] = vertices.positions[v];
-            if (!vertices.normals.empty())
-                vertices.normals[next] = vertices.normals[v];
-            if (!vertices.colors.empty())
-                vertices.colors[next] = vertices.colors[v];
-            if (!vertices.radii.empty())
-                vertices.radii[next] = vertices.radii[v];
-            ++next;
-        }
-    vertices.positions.resize(next);
-    if (!vertices.normals.empty())
-        vertices.normals.resize(next);
-    if (!vertices.colors.empty())
-        vertices.colors.resize(next);
-    if (!vertices.radii.empty())
-        vertices.radii.resize(next);
-    for (Triangle& t : triangles)
-        for (std::uint32_t& v : t)
-            v = remap[v];
-    mesh.triangles = std::move(triangles);
+        keep_face[f] = keep[face_component[f]];
+    report.removed_faces = keep_faces(mesh, keep_face);
     return report;
 }
 

@@ -1269,54 +1269,16 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
         std::vector<FieldSample> at_vertices(nv);
         evaluate_near_zero(field, exact_range, points, at_vertices);
         stats.field_evaluations += nv;
-        std::size_t kept = 0;
-        for (const Triangle& tri : mesh.triangles)
+        std::vector<std::uint8_t> keep(mesh.face_count());
+        for (std::size_t f = 0; f < mesh.face_count(); ++f)
         {
-            if (at_vertices[tri[0]].defined && at_vertices[tri[1]].defined &&
-                at_vertices[tri[2]].defined)
-            {
-                mesh.triangles[kept++] = tri;
-            }
+            const Triangle& tri = mesh.triangles[f];
+            keep[f] = at_vertices[tri[0]].defined && at_vertices[tri[1]].defined &&
+                              at_vertices[tri[2]].defined
+                          ? 1
+                          : 0;
         }
-        stats.undefined_triangles = mesh.triangles.size() - kept;
-        mesh.triangles.resize(kept);
-        if (stats.undefined_triangles > 0)
-        {
-            std::vector<std::uint32_t> remap(nv, std::numeric_limits<std::uint32_t>::max());
-            for (const Triangle& tri : mesh.triangles)
-            {
-                for (const std::uint32_t v : tri)
-                {
-                    remap[v] = 0;
-                }
-            }
-            std::uint32_t next = 0;
-            for (std::size_t v = 0; v < nv; ++v)
-            {
-                if (remap[v] == 0)
-                {
-                    remap[v] = next;
-                    mesh.vertices.positions[next] = mesh.vertices.positions[v];
-                    if (options.vertex_normals)
-                    {
-                        mesh.vertices.normals[next] = mesh.vertices.normals[v];
-                    }
-                    ++next;
-                }
-            }
-            mesh.vertices.positions.resize(next);
-            if (options.vertex_normals)
-            {
-                mesh.vertices.normals.resize(next);
-            }
-            for (Triangle& tri : mesh.triangles)
-            {
-                for (std::uint32_t& v : tri)
-                {
-                    v = remap[v];
-                }
-            }
-        }
+        stats.undefined_triangles = keep_faces(mesh, keep);
     }
     repair_degenerate_triangles(mesh, grid.cell, stats);
     // Where undefined cells meet diagonally, two sheets touch at one vertex; give each its own.

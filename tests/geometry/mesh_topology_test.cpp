@@ -96,6 +96,42 @@ TEST(MeshTopology, TwoDisjointTetrahedra)
     EXPECT_EQ(t.euler_characteristic, 4);
 }
 
+TEST(MeshTopology, KeepFacesCompactsVerticesAndTheirAttributes)
+{
+    // Two tetrahedra; vertex i sits at (i, 0, 0) with radius i, so the survivors can be told apart.
+    TriMesh two = tetrahedron();
+    two.vertices.positions.resize(8);
+    two.vertices.radii.resize(8);
+    for (std::uint32_t v = 0; v < 8; ++v)
+    {
+        two.vertices.positions[v] = Vec3f(static_cast<float>(v), 0.0F, 0.0F);
+        two.vertices.radii[v] = static_cast<float>(v);
+    }
+    for (Triangle t : tetrahedron().triangles)
+        two.triangles.push_back({t[0] + 4, t[1] + 4, t[2] + 4});
+    const std::vector<std::uint8_t> keep = {0, 0, 0, 0, 1, 0, 1, 1};
+    EXPECT_EQ(keep_faces(two, keep), 5U);
+    ASSERT_EQ(two.face_count(), 3U);
+    ASSERT_EQ(two.vertex_count(), 4U); // the second tetrahedron's faces 0, 2, 3 use all four
+    for (std::uint32_t v = 0; v < 4; ++v)
+    {
+        EXPECT_EQ(two.vertices.positions[v].x(), static_cast<float>(v + 4));
+        EXPECT_EQ(two.vertices.radii[v], static_cast<float>(v + 4));
+    }
+    const std::vector<Triangle> tet = tetrahedron().triangles;
+    EXPECT_EQ(two.triangles[0], tet[0]);
+    EXPECT_EQ(two.triangles[1], tet[2]);
+    EXPECT_EQ(two.triangles[2], tet[3]);
+
+    const std::vector<std::uint8_t> all(3, 1);
+    EXPECT_EQ(keep_faces(two, all), 0U);
+    EXPECT_EQ(two.vertex_count(), 4U);
+    const std::vector<std::uint8_t> none(3, 0);
+    EXPECT_EQ(keep_faces(two, none), 3U);
+    EXPECT_EQ(two.vertex_count(), 0U);
+    EXPECT_TRUE(two.vertices.radii.empty());
+}
+
 /// The plain definitions, pair by pair (quadratic), to check analyze_topology, vertex_fans and
 /// split_nonmanifold_vertices against.
 struct Reference

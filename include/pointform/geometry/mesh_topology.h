@@ -83,4 +83,10 @@ struct VertexFans
 /// \return the number of vertices added
 std::size_t split_nonmanifold_vertices(TriMesh& mesh);
 
+/// \brief Keeps the triangles whose `keep[f]` is non-zero (in order), then removes the vertices
+/// no kept triangle uses, with their attributes, and renumbers the triangles.
+/// \pre keep.size() == mesh.face_count()
+/// \return the number of triangles removed
+std::size_t keep_faces(TriMesh& mesh, std::span<const std::uint8_t> keep);
+
 } // namespace pointform
