@@ -13,11 +13,11 @@ namespace pointform::cli {
 SurfelsFromSamples load_surfels(const std::string& path, SurfelsFromSamplesOptions options,
                                 const ProgressCallback& progress)
 {
-    PointCloud cloud = read_point_cloud(path);
+    const PointCloud cloud = read_point_cloud(path);
     options.progress = progress;
     try
     {
-        return surfels_from_samples(std::move(cloud), options);
+        return surfels_from_samples(cloud, options);
     }
     catch (const InvalidInput& e)
     {

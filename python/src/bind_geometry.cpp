@@ -107,6 +107,22 @@ py::array as_float64(const py::array& a)
     return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
 }
 
+/// Whether `a` holds T exactly as the library stores it: native dtype, C order, aligned.
+template <class T>
+bool in_library_layout(const py::array& a)
+{
+    return is_native(a, py::dtype::of<T>()) && (a.flags() & py::array::c_style) != 0 &&
+           (a.flags() & py::detail::npy_api::NPY_ARRAY_ALIGNED_) != 0;
+}
+
+void check_finite_rows(std::span<const Vec3f> rows, const char* name)
+{
+    for (std::size_t i = 0; i < rows.size(); ++i)
+        if (!rows[i].allFinite())
+            throw InvalidInput(std::string(name) + "[" + std::to_string(i) + "] is not finite: " +
+                               row_text(rows[i].x(), rows[i].y(), rows[i].z()));
+}
+
 } // namespace
 
 py::array as_array(const py::handle& object, const char* name)
@@ -138,11 +154,7 @@ std::vector<Vec3f> vec3f_rows(const py::handle& array, const char* name,
         {
             // The one copy into the library's storage; then the finiteness check in place.
             std::memcpy(static_cast<void*>(out.data()), a.data(), n * sizeof(Vec3f));
-            for (std::size_t i = 0; i < n; ++i)
-                if (!out[i].allFinite())
-                    throw InvalidInput(
-                        std::string(name) + "[" + std::to_string(i) +
-                        "] is not finite: " + row_text(out[i].x(), out[i].y(), out[i].z()));
+            check_finite_rows(out, name);
             return out;
         }
         read_rows<float>(a, name, origin, out.data());
@@ -219,9 +231,9 @@ Vec3d origin_from(const py::handle& origin)
     return o;
 }
 
-std::vector<Color> colors_from(const py::handle& colors, std::size_t n)
+/// Checks an N by 3 integer color array; returns it as int64 C order (a view if it was one).
+py::array_t<std::int64_t> checked_colors(const py::array& a, std::size_t n)
 {
-    py::array a = as_array(colors, "colors");
     if (dtype_kind(a) != 'i' && dtype_kind(a) != 'u')
         throw InvalidInput("colors: expected integers 0-255 (uint8), got dtype " + dtype_text(a));
     if (a.ndim() != 2 || a.shape(1) != 3)
@@ -231,26 +243,28 @@ std::vector<Color> colors_from(const py::handle& colors, std::size_t n)
                            std::to_string(a.shape(0)));
     auto v = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
     const std::int64_t* data = v.data();
+    for (std::size_t i = 0; i < 3 * n; ++i)
+        if (data[i] < 0 || data[i] > 255)
+            throw InvalidInput("colors[" + std::to_string(i / 3) + "] has a channel out of " +
+                               "0-255: " + std::to_string(data[i]));
+    return v;
+}
+
+std::vector<Color> colors_from(const py::array& a, std::size_t n)
+{
+    const py::array_t<std::int64_t> v = checked_colors(a, n);
+    const std::int64_t* data = v.data();
     std::vector<Color> out(n);
     for (std::size_t i = 0; i < n; ++i)
-    {
-        for (int j = 0; j < 3; ++j)
-        {
-            const std::int64_t c = data[3 * i + static_cast<std::size_t>(j)];
-            if (c < 0 || c > 255)
-                throw InvalidInput("colors[" + std::to_string(i) + "] has a channel out of " +
-                                   "0-255: " + std::to_string(c));
-        }
         out[i] = Color{static_cast<std::uint8_t>(data[3 * i]),
                        static_cast<std::uint8_t>(data[3 * i + 1]),
                        static_cast<std::uint8_t>(data[3 * i + 2])};
-    }
     return out;
 }
 
-std::vector<float> radii_from(const py::handle& radii, std::size_t n)
+/// Checks an array of N radii; returns them as float64 C order (a view if they were).
+py::array_t<double> checked_radii(const py::array& a, std::size_t n)
 {
-    py::array a = as_array(radii, "radii");
     if (dtype_kind(a) != 'f' && dtype_kind(a) != 'i' && dtype_kind(a) != 'u')
         throw InvalidInput("radii: expected real numbers, got dtype " + dtype_text(a));
     if (a.ndim() != 1)
@@ -259,26 +273,33 @@ std::vector<float> radii_from(const py::handle& radii, std::size_t n)
         throw InvalidInput("radii: expected " + std::to_string(n) +
                            " values (one per point), got " + std::to_string(a.shape(0)));
     auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
-    std::vector<float> out(n);
     for (std::size_t i = 0; i < n; ++i)
     {
         const double r = d.data()[i];
         if (!std::isfinite(r) || !(r > 0.0))
             throw InvalidInput("radii[" + std::to_string(i) +
                                "] must be positive and finite, got " + std::to_string(r));
-        out[i] = static_cast<float>(r);
     }
+    return d;
+}
+
+std::vector<float> radii_from(const py::array& a, std::size_t n)
+{
+    const py::array_t<double> d = checked_radii(a, n);
+    std::vector<float> out(n);
+    for (std::size_t i = 0; i < n; ++i)
+        out[i] = static_cast<float>(d.data()[i]);
     return out;
 }
 
-py::object optional_rows3f(const std::vector<Vec3f>& rows, py::handle owner)
+py::object optional_rows3f(std::span<const Vec3f> rows, py::handle owner)
 {
     if (rows.empty())
         return py::none();
     return rows3_view<float>(rows, owner);
 }
 
-py::object optional_colors(const std::vector<Color>& colors, py::handle owner)
+py::object optional_colors(std::span<const Color> colors, py::handle owner)
 {
     static_assert(sizeof(Color) == 3);
     if (colors.empty())
@@ -286,14 +307,14 @@ py::object optional_colors(const std::vector<Color>& colors, py::handle owner)
     return rows3_view<std::uint8_t>(colors, owner);
 }
 
-py::object optional_radii(const std::vector<float>& radii, py::handle owner)
+py::object optional_radii(std::span<const float> radii, py::handle owner)
 {
     if (radii.empty())
         return py::none();
     return readonly_view(radii.data(), {static_cast<py::ssize_t>(radii.size())}, owner);
 }
 
-py::array world_positions(const PointCloud& cloud)
+py::array world_positions(const PointCloudView& cloud)
 {
     std::vector<Vec3d> world(cloud.size());
     for (std::size_t i = 0; i < cloud.size(); ++i)
@@ -302,7 +323,7 @@ py::array world_positions(const PointCloud& cloud)
     return owning_array<double>(std::move(world), {n, 3}, true);
 }
 
-py::tuple bounds_tuple(const PointCloud& cloud)
+py::tuple bounds_tuple(const PointCloudView& cloud)
 {
     if (cloud.empty())
         throw InvalidInput("bounds: the cloud has no points");
@@ -313,28 +334,74 @@ py::tuple bounds_tuple(const PointCloud& cloud)
 
 } // namespace
 
-PointCloud make_cloud(const py::handle& positions, const py::handle& normals,
-                      const py::handle& colors, const py::handle& radii, const py::handle& origin)
+std::shared_ptr<Cloud> make_cloud(const py::handle& positions, const py::handle& normals,
+                                  const py::handle& colors, const py::handle& radii,
+                                  const py::handle& origin, bool in_place)
 {
-    PointCloud cloud;
+    PointCloud converted;
+    py::array p = as_array(positions, "positions");
     if (!origin.is_none())
-        cloud.origin = origin_from(origin);
-    else
+        converted.origin = origin_from(origin);
+    else if (!is_native(p, py::dtype::of<float>()))
     {
-        py::array a = as_array(positions, "positions");
         // float32 positions are taken as they are (origin 0); others are re-centred the way the
         // readers re-centre a file's double coordinates (choose_origin()).
-        if (!is_native(a, py::dtype::of<float>()))
-            cloud.origin = choose_origin(first_row(a, "positions"));
+        converted.origin = choose_origin(first_row(p, "positions"));
     }
-    cloud.positions = vec3f_rows(positions, "positions", std::nullopt, cloud.origin);
-    const std::size_t n = cloud.positions.size();
+    check_rows3(p, "positions", std::nullopt, false);
+    const auto n = static_cast<std::size_t>(p.shape(0));
+    std::vector<py::object> borrowed;
+    PointCloudView view;
+    const auto rows_in_place = [&](const py::array& a, const char* name) {
+        std::span<const Vec3f> rows(static_cast<const Vec3f*>(a.data()), n);
+        check_finite_rows(rows, name);
+        borrowed.push_back(a);
+        return rows;
+    };
+    if (in_place && converted.origin.isZero() && in_library_layout<float>(p))
+        view.positions = rows_in_place(p, "positions");
+    else
+        converted.positions = vec3f_rows(p, "positions", std::nullopt, converted.origin);
     if (!normals.is_none())
-        cloud.normals = vec3f_rows(normals, "normals", n);
+    {
+        py::array a = as_array(normals, "normals");
+        check_rows3(a, "normals", n, false);
+        if (in_place && in_library_layout<float>(a))
+            view.normals = rows_in_place(a, "normals");
+        else
+            converted.normals = vec3f_rows(a, "normals", n);
+    }
     if (!colors.is_none())
-        cloud.colors = colors_from(colors, n);
+    {
+        py::array a = as_array(colors, "colors");
+        if (in_place && in_library_layout<std::uint8_t>(a))
+        {
+            checked_colors(a, n);
+            view.colors = {static_cast<const Color*>(a.data()), n};
+            borrowed.push_back(a);
+        }
+        else
+            converted.colors = colors_from(a, n);
+    }
     if (!radii.is_none())
-        cloud.radii = radii_from(radii, n);
+    {
+        py::array a = as_array(radii, "radii");
+        if (in_place && in_library_layout<float>(a))
+        {
+            checked_radii(a, n);
+            view.radii = {static_cast<const float*>(a.data()), n};
+            borrowed.push_back(a);
+        }
+        else
+            converted.radii = radii_from(a, n);
+    }
+    auto cloud = owned_cloud(std::move(converted));
+    cloud->borrowed = std::move(borrowed);
+    const PointCloud& owned = cloud->owned;
+    cloud->view.positions = view.positions.empty() ? owned.positions : view.positions;
+    cloud->view.normals = view.normals.empty() ? owned.normals : view.normals;
+    cloud->view.colors = view.colors.empty() ? owned.colors : view.colors;
+    cloud->view.radii = view.radii.empty() ? owned.radii : view.radii;
     return cloud;
 }
 
@@ -372,11 +439,12 @@ std::vector<Triangle> triangles_from(const py::handle& faces, std::size_t vertic
 
 void bind_geometry(py::module_& m)
 {
-    py::class_<PointCloud, std::shared_ptr<PointCloud>>(
+    py::class_<Cloud, std::shared_ptr<Cloud>>(
         m, "PointCloud",
         "Level 1 or 2 samples: N positions (float32, relative to `origin`) with optional "
-        "normals, colors and influence radii. Immutable; its arrays are read-only views of the "
-        "library's storage, alive as long as any of them or the cloud is.")
+        "normals, colors and influence radii. Immutable; its arrays are read-only views of its "
+        "storage (the library's, or the numpy arrays it was made from), alive as long as any of "
+        "them or the cloud is.")
         .def(py::init([](const py::object& positions, const py::object& normals,
                          const py::object& colors, const py::object& radii,
                          const py::object& origin) {
@@ -390,50 +458,56 @@ void bind_geometry(py::module_& m)
              "finite. Without `origin`, float32 positions are taken as they are (origin 0) and "
              "other dtypes are re-centred on their first point rounded to whole units, as the "
              "file readers do, so that large (georeferenced) coordinates keep their precision. "
-             "With `origin` (3 numbers), positions are relative to it.\n"
+             "With `origin` (3 numbers), positions are stored relative to it.\n"
              "normals: N by 3 real; colors: N by 3 integers 0-255; radii: N positive reals.\n"
-             "The arrays are copied once into the library's storage (a float32 C-contiguous "
-             "array by one memcpy, other dtypes converted element by element).\n"
+             "Arrays already in the library's layout are used in place, without a copy: float32 "
+             "positions (origin 0) and normals, uint8 colors and float32 radii, C-contiguous. The "
+             "cloud keeps them alive and reads them in every later call, so change them only by "
+             "making a new PointCloud. Other dtypes and orders are converted once into the "
+             "cloud's own storage.\n"
              "Raises InvalidInput (a ValueError) for wrong shapes or dtypes, empty positions, "
              "non-finite values or out-of-range colors and radii.")
         .def_property_readonly(
             "positions",
             [](py::object self) {
-                return rows3_view<float>(self.cast<const PointCloud&>().positions, self);
+                return rows3_view<float>(self.cast<const Cloud&>().view.positions, self);
             },
             "N by 3 float32, relative to `origin` (read-only view).")
         .def_property_readonly(
             "normals",
             [](py::object self) {
-                return optional_rows3f(self.cast<const PointCloud&>().normals, self);
+                return optional_rows3f(self.cast<const Cloud&>().view.normals, self);
             },
             "N by 3 float32 unit normals, or None (read-only view).")
         .def_property_readonly(
             "colors",
             [](py::object self) {
-                return optional_colors(self.cast<const PointCloud&>().colors, self);
+                return optional_colors(self.cast<const Cloud&>().view.colors, self);
             },
             "N by 3 uint8 colors, or None (read-only view).")
         .def_property_readonly(
             "radii",
             [](py::object self) {
-                return optional_radii(self.cast<const PointCloud&>().radii, self);
+                return optional_radii(self.cast<const Cloud&>().view.radii, self);
             },
             "N float32 influence radii in world units, or None (read-only view).")
         .def_property_readonly(
             "origin",
             [](py::object self) {
-                return readonly_view(self.cast<const PointCloud&>().origin.data(), {3}, self);
+                return readonly_view(self.cast<const Cloud&>().view.origin.data(), {3}, self);
             },
             "float64 3-vector: world position = origin + position (read-only view).")
         .def(
-            "world", [](const PointCloud& c) { return world_positions(c); },
+            "world", [](const Cloud& c) { return world_positions(c.view); },
             "world() -> N by 3 float64 array of world positions (origin + positions), a new "
             "array.")
-        .def("bounds", &bounds_tuple,
-             "bounds() -> (min, max): the bounding box in world units, two float64 3-vectors.")
-        .def("__len__", &PointCloud::size, "Number of points.")
-        .def("__repr__", [](const PointCloud& c) {
+        .def(
+            "bounds", [](const Cloud& c) { return bounds_tuple(c.view); },
+            "bounds() -> (min, max): the bounding box in world units, two float64 3-vectors.")
+        .def(
+            "__len__", [](const Cloud& c) { return c.view.size(); }, "Number of points.")
+        .def("__repr__", [](const Cloud& cloud) {
+            const PointCloudView& c = cloud.view;
             std::string attributes;
             if (c.has_normals())
                 attributes += ", normals";
@@ -454,7 +528,9 @@ void bind_geometry(py::module_& m)
                          const py::object& normals, const py::object& colors,
                          const py::object& origin) {
                  TriMesh mesh;
-                 mesh.vertices = make_cloud(vertices, normals, colors, py::none(), origin);
+                 // The library's TriMesh owns its vertices: converted once, never borrowed.
+                 mesh.vertices = std::move(
+                     make_cloud(vertices, normals, colors, py::none(), origin, false)->owned);
                  mesh.triangles = triangles_from(faces, mesh.vertices.size());
                  return mesh;
              }),
@@ -500,7 +576,7 @@ void bind_geometry(py::module_& m)
             "world", [](const TriMesh& mesh) { return world_positions(mesh.vertices); },
             "world() -> N by 3 float64 array of world vertex positions, a new array.")
         .def(
-            "points", [](const TriMesh& mesh) { return mesh.vertices; },
+            "points", [](const TriMesh& mesh) { return owned_cloud(mesh.vertices); },
             "points() -> PointCloud: the vertices and their attributes (a copy).")
         .def(
             "bounds", [](const TriMesh& mesh) { return bounds_tuple(mesh.vertices); },

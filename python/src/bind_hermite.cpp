@@ -16,13 +16,13 @@ void bind_hermite(py::module_& m)
 
     m.def(
         "surfels",
-        [](const std::shared_ptr<PointCloud>& cloud, std::size_t k, double radius_scale,
+        [](const std::shared_ptr<Cloud>& cloud, std::size_t k, double radius_scale,
            bool reestimate) {
             SurfelsFromSamples result = run_interruptible([&](const ProgressCallback& progress) {
-                return surfels_from_samples(*cloud, {.k = k,
-                                                     .radius_scale = radius_scale,
-                                                     .reestimate = reestimate,
-                                                     .progress = progress});
+                return surfels_from_samples(cloud->view, {.k = k,
+                                                          .radius_scale = radius_scale,
+                                                          .reestimate = reestimate,
+                                                          .progress = progress});
             });
             py::dict report;
             report["estimated_normals"] = result.estimated_normals;
@@ -31,7 +31,7 @@ void bind_hermite(py::module_& m)
             report["flipped"] = result.flipped;
             report["degenerate"] = result.degenerate;
             report["unoriented"] = result.unoriented;
-            return py::make_tuple(std::make_shared<PointCloud>(std::move(result.surfels)), report);
+            return py::make_tuple(owned_cloud(std::move(result.surfels)), report);
         },
         py::arg("cloud"), py::kw_only(), py::arg("k") = default_neighbors,
         py::arg("radius_scale") = default_field_radius_scale, py::arg("reestimate") = false,
@@ -60,7 +60,7 @@ void bind_hermite(py::module_& m)
             py::dict report;
             report["vertex_surfels"] = result.vertex_surfels;
             report["area_surfels"] = result.area_surfels;
-            return py::make_tuple(std::make_shared<PointCloud>(std::move(result.surfels)), report);
+            return py::make_tuple(owned_cloud(std::move(result.surfels)), report);
         },
         py::arg("mesh"), py::kw_only(), py::arg("samples") = 0,
         py::arg("seed") = SurfelsFromMeshOptions{}.seed, py::arg("k") = default_neighbors,

@@ -64,13 +64,15 @@ void bind_implicit(py::module_& m)
         "the surface. Field(surfels) is the point field of oriented surfels (paper §4); "
         "pointform.scene() makes one from the modeling language. Immutable and safe to "
         "evaluate from many threads.")
-        .def(py::init([](const std::shared_ptr<PointCloud>& surfels, const std::string& fit,
+        .def(py::init([](const std::shared_ptr<Cloud>& surfels, const std::string& fit,
                          bool far_grid) {
                  PointFieldOptions options{.fit = parse_plane_fit(fit), .far_grid = far_grid};
                  std::shared_ptr<const PointField> field;
                  {
                      py::gil_scoped_release release;
-                     field = std::make_shared<const PointField>(*surfels, options);
+                     // The field keeps its own copy (it normalizes the normals).
+                     field =
+                         std::make_shared<const PointField>(to_point_cloud(surfels->view), options);
                  }
                  return FieldHandle{field, field, "point field (" + fit + ")"};
              }),

@@ -26,7 +26,7 @@ void bind_io(py::module_& m)
                 read = read_geometry(path);
             }
             if (read.triangles.empty())
-                return py::cast(std::make_shared<PointCloud>(std::move(read.points)));
+                return py::cast(owned_cloud(std::move(read.points)));
             auto mesh = std::make_shared<TriMesh>();
             mesh->vertices = std::move(read.points);
             mesh->triangles = std::move(read.triangles);
@@ -50,8 +50,12 @@ void bind_io(py::module_& m)
     m.def(
         "read_points",
         [](const std::filesystem::path& path) {
-            py::gil_scoped_release release;
-            return std::make_shared<PointCloud>(read_point_cloud(path));
+            PointCloud cloud;
+            {
+                py::gil_scoped_release release;
+                cloud = read_point_cloud(path);
+            }
+            return owned_cloud(std::move(cloud));
         },
         py::arg("path"),
         "read_points(path) -> PointCloud\n\nReads the points of any supported file (a mesh "
@@ -60,11 +64,11 @@ void bind_io(py::module_& m)
         "write",
         [](const std::filesystem::path& path, const py::object& shape, bool ascii) {
             const WriteOptions options{.ascii = ascii};
-            if (py::isinstance<PointCloud>(shape))
+            if (py::isinstance<Cloud>(shape))
             {
-                const auto cloud = shape.cast<std::shared_ptr<PointCloud>>();
+                const auto cloud = shape.cast<std::shared_ptr<Cloud>>();
                 py::gil_scoped_release release;
-                write_point_cloud(path, *cloud, options);
+                write_point_cloud(path, cloud->view, options);
             }
             else if (py::isinstance<TriMesh>(shape))
             {

@@ -18,11 +18,14 @@ namespace pointform::python {
 namespace {
 
 /// A shape to compare and how Python named it: a file (read as `pointform distance` reads it:
-/// a mesh if it has faces, else a point set), a PointCloud or a Mesh.
+/// a mesh if it has faces, else a point set), a PointCloud (measured in place) or a Mesh.
 struct Shape
 {
     std::shared_ptr<const TriMesh> mesh;
+    std::shared_ptr<const Cloud> cloud;
     py::object file = py::none();
+
+    [[nodiscard]] ShapeRef ref() const { return mesh ? ShapeRef(*mesh) : ShapeRef(cloud->view); }
 };
 
 /// Turns a path, PointCloud or Mesh into a shape; a file is read with the GIL released.
@@ -31,12 +34,8 @@ Shape shape_from(const py::object& object, const char* name)
     Shape shape;
     if (py::isinstance<TriMesh>(object))
         shape.mesh = object.cast<std::shared_ptr<TriMesh>>();
-    else if (py::isinstance<PointCloud>(object))
-    {
-        auto mesh = std::make_shared<TriMesh>();
-        mesh->vertices = object.cast<const PointCloud&>();
-        shape.mesh = mesh;
-    }
+    else if (py::isinstance<Cloud>(object))
+        shape.cloud = object.cast<std::shared_ptr<Cloud>>();
     else if (py::isinstance<py::str>(object) || py::hasattr(object, "__fspath__"))
     {
         const std::string path =
@@ -56,19 +55,20 @@ Shape shape_from(const py::object& object, const char* name)
     else
         throw InvalidInput(std::string(name) + ": expected a path, PointCloud or Mesh, got " +
                            py::str(py::type::of(object)).cast<std::string>());
-    if (shape.mesh->vertex_count() == 0)
+    const ShapeRef ref = shape.ref();
+    if (ref.points.empty())
         throw InvalidInput(std::string(name) + ": the shape has no points");
-    if (shape.mesh->face_count() > 0 && !(surface_area(*shape.mesh) > 0.0))
+    if (ref.mesh != nullptr && !(surface_area(*ref.mesh) > 0.0))
         throw InvalidInput(std::string(name) + ": every triangle of the mesh has zero area");
     return shape;
 }
 
-std::size_t sample_count(const TriMesh& shape, std::size_t samples)
+std::size_t sample_count(const ShapeRef& shape, std::size_t samples)
 {
-    if (shape.face_count() == 0)
-        return shape.vertex_count();
-    std::vector<bool> used(shape.vertex_count(), false);
-    for (const auto& t : shape.triangles)
+    if (shape.mesh == nullptr)
+        return shape.points.size();
+    std::vector<bool> used(shape.mesh->vertex_count(), false);
+    for (const auto& t : shape.mesh->triangles)
         for (const auto v : t)
             used[v] = true;
     std::size_t count = samples;
@@ -94,11 +94,12 @@ py::dict summary_dict(const DistanceSummary& s)
 
 py::dict shape_dict(const Shape& shape, std::size_t samples)
 {
-    const TriMesh& mesh = *shape.mesh;
+    const ShapeRef ref = shape.ref();
+    const std::size_t faces = ref.mesh != nullptr ? ref.mesh->face_count() : 0;
     return py::dict(py::arg("file") = shape.file,
-                    py::arg("kind") = mesh.face_count() > 0 ? "mesh" : "points",
-                    py::arg("points") = mesh.vertex_count(), py::arg("faces") = mesh.face_count(),
-                    py::arg("samples") = sample_count(mesh, samples));
+                    py::arg("kind") = ref.mesh != nullptr ? "mesh" : "points",
+                    py::arg("points") = ref.points.size(), py::arg("faces") = faces,
+                    py::arg("samples") = sample_count(ref, samples));
 }
 
 } // namespace
@@ -116,7 +117,7 @@ void bind_metrics(py::module_& m)
             const auto sample_total = static_cast<std::size_t>(samples);
             const DistanceComparison result =
                 run_interruptible([&](const ProgressCallback& progress) {
-                    return compare(*shape_a.mesh, *shape_b.mesh,
+                    return compare(shape_a.ref(), shape_b.ref(),
                                    {.samples = sample_total,
                                     .seed = seed,
                                     .include_vertices = true,

@@ -349,7 +349,7 @@ void bind_polygonize(py::module_& m)
 
     m.def(
         "reconstruct",
-        [](const std::shared_ptr<PointCloud>& cloud, const std::optional<long long>& levels,
+        [](const std::shared_ptr<Cloud>& cloud, const std::optional<long long>& levels,
            const std::optional<long long>& base_faces, const std::string& stop_rule,
            const std::string& fit, int resolution, double cell,
            const std::optional<long long>& min_component_samples,
@@ -382,7 +382,7 @@ void bind_polygonize(py::module_& m)
             ReconstructReport report = run_interruptible([&](const ProgressCallback& progress) {
                 SurfelsFromSamplesOptions with_progress = surfel_options;
                 with_progress.progress = progress;
-                input = surfels_from_samples(*cloud, with_progress);
+                input = surfels_from_samples(cloud->view, with_progress);
                 options.progress = progress;
                 return reconstruct(std::move(input.surfels), options);
             });

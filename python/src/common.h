@@ -26,6 +26,7 @@
 #include <span>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 namespace pointform::python {
@@ -101,10 +102,12 @@ auto run_interruptible(Work&& work)
     }
 }
 
-/// \brief An N by 3 array of 3-vectors of T (Eigen vectors or std::array), as a view.
-template <class T, class V>
-py::array rows3_view(const std::vector<V>& rows, py::handle owner)
+/// \brief An N by 3 array of 3-vectors of T (Eigen vectors or std::array), as a view; `rows` is
+/// a contiguous range (std::vector or std::span).
+template <class T, class Rows>
+py::array rows3_view(const Rows& rows, py::handle owner)
 {
+    using V = std::remove_cvref_t<decltype(*rows.data())>;
     static_assert(sizeof(V) == 3 * sizeof(T), "rows must be three packed scalars");
     return readonly_view(reinterpret_cast<const T*>(rows.data()),
                          {static_cast<py::ssize_t>(rows.size()), 3}, owner);
@@ -132,9 +135,37 @@ Vec3d first_row(const py::handle& array, const char* name);
 /// \brief A numpy array (or anything numpy.asarray takes) as a py::array, without copying.
 py::array as_array(const py::handle& object, const char* name);
 
-/// \brief A point cloud from numpy arrays (the PointCloud constructor).
-PointCloud make_cloud(const py::handle& positions, const py::handle& normals,
-                      const py::handle& colors, const py::handle& radii, const py::handle& origin);
+/// \brief A point cloud as Python holds it (pointform.PointCloud): the arrays the library made
+/// or the bindings converted, owned here, and numpy arrays used in place, kept alive here.
+/// Library calls read `view`, which points into both; so a Cloud is made once, by make_shared,
+/// and never copied or moved. Its last reference must go with the GIL held (the numpy arrays).
+struct Cloud
+{
+    PointCloud owned;
+    std::vector<py::object> borrowed; ///< numpy arrays `view` reads in place
+    PointCloudView view;
+
+    explicit Cloud(PointCloud cloud) : owned(std::move(cloud)), view(owned) {}
+    Cloud(const Cloud&) = delete;
+    Cloud& operator=(const Cloud&) = delete;
+    Cloud(Cloud&&) = delete;
+    Cloud& operator=(Cloud&&) = delete;
+    ~Cloud() = default;
+};
+
+/// \brief A Cloud owning what the library made.
+inline std::shared_ptr<Cloud> owned_cloud(PointCloud cloud)
+{
+    return std::make_shared<Cloud>(std::move(cloud));
+}
+
+/// \brief A point cloud from numpy arrays (the PointCloud constructor): with `in_place`, arrays
+/// already in the library's layout (float32 positions and normals N by 3 C-contiguous with
+/// origin 0, uint8 colors N by 3 and float32 radii, contiguous) are checked and used in place;
+/// others are converted once into the cloud's own storage.
+std::shared_ptr<Cloud> make_cloud(const py::handle& positions, const py::handle& normals,
+                                  const py::handle& colors, const py::handle& radii,
+                                  const py::handle& origin, bool in_place = true);
 
 /// \brief Triangles from an F by 3 integer array, each index below `vertices`.
 std::vector<Triangle> triangles_from(const py::handle& faces, std::size_t vertices);

@@ -69,6 +69,54 @@ def test_arrays_are_read_only_views_tied_to_the_owner():
     assert np.array_equal(first, expected)  # the view keeps the cloud alive
 
 
+def test_arrays_in_the_library_layout_are_used_in_place():
+    p = np.ascontiguousarray(sphere_points(300), dtype=np.float32)
+    n = p.copy()
+    colors = np.arange(900, dtype=np.uint8).reshape(300, 3)
+    radii = np.full(300, 0.05, dtype=np.float32)
+    cloud = pointform.PointCloud(p, normals=n, colors=colors, radii=radii)
+    for given, held in ((p, cloud.positions), (n, cloud.normals), (colors, cloud.colors),
+                        (radii, cloud.radii)):
+        assert np.shares_memory(given, held)  # no copy
+        assert not held.flags.writeable
+    expected = p.copy()
+    del p, n, colors, radii
+    gc.collect()
+    assert np.array_equal(cloud.positions, expected)  # the cloud keeps the arrays alive
+
+
+def test_other_layouts_are_converted_not_shared():
+    p = sphere_points(300).astype(np.float32)
+    unaligned = np.frombuffer(b"\0" + p.tobytes(), dtype=np.float32, offset=1).reshape(300, 3)
+    for variant, origin in ((sphere_points(300), None), (np.asfortranarray(p), None),
+                            (p[::2], None), (unaligned, None), (p, np.ones(3))):
+        cloud = pointform.PointCloud(variant, origin=origin)
+        assert not np.shares_memory(variant, cloud.positions)
+    mesh = pointform.Mesh(p[:3].copy(), np.array([[0, 1, 2]]))
+    assert not np.shares_memory(p, mesh.vertices)  # a Mesh owns its vertices
+
+
+def test_in_place_and_converted_clouds_give_the_same_results():
+    p = np.ascontiguousarray(sphere_points(3000), dtype=np.float32)
+    in_place = pointform.PointCloud(p)
+    converted = pointform.PointCloud(np.asfortranarray(p))
+    assert np.shares_memory(p, in_place.positions)
+    assert not np.shares_memory(p, converted.positions)
+    a, report_a = pointform.surfels(in_place)
+    b, report_b = pointform.surfels(converted)
+    assert report_a == report_b
+    for x, y in ((a.positions, b.positions), (a.normals, b.normals), (a.radii, b.radii)):
+        assert np.array_equal(x, y)
+    # Surfels given in place (normals and radii float32 C order) make the same field.
+    normals, radii = np.array(a.normals), np.array(a.radii)
+    again = pointform.PointCloud(np.array(a.positions), normals=normals, radii=radii)
+    assert np.shares_memory(normals, again.normals) and np.shares_memory(radii, again.radii)
+    queries = sphere_points(50, radius=1.2)
+    assert np.array_equal(pointform.Field(a).evaluate(queries)[0],
+                          pointform.Field(again).evaluate(queries)[0])
+    assert pointform.distance(in_place, a) == pointform.distance(converted, b)
+
+
 def test_mesh():
     vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float32)
     faces = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]], dtype=np.int64)

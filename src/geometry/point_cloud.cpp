@@ -27,12 +27,23 @@ Aabb bounding_box(std::span<const Vec3f> positions, const Vec3d& origin)
     return box;
 }
 
+PointCloud to_point_cloud(const PointCloudView& view)
+{
+    PointCloud cloud;
+    cloud.origin = view.origin;
+    cloud.positions.assign(view.positions.begin(), view.positions.end());
+    cloud.normals.assign(view.normals.begin(), view.normals.end());
+    cloud.colors.assign(view.colors.begin(), view.colors.end());
+    cloud.radii.assign(view.radii.begin(), view.radii.end());
+    return cloud;
+}
+
 Vec3d choose_origin(const Vec3d& first)
 {
     return {std::round(first.x()), std::round(first.y()), std::round(first.z())};
 }
 
-void validate(const PointCloud& cloud)
+void validate(const PointCloudView& cloud)
 {
     const auto check = [&](std::size_t size, const char* name) {
         if (size != 0 && size != cloud.size())

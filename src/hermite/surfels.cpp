@@ -41,7 +41,7 @@ private:
 
 } // namespace
 
-void check_surfel_input(const PointCloud& cloud, std::size_t k)
+void check_surfel_input(const PointCloudView& cloud, std::size_t k)
 {
     validate(cloud);
     if (k < 3)
@@ -73,7 +73,7 @@ void check_surfel_input(const PointCloud& cloud, std::size_t k)
         throw InvalidInput("all points lie on one line: no surface normal is defined");
 }
 
-SurfelResult compute_surfels(const PointCloud& cloud, const SurfelOptions& options)
+SurfelResult compute_surfels(const PointCloudView& cloud, const SurfelOptions& options)
 {
     check_surfel_input(cloud, options.k);
     if (!(options.radius_scale > 0.0) || !std::isfinite(options.radius_scale))
@@ -139,8 +139,8 @@ SurfelResult compute_surfels(const PointCloud& cloud, const SurfelOptions& optio
 
     // Back to the input order.
     result.surfels.origin = cloud.origin;
-    result.surfels.positions = cloud.positions;
-    result.surfels.colors = cloud.colors;
+    result.surfels.positions.assign(cloud.positions.begin(), cloud.positions.end());
+    result.surfels.colors.assign(cloud.colors.begin(), cloud.colors.end());
     result.surfels.normals.resize(n);
     result.surfels.radii.resize(n);
     for (std::size_t j = 0; j < n; ++j)

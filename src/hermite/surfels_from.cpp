@@ -52,7 +52,7 @@ void check_radius_scale(double scale)
 }
 
 /// Automatic radii: the distance to the k-th neighbour times `scale`.
-std::vector<float> automatic_radii(const PointCloud& cloud, std::size_t k, double scale)
+std::vector<float> automatic_radii(const PointCloudView& cloud, std::size_t k, double scale)
 {
     const KdTree tree(cloud.positions);
     const KnnTable knn = knn_batch(tree, cloud.positions, k + 1);
@@ -61,19 +61,20 @@ std::vector<float> automatic_radii(const PointCloud& cloud, std::size_t k, doubl
 
 } // namespace
 
-SurfelsFromSamples surfels_from_samples(PointCloud samples,
+SurfelsFromSamples surfels_from_samples(const PointCloudView& samples,
                                         const SurfelsFromSamplesOptions& options)
 {
     check_radius_scale(options.radius_scale);
     SurfelsFromSamples out;
     if (!samples.has_normals() || options.reestimate)
     {
-        samples.normals.clear();
-        samples.radii.clear();
-        SurfelResult result = compute_surfels(samples, {.k = options.k,
-                                                        .radius_scale = options.radius_scale,
-                                                        .radius_regions = options.radius_regions,
-                                                        .progress = options.progress});
+        PointCloudView raw = samples;
+        raw.normals = {};
+        raw.radii = {};
+        SurfelResult result = compute_surfels(raw, {.k = options.k,
+                                                    .radius_scale = options.radius_scale,
+                                                    .radius_regions = options.radius_regions,
+                                                    .progress = options.progress});
         out.surfels = std::move(result.surfels);
         out.estimated_normals = true;
         out.estimated_radii = true;
@@ -85,20 +86,21 @@ SurfelsFromSamples surfels_from_samples(PointCloud samples,
         return out;
     }
     check_surfel_input(samples, options.k);
-    out.unoriented = drop_unoriented(samples);
-    if (samples.size() <= options.k)
+    out.surfels = to_point_cloud(samples);
+    out.unoriented = drop_unoriented(out.surfels);
+    PointCloud& surfels = out.surfels;
+    if (surfels.size() <= options.k)
         throw InvalidInput(std::to_string(out.unoriented) +
                            " samples have a zero or non-finite normal, and too few usable ones "
                            "are left; orient the samples (pointform normals) or estimate their "
                            "normals again (--reestimate)");
-    if (!samples.has_radii())
+    if (!surfels.has_radii())
     {
-        samples.radii = automatic_radii(samples, options.k, options.radius_scale);
-        samples.radii = apply_radius_regions(samples.positions, samples.origin,
-                                             std::move(samples.radii), options.radius_regions);
+        surfels.radii = automatic_radii(surfels, options.k, options.radius_scale);
+        surfels.radii = apply_radius_regions(surfels.positions, surfels.origin,
+                                             std::move(surfels.radii), options.radius_regions);
         out.estimated_radii = true;
     }
-    out.surfels = std::move(samples);
     return out;
 }
 

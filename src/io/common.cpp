@@ -124,7 +124,7 @@ void OutputBuffer::write_integer(std::uint64_t value)
     write(std::string_view(text, static_cast<std::size_t>(result.ptr - text)));
 }
 
-void write_world_text(OutputBuffer& out, const PointCloud& cloud, std::size_t i, int precision)
+void write_world_text(OutputBuffer& out, const PointCloudView& cloud, std::size_t i, int precision)
 {
     const Vec3f& p = cloud.positions[i];
     const bool exact_float = precision <= 0 && cloud.origin.isZero(0.0);

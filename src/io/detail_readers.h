@@ -479,7 +479,7 @@ private:
 
 /// Writes the world position of point i as "x y z" text: float shortest when the origin is zero
 /// and no precision is asked, else the double world value.
-void write_world_text(OutputBuffer& out, const PointCloud& cloud, std::size_t i, int precision);
+void write_world_text(OutputBuffer& out, const PointCloudView& cloud, std::size_t i, int precision);
 
 /// Writes a triangle as the text face line "3 a b c" (OFF and ascii PLY).
 void write_triangle_text(OutputBuffer& out, const Triangle& t);
@@ -502,9 +502,9 @@ void write_triangle_text(OutputBuffer& out, const Triangle& t);
 /// is malformed, refers outside the output, or does not fill the output exactly.
 [[nodiscard]] bool lzf_decompress(std::string_view input, std::span<char> output);
 
-void write_ply(OutputBuffer& out, const PointCloud& cloud, std::span<const Triangle> triangles,
+void write_ply(OutputBuffer& out, const PointCloudView& cloud, std::span<const Triangle> triangles,
                bool ascii, int precision);
-void write_xyz(OutputBuffer& out, const PointCloud& cloud, int precision);
+void write_xyz(OutputBuffer& out, const PointCloudView& cloud, int precision);
 void write_off(OutputBuffer& out, const TriMesh& mesh, int precision);
 void write_obj(OutputBuffer& out, const TriMesh& mesh, int precision);
 

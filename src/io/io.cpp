@@ -194,7 +194,7 @@ TriMesh read_mesh(const std::filesystem::path& path, const ReadOptions& options)
     return {std::move(result.points), std::move(result.triangles)};
 }
 
-void write_point_cloud(const std::filesystem::path& path, const PointCloud& cloud,
+void write_point_cloud(const std::filesystem::path& path, const PointCloudView& cloud,
                        const WriteOptions& options)
 {
     validate(cloud);

@@ -655,7 +655,7 @@ ReadResult read_body(Source& source, const PlyHeader& header, NonFinitePolicy po
     return result;
 }
 
-void write_header(OutputBuffer& out, const PointCloud& cloud, std::size_t faces, bool ascii)
+void write_header(OutputBuffer& out, const PointCloudView& cloud, std::size_t faces, bool ascii)
 {
     const bool world_double = !cloud.origin.isZero(0.0);
     out.write("ply\nformat ");
@@ -706,7 +706,7 @@ ReadResult read_ply(const std::filesystem::path& path, std::string_view bytes,
     return result;
 }
 
-void write_ply(OutputBuffer& out, const PointCloud& cloud, std::span<const Triangle> triangles,
+void write_ply(OutputBuffer& out, const PointCloudView& cloud, std::span<const Triangle> triangles,
                bool ascii, int precision)
 {
     write_header(out, cloud, triangles.size(), ascii);

@@ -243,7 +243,7 @@ ReadResult read_text(const std::filesystem::path& path, std::string_view bytes,
     return result;
 }
 
-void write_xyz(OutputBuffer& out, const PointCloud& cloud, int precision)
+void write_xyz(OutputBuffer& out, const PointCloudView& cloud, int precision)
 {
     for (std::size_t i = 0; i < cloud.size(); ++i)
     {

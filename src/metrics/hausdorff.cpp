@@ -18,7 +18,7 @@ namespace {
 
 constexpr std::size_t query_block = 2048;
 
-void check_finite(const PointCloud& cloud, const char* what)
+void check_finite(const PointCloudView& cloud, const char* what)
 {
     if (!cloud.origin.allFinite())
         throw InvalidInput(std::string(what) + ": the origin is not finite");
@@ -38,33 +38,35 @@ double percentile(const std::vector<double>& sorted, double q)
     return sorted[lo] + t * (sorted[hi] - sorted[lo]);
 }
 
-/// The points a shape is measured by: a mesh's samples, or a point set itself.
-PointCloud samples_of(const TriMesh& shape, std::size_t count, std::uint64_t seed,
-                      bool include_vertices, const char* name)
+/// The points a shape is measured by: a surface's samples (made into `storage`), or a point set
+/// itself.
+PointCloudView samples_of(const ShapeRef& shape, std::size_t count, std::uint64_t seed,
+                          bool include_vertices, const char* name, PointCloud& storage)
 {
-    if (shape.vertex_count() == 0)
+    if (shape.points.empty())
         throw InvalidInput(std::string("compare: ") + name + " has no points");
-    if (shape.face_count() == 0)
+    if (shape.mesh == nullptr)
     {
-        check_finite(shape.vertices, name);
-        PointCloud points;
-        points.origin = shape.vertices.origin;
-        points.positions = shape.vertices.positions;
+        check_finite(shape.points, name);
+        PointCloudView points;
+        points.origin = shape.points.origin;
+        points.positions = shape.points.positions;
         return points;
     }
     if (count == 0 && !include_vertices)
         throw InvalidInput(std::string("compare: ") + name +
                            " is a mesh and would get no samples (0 samples, no vertices)");
-    return sample_surface(shape,
-                          {.count = count, .seed = seed, .include_vertices = include_vertices});
+    storage = sample_surface(*shape.mesh,
+                             {.count = count, .seed = seed, .include_vertices = include_vertices});
+    return storage;
 }
 
-std::vector<double> distances_to_shape(const PointCloud& points, const TriMesh& shape,
+std::vector<double> distances_to_shape(const PointCloudView& points, const ShapeRef& shape,
                                        const ProgressCallback& progress)
 {
-    if (shape.face_count() > 0)
-        return distances_to_mesh(points, shape, {.progress = progress});
-    return distances_to_points(points, shape.vertices, {.progress = progress});
+    if (shape.mesh != nullptr)
+        return distances_to_mesh(points, *shape.mesh, {.progress = progress});
+    return distances_to_points(points, shape.points, {.progress = progress});
 }
 
 DistanceSummary summary_of(const std::vector<double>& a_to_b, const std::vector<double>& b_to_a)
@@ -84,7 +86,7 @@ DistanceSummary summary_of(const std::vector<double>& a_to_b, const std::vector<
 
 } // namespace
 
-std::vector<double> distances_to_mesh(const PointCloud& points, const TriMesh& mesh,
+std::vector<double> distances_to_mesh(const PointCloudView& points, const TriMesh& mesh,
                                       const DistanceOptions& options)
 {
     check_finite(points, "point-to-mesh distance");
@@ -93,7 +95,7 @@ std::vector<double> distances_to_mesh(const PointCloud& points, const TriMesh& m
     return distances_to_mesh(bvh, points, {.progress = options.progress});
 }
 
-std::vector<double> distances_to_points(const PointCloud& points, const PointCloud& targets,
+std::vector<double> distances_to_points(const PointCloudView& points, const PointCloudView& targets,
                                         const DistanceOptions& options)
 {
     if (targets.empty())
@@ -156,23 +158,26 @@ DistanceStats scaled(const DistanceStats& stats, double factor)
     return s;
 }
 
-DistanceComparison compare(const TriMesh& a, const TriMesh& b, const CompareOptions& options)
+DistanceComparison compare(const ShapeRef& a, const ShapeRef& b, const CompareOptions& options)
 {
     for (const double tau : options.fscore_thresholds)
         if (!(tau > 0.0 && std::isfinite(tau)))
             throw InvalidInput("F-score threshold must be positive and finite, got " +
                                std::to_string(tau));
-    const PointCloud samples_a =
-        samples_of(a, options.samples, options.seed, options.include_vertices, "A");
-    const PointCloud samples_b = samples_of(
-        b, options.samples, options.seed ^ 0x5851F42D4C957F2DULL, options.include_vertices, "B");
+    PointCloud storage_a;
+    PointCloud storage_b;
+    const PointCloudView samples_a =
+        samples_of(a, options.samples, options.seed, options.include_vertices, "A", storage_a);
+    const PointCloudView samples_b =
+        samples_of(b, options.samples, options.seed ^ 0x5851F42D4C957F2DULL,
+                   options.include_vertices, "B", storage_b);
     const std::vector<double> a_to_b = distances_to_shape(samples_a, b, options.progress);
     const std::vector<double> b_to_a = distances_to_shape(samples_b, a, options.progress);
 
     DistanceComparison result;
     result.absolute = summary_of(a_to_b, b_to_a);
-    Aabb box = a.vertices.bounds();
-    const Aabb box_b = b.vertices.bounds();
+    Aabb box = a.points.bounds();
+    const Aabb box_b = b.points.bounds();
     box.extend(box_b.min);
     box.extend(box_b.max);
     result.diagonal = box.diagonal();

@@ -15,7 +15,7 @@
 
 namespace pointform {
 
-SamplingDensity measure_sampling_density(const PointCloud& samples,
+SamplingDensity measure_sampling_density(const PointCloudView& samples,
                                          const ProgressCallback& progress)
 {
     if (samples.size() < 2)
@@ -62,7 +62,7 @@ SamplingDensity measure_sampling_density(const PointCloud& samples,
     return out;
 }
 
-double estimate_sampling_density(const PointCloud& samples)
+double estimate_sampling_density(const PointCloudView& samples)
 {
     return measure_sampling_density(samples).median;
 }

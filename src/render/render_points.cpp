@@ -21,7 +21,7 @@ namespace {
 constexpr std::uint32_t no_point = std::numeric_limits<std::uint32_t>::max();
 constexpr std::size_t band_rows = 16; // sample rows that one task of the splatter owns
 
-void check_cloud(const PointCloud& cloud)
+void check_cloud(const PointCloudView& cloud)
 {
     if (cloud.empty())
         throw InvalidInput("render_points: the point cloud is empty");
@@ -36,11 +36,11 @@ void check_cloud(const PointCloud& cloud)
 }
 
 /// Unit normals to shade by: the cloud's, estimated ones, or none (flat shading).
-std::vector<Vec3f> shading_normals(const PointCloud& cloud, const RenderOptions& options)
+std::vector<Vec3f> shading_normals(const PointCloudView& cloud, const RenderOptions& options)
 {
     std::vector<Vec3f> normals;
     if (cloud.has_normals())
-        normals = cloud.normals;
+        normals.assign(cloud.normals.begin(), cloud.normals.end());
     else if (options.estimate_normals)
     {
         try
@@ -61,7 +61,8 @@ std::vector<Vec3f> shading_normals(const PointCloud& cloud, const RenderOptions&
 }
 
 /// Disc radius of every point, in world (= local) units, scale included.
-std::vector<float> splat_radii(const PointCloud& cloud, const RenderOptions& options, double extent)
+std::vector<float> splat_radii(const PointCloudView& cloud, const RenderOptions& options,
+                               double extent)
 {
     const std::size_t n = cloud.size();
     const auto scale = static_cast<float>(options.splat_scale);
@@ -102,7 +103,7 @@ std::vector<float> splat_radii(const PointCloud& cloud, const RenderOptions& opt
 
 } // namespace
 
-Image render_points(const PointCloud& cloud, const RenderOptions& options)
+Image render_points(const PointCloudView& cloud, const RenderOptions& options)
 {
     validate(options);
     check_cloud(cloud);

@@ -655,7 +655,7 @@ std::vector<TriangleBvh::Hit> closest_points(const TriangleBvh& bvh, std::span<c
     return hits;
 }
 
-std::vector<double> distances_to_mesh(const TriangleBvh& bvh, const PointCloud& points,
+std::vector<double> distances_to_mesh(const TriangleBvh& bvh, const PointCloudView& points,
                                       const ClosestPointOptions& options)
 {
     std::vector<double> distances(points.size());

@@ -7,6 +7,7 @@
 #include "pointform/geometry/aabb.h"
 
 #include <cstddef>
+#include <span>
 #include <vector>
 
 namespace pointform {
@@ -36,6 +37,39 @@ struct PointCloud
     [[nodiscard]] Aabb bounds() const { return bounding_box(positions, origin); }
 };
 
+/// \brief A point cloud's arrays held elsewhere, read only: what the library's functions that
+/// only read samples take, so that a caller's own storage (a numpy array, a memory-mapped file)
+/// is used in place. A PointCloud converts to it implicitly; the arrays must outlive the view.
+struct PointCloudView
+{
+    Vec3d origin = Vec3d::Zero();
+    std::span<const Vec3f> positions; ///< N, relative to origin
+    std::span<const Vec3f> normals;   ///< empty or N
+    std::span<const Color> colors;    ///< empty or N
+    std::span<const float> radii;     ///< empty or N
+
+    PointCloudView() = default;
+    // NOLINTNEXTLINE(google-explicit-constructor): a cloud is its own view
+    PointCloudView(const PointCloud& cloud)
+        : origin(cloud.origin),
+          positions(cloud.positions),
+          normals(cloud.normals),
+          colors(cloud.colors),
+          radii(cloud.radii)
+    {}
+
+    [[nodiscard]] std::size_t size() const { return positions.size(); }
+    [[nodiscard]] bool empty() const { return positions.empty(); }
+    [[nodiscard]] bool has_normals() const { return !normals.empty(); }
+    [[nodiscard]] bool has_colors() const { return !colors.empty(); }
+    [[nodiscard]] bool has_radii() const { return !radii.empty(); }
+    [[nodiscard]] Vec3d world(std::size_t i) const { return origin + positions[i].cast<double>(); }
+    [[nodiscard]] Aabb bounds() const { return bounding_box(positions, origin); }
+};
+
+/// \brief A cloud that owns copies of the view's arrays.
+[[nodiscard]] PointCloud to_point_cloud(const PointCloudView& view);
+
 /// \brief Picks the float storage origin for a cloud whose first point is `first`: the point
 /// rounded to whole units, so that small models (within about ±0.5 unit of zero) keep origin 0
 /// and float inputs round-trip exactly, while georeferenced ones are re-centred.
@@ -43,6 +77,6 @@ struct PointCloud
 
 /// \brief Checks that every attribute array is empty or of the cloud's size.
 /// \throw InvalidInput naming the offending attribute.
-void validate(const PointCloud& cloud);
+void validate(const PointCloudView& cloud);
 
 } // namespace pointform

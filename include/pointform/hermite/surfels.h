@@ -68,12 +68,12 @@ struct SurfelResult
 /// \brief Checks that points can carry surfels: more than `k` points (k ≥ 3), all finite, not all
 /// coincident and not all on one line.
 /// \throw InvalidInput saying which condition fails
-void check_surfel_input(const PointCloud& cloud, std::size_t k);
+void check_surfel_input(const PointCloudView& cloud, std::size_t k);
 
 /// \brief Level 1 → 2 (§4): k nearest neighbours, PCA normals, consistent orientation and
 /// influence radii, for every sample, in parallel where it pays.
 /// \throw InvalidInput as check_surfel_input, or for non-positive radius_scale
-[[nodiscard]] SurfelResult compute_surfels(const PointCloud& cloud,
+[[nodiscard]] SurfelResult compute_surfels(const PointCloudView& cloud,
                                            const SurfelOptions& options = {});
 
 /// \brief Options of surfels_from_samples(): samples of any kind to the surfels of a field.
@@ -117,7 +117,7 @@ struct SurfelsFromSamples
 /// \throw InvalidInput as check_surfel_input(), for a radius_scale not positive and finite, or
 ///        when fewer than k + 1 samples with a usable normal are left
 [[nodiscard]] SurfelsFromSamples surfels_from_samples(
-    PointCloud samples, const SurfelsFromSamplesOptions& options = {});
+    const PointCloudView& samples, const SurfelsFromSamplesOptions& options = {});
 
 /// \brief Options of surfels_from_mesh().
 struct SurfelsFromMeshOptions

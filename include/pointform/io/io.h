@@ -53,7 +53,7 @@ struct ReadResult
 /// The file is written to a temporary name beside `path` and renamed when complete, so a
 /// failure never leaves a half-written file.
 /// \throw IoError if the format is not writable or the file cannot be written.
-void write_point_cloud(const std::filesystem::path& path, const PointCloud& cloud,
+void write_point_cloud(const std::filesystem::path& path, const PointCloudView& cloud,
                        const WriteOptions& options = {});
 
 /// \brief Writes a triangle mesh as PLY, OFF or OBJ, atomically like write_point_cloud.

@@ -29,7 +29,8 @@ struct DistanceOptions
 /// \return N distances, in the order of the points
 /// \throw InvalidInput if the mesh has no triangles, an index is out of range, or a coordinate is
 ///        not finite
-[[nodiscard]] std::vector<double> distances_to_mesh(const PointCloud& points, const TriMesh& mesh,
+[[nodiscard]] std::vector<double> distances_to_mesh(const PointCloudView& points,
+                                                    const TriMesh& mesh,
                                                     const DistanceOptions& options = {});
 
 /// \brief Distance from every point to the nearest point of `targets` (kd-tree), in parallel.
@@ -38,8 +39,8 @@ struct DistanceOptions
 /// distance to it is then computed exactly in double, in world units.
 /// \return points.size() distances, in the order of the points
 /// \throw InvalidInput if targets is empty or a coordinate is not finite
-[[nodiscard]] std::vector<double> distances_to_points(const PointCloud& points,
-                                                      const PointCloud& targets,
+[[nodiscard]] std::vector<double> distances_to_points(const PointCloudView& points,
+                                                      const PointCloudView& targets,
                                                       const DistanceOptions& options = {});
 
 /// \brief Summary of a set of distances (all in the same unit).
@@ -123,17 +124,31 @@ struct DistanceComparison
     std::vector<FScore> fscores;
 };
 
+/// \brief A shape compare() measures, held by the caller: a surface (a TriMesh with triangles)
+/// or a point set (a PointCloudView, or a TriMesh without triangles). Converts implicitly from
+/// both; what it refers to must outlive it.
+struct ShapeRef
+{
+    const TriMesh* mesh = nullptr; ///< the surface; null for a point set
+    PointCloudView points;         ///< the mesh's vertices, or the point set
+
+    // NOLINTNEXTLINE(google-explicit-constructor)
+    ShapeRef(const TriMesh& m) : mesh(m.face_count() > 0 ? &m : nullptr), points(m.vertices) {}
+    // NOLINTNEXTLINE(google-explicit-constructor)
+    ShapeRef(const PointCloudView& p) : points(p) {}
+};
+
 /// \brief Compares two shapes the way MeshLab's Metro does: samples both, measures each set of
 /// samples against the other shape, and reports one-sided and symmetric statistics.
 ///
-/// A shape is given as a TriMesh: with triangles it is a surface, sampled area-uniformly
-/// (options.samples random points plus, if include_vertices, its vertices) and measured against
-/// exactly (point-to-triangle, through a TriangleBvh); without triangles it is a point set,
-/// used as its own samples and measured against by nearest point (kd-tree).
+/// A surface is sampled area-uniformly (options.samples random points plus, if
+/// include_vertices, its vertices) and measured against exactly (point-to-triangle, through a
+/// TriangleBvh); a point set is used as its own samples, in place, and measured against by
+/// nearest point (kd-tree).
 /// \throw InvalidInput if a shape has no points, a mesh has zero area or a bad index, a
 ///        coordinate is not finite, a mesh would get no samples, or an F-score threshold is not
 ///        positive and finite
-[[nodiscard]] DistanceComparison compare(const TriMesh& a, const TriMesh& b,
+[[nodiscard]] DistanceComparison compare(const ShapeRef& a, const ShapeRef& b,
                                          const CompareOptions& options = {});
 
 } // namespace pointform

@@ -33,10 +33,10 @@ inline constexpr std::size_t max_sampling_density_queries = 100000;
 /// a sample's distance is to its nearest sample at a positive distance (among its 8 nearest).
 /// The result does not depend on the thread count.
 /// \throw InvalidInput if the cloud has fewer than 2 points, or all are coincident
-[[nodiscard]] SamplingDensity measure_sampling_density(const PointCloud& samples,
+[[nodiscard]] SamplingDensity measure_sampling_density(const PointCloudView& samples,
                                                        const ProgressCallback& progress = {});
 
 /// \brief measure_sampling_density(samples).median.
-[[nodiscard]] double estimate_sampling_density(const PointCloud& samples);
+[[nodiscard]] double estimate_sampling_density(const PointCloudView& samples);
 
 } // namespace pointform

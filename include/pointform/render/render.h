@@ -121,7 +121,7 @@ void validate(const RenderOptions& options);
 /// \throw InvalidInput if the cloud is empty, a position is not finite, an attribute array has
 ///        the wrong size, the options are invalid, or the supersampled image would exceed 2²⁸
 ///        samples (its depth buffer is 8 bytes a sample)
-[[nodiscard]] Image render_points(const PointCloud& cloud, const RenderOptions& options = {});
+[[nodiscard]] Image render_points(const PointCloudView& cloud, const RenderOptions& options = {});
 
 /// \brief Encodes an image as PNG (stb_image_write). \throw InvalidInput for an inconsistent
 /// image (size does not match width × height × 3, or a side ≤ 0).

@@ -126,7 +126,7 @@ private:
 /// parallel, in world units.
 /// \return points.size() distances, in the order of the points
 [[nodiscard]] std::vector<double> distances_to_mesh(const TriangleBvh& bvh,
-                                                    const PointCloud& points,
+                                                    const PointCloudView& points,
                                                     const ClosestPointOptions& options = {});
 
 /// \brief How many triangles' bounding boxes a random line through the mesh's bounding box
