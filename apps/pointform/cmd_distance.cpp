@@ -46,42 +46,11 @@ TriMesh read_shape(const std::string& path)
     return shape;
 }
 
-std::size_t sample_count(const TriMesh& shape, std::size_t samples)
-{
-    if (shape.face_count() == 0)
-        return shape.vertex_count();
-    std::vector<bool> used(shape.vertex_count(), false);
-    for (const auto& t : shape.triangles)
-        for (const auto v : t)
-            used[v] = true;
-    std::size_t count = samples;
-    for (const bool u : used)
-        count += u ? 1 : 0;
-    return count;
-}
-
-nlohmann::json stats_json(const DistanceStats& s)
-{
-    return {{"count", s.count}, {"min", s.min}, {"max", s.max}, {"mean", s.mean},
-            {"rms", s.rms},     {"p50", s.p50}, {"p90", s.p90}, {"p99", s.p99}};
-}
-
-nlohmann::json summary_json(const DistanceSummary& s)
-{
-    return {{"a_to_b", stats_json(s.a_to_b)},
-            {"b_to_a", stats_json(s.b_to_a)},
-            {"symmetric", stats_json(s.symmetric)},
-            {"hausdorff", s.hausdorff},
-            {"chamfer", s.chamfer}};
-}
-
 nlohmann::json shape_json(const std::string& file, const TriMesh& shape, std::size_t samples)
 {
-    return {{"file", file},
-            {"kind", shape.face_count() > 0 ? "mesh" : "points"},
-            {"points", shape.vertex_count()},
-            {"faces", shape.face_count()},
-            {"samples", sample_count(shape, samples)}};
+    nlohmann::json out = report_json(shape, samples);
+    out["file"] = file;
+    return out;
 }
 
 void print_table(const char* title, const DistanceSummary& s)
@@ -107,7 +76,7 @@ std::string shape_text(const TriMesh& shape, std::size_t samples)
         return "point set, " + std::to_string(shape.vertex_count()) + " points";
     return "mesh, " + std::to_string(shape.vertex_count()) + " vertices, " +
            std::to_string(shape.face_count()) + " faces, " +
-           std::to_string(sample_count(shape, samples)) + " samples";
+           std::to_string(compare_sample_count(shape, samples)) + " samples";
 }
 
 /// Bytes the comparison needs per sample of each mesh (its position, distance, closest-point
@@ -146,17 +115,7 @@ void run_distance(const DistanceCommandOptions& options, const GlobalOptions& gl
         out["b"] = shape_json(options.b, b, options.samples);
         out["samples_per_mesh"] = options.samples;
         out["seed"] = options.seed;
-        out["diagonal"] = result.diagonal;
-        out["absolute"] = summary_json(result.absolute);
-        out["relative_to_diagonal"] = summary_json(result.relative);
-        nlohmann::json scores = nlohmann::json::array();
-        for (const FScore& f : result.fscores)
-            scores.push_back({{"threshold", f.threshold},
-                              {"absolute_threshold", f.absolute_threshold},
-                              {"precision", f.precision},
-                              {"recall", f.recall},
-                              {"f", f.f}});
-        out["fscore"] = scores;
+        out.update(report_json(result));
         add_run_report(out, timings);
         std::printf("%s\n", out.dump(2).c_str());
         return;

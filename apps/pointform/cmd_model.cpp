@@ -107,7 +107,7 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
         if (semi)
         {
             out["marching_cubes_faces"] = result.mesh.face_count();
-            out["base_mesh"] = base_mesh_json(*semi->base);
+            out["base_mesh"] = report_json(*semi->base);
             nlohmann::json levels = nlohmann::json::array();
             for (const RefineLevelStats& level : semi->refinement.levels)
             {

@@ -47,47 +47,20 @@ void run_reconstruct(const ReconstructCommandOptions& options, const GlobalOptio
     const std::optional<BaseMeshStats> base_stats = report.semi_regular.base;
     const std::string fit(to_string(options.reconstruct.fit));
     const std::string& base_mesh = options.reconstruct.base_mesh.native();
+    nlohmann::json report_figures;
+    if (options.refine.json)
+    {
+        report_figures = report_json(report, reconstruct_options);
+        report_figures["estimated_normals"] = input.estimated_normals;
+        report_figures["surfels"] = report_json(input);
+    }
     const SemiRegularOutput run =
         write_and_measure(std::move(report.semi_regular), options.refine, options.output, timings);
     progress.clear();
     if (options.refine.json)
     {
-        nlohmann::json out = semi_regular_json(run, options.refine, options.input, options.output);
-        out["estimated_normals"] = input.estimated_normals;
-        out["fit"] = fit;
-        if (base_stats)
-        {
-            out["cell"] = report.cell;
-            out["intermediate_coarsening"] = report.coarsening;
-            out["intermediate_undefined_triangles"] = report.undefined_triangles;
-            out["intermediate_cell_vertices"] = report.cell_vertices;
-            out["intermediate_faces"] = report.intermediate_faces;
-            out["intermediate_vertices"] = report.intermediate_vertices;
-            out["degenerate_triangles"] = report.degenerate_triangles;
-            out["degenerate_kept"] = report.degenerate_kept;
-            out["debris"] = {{"components", report.debris.components},
-                             {"removed_components", report.debris.removed_components},
-                             {"removed_faces", report.debris.removed_faces},
-                             {"min_samples", report.debris.min_samples}};
-            out["base_mesh"] = base_mesh_json(*base_stats);
-            out["base_mesh"]["source"] = "automatic";
-        }
-        else
-        {
-            const PickedBaseMesh& picked = *report.picked;
-            nlohmann::json b;
-            b["source"] = base_mesh;
-            b["faces"] = picked.mesh.face_count();
-            b["vertices"] = picked.mesh.vertex_count();
-            b["reoriented_faces"] = picked.reoriented_faces;
-            b["max_snap_distance"] = picked.max_snap_distance;
-            b["min_angle_degrees"] = report.picked_angles.min_degrees;
-            b["share_below_20_degrees"] = report.picked_angles.sliver_share;
-            b["euler_characteristic"] = picked.topology.euler_characteristic;
-            b["boundary_loops"] = picked.topology.boundary_loops;
-            b["components"] = picked.topology.components;
-            out["base_mesh"] = b;
-        }
+        nlohmann::json out = semi_regular_json(std::move(report_figures), run, options.refine,
+                                               options.input, options.output);
         add_run_report(out, timings);
         std::printf("%s\n", out.dump(2).c_str());
         return;

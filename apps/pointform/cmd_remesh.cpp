@@ -50,18 +50,16 @@ void run_remesh(const RemeshCommandOptions& options, const GlobalOptions& global
         timings.add(stage, seconds);
     }
     const BaseMeshStats base = *report.semi_regular.base;
+    nlohmann::json report_figures;
+    if (options.refine.json)
+        report_figures = report_json(report, remesh_options);
     const SemiRegularOutput run =
         write_and_measure(std::move(report.semi_regular), options.refine, options.output, timings);
     progress.clear();
     if (options.refine.json)
     {
-        nlohmann::json out = semi_regular_json(run, options.refine, options.input, options.output);
-        out["input_faces"] = mesh.face_count();
-        out["input_vertices"] = mesh.vertex_count();
-        out["area_samples"] = report.area_surfels;
-        out["fit"] = std::string(to_string(options.remesh.fit));
-        out["base_mesh"] = base_mesh_json(base);
-        out["base_mesh"]["source"] = "automatic";
+        nlohmann::json out = semi_regular_json(std::move(report_figures), run, options.refine,
+                                               options.input, options.output);
         add_run_report(out, timings);
         std::printf("%s\n", out.dump(2).c_str());
         return;

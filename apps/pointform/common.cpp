@@ -93,13 +93,6 @@ Vec3d parse_vec3(const std::string& text, const std::string& what)
     return v;
 }
 
-std::string format_number(double value)
-{
-    char buffer[64];
-    std::snprintf(buffer, sizeof buffer, "%.6g", value);
-    return buffer;
-}
-
 std::string describe_degenerate(std::size_t degenerate, std::size_t kept)
 {
     return std::to_string(degenerate) + " (" + std::to_string(degenerate - kept) + " flipped, " +

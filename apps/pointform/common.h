@@ -5,6 +5,7 @@
 
 #include "pointform/core/progress.h"
 #include "pointform/core/types.h"
+#include "pointform/report/report_json.h" // format_number
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json_fwd.hpp>
@@ -75,9 +76,6 @@ void print_timings(const Timings& timings);
 
 /// \brief Parses "X,Y,Z" into a vector. \throw CLI::ValidationError on malformed input.
 [[nodiscard]] Vec3d parse_vec3(const std::string& text, const std::string& what);
-
-/// \brief Formats a number compactly for summaries (6 significant digits).
-[[nodiscard]] std::string format_number(double value);
 
 /// \brief Prints a one-line JSON-free summary row "label: value" aligned for humans.
 void print_row(const std::string& label, const std::string& value);

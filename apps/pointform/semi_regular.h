@@ -15,7 +15,7 @@
 #include "common.h"
 #include "options.h"
 
-#include <nlohmann/json_fwd.hpp>
+#include <nlohmann/json.hpp>
 
 #include <string>
 
@@ -40,12 +40,9 @@ struct SemiRegularOutput
                                                   const SemiRegularCommandOptions& options,
                                                   const std::string& output, Timings& timings);
 
-/// \brief Why the refinement stopped, in words.
-[[nodiscard]] std::string stop_reason(const SemiRegularReport& report);
-
-/// \brief The JSON report's shared part: the refinement (refinement_json), input, output, the
-/// hierarchy file if one was written, and the output's topology.
-[[nodiscard]] nlohmann::json semi_regular_json(const SemiRegularOutput& run,
+/// \brief The JSON report: the library's `report` (report_json()) with the input, the output,
+/// the hierarchy file if one was written, and the output's topology.
+[[nodiscard]] nlohmann::json semi_regular_json(nlohmann::json report, const SemiRegularOutput& run,
                                                const SemiRegularCommandOptions& options,
                                                const std::string& input, const std::string& output);
 
@@ -53,14 +50,9 @@ struct SemiRegularOutput
 /// the hierarchy file if one was written.
 void print_semi_regular(const SemiRegularOutput& run, const SemiRegularCommandOptions& options);
 
-/// JSON of the automatic base mesh's stats.
-[[nodiscard]] nlohmann::json base_mesh_json(const BaseMeshStats& stats);
 /// Prints the automatic base mesh's stats as rows.
 void print_base_mesh(const BaseMeshStats& stats);
 
-/// JSON of the refinement: sampling density, its definition, levels (0 = base), stop.
-[[nodiscard]] nlohmann::json refinement_json(const SemiRegularReport& report,
-                                             const SemiRegularOptions& options);
 /// Prints the sampling density, the per-level table and why refinement stopped.
 void print_refinement(const SemiRegularReport& report);
 

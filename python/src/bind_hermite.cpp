@@ -2,6 +2,7 @@
 // Copyright (c) 2026 the pointform authors
 
 #include "pointform/hermite/surfels.h"
+#include "pointform/report/report_json.h"
 
 #include "common.h"
 
@@ -24,14 +25,8 @@ void bind_hermite(py::module_& m)
                                                           .reestimate = reestimate,
                                                           .progress = progress});
             });
-            py::dict report;
-            report["estimated_normals"] = result.estimated_normals;
-            report["estimated_radii"] = result.estimated_radii;
-            report["components"] = result.components;
-            report["flipped"] = result.flipped;
-            report["degenerate"] = result.degenerate;
-            report["unoriented"] = result.unoriented;
-            return py::make_tuple(owned_cloud(std::move(result.surfels)), report);
+            return py::make_tuple(owned_cloud(std::move(result.surfels)),
+                                  to_python(report_json(result)));
         },
         py::arg("cloud"), py::kw_only(), py::arg("k") = default_neighbors,
         py::arg("radius_scale") = default_field_radius_scale, py::arg("reestimate") = false,

@@ -5,6 +5,7 @@
 #include "pointform/io/io.h"
 #include "pointform/metrics/hausdorff.h"
 #include "pointform/metrics/surface_sampling.h"
+#include "pointform/report/report_json.h"
 
 #include "common.h"
 
@@ -63,43 +64,12 @@ Shape shape_from(const py::object& object, const char* name)
     return shape;
 }
 
-std::size_t sample_count(const ShapeRef& shape, std::size_t samples)
-{
-    if (shape.mesh == nullptr)
-        return shape.points.size();
-    std::vector<bool> used(shape.mesh->vertex_count(), false);
-    for (const auto& t : shape.mesh->triangles)
-        for (const auto v : t)
-            used[v] = true;
-    std::size_t count = samples;
-    for (const bool u : used)
-        count += u ? 1 : 0;
-    return count;
-}
-
-py::dict stats_dict(const DistanceStats& s)
-{
-    return py::dict(py::arg("count") = s.count, py::arg("min") = s.min, py::arg("max") = s.max,
-                    py::arg("mean") = s.mean, py::arg("rms") = s.rms, py::arg("p50") = s.p50,
-                    py::arg("p90") = s.p90, py::arg("p99") = s.p99);
-}
-
-py::dict summary_dict(const DistanceSummary& s)
-{
-    return py::dict(py::arg("a_to_b") = stats_dict(s.a_to_b),
-                    py::arg("b_to_a") = stats_dict(s.b_to_a),
-                    py::arg("symmetric") = stats_dict(s.symmetric),
-                    py::arg("hausdorff") = s.hausdorff, py::arg("chamfer") = s.chamfer);
-}
-
 py::dict shape_dict(const Shape& shape, std::size_t samples)
 {
-    const ShapeRef ref = shape.ref();
-    const std::size_t faces = ref.mesh != nullptr ? ref.mesh->face_count() : 0;
-    return py::dict(py::arg("file") = shape.file,
-                    py::arg("kind") = ref.mesh != nullptr ? "mesh" : "points",
-                    py::arg("points") = ref.points.size(), py::arg("faces") = faces,
-                    py::arg("samples") = sample_count(ref, samples));
+    nlohmann::json out = report_json(shape.ref(), samples);
+    py::dict dict = to_python(out);
+    dict["file"] = shape.file;
+    return dict;
 }
 
 } // namespace
@@ -124,21 +94,11 @@ void bind_metrics(py::module_& m)
                                     .fscore_thresholds = fscore,
                                     .progress = progress});
                 });
-            py::dict out;
+            py::dict out = to_python(report_json(result));
             out["a"] = shape_dict(shape_a, sample_total);
             out["b"] = shape_dict(shape_b, sample_total);
             out["samples_per_mesh"] = sample_total;
             out["seed"] = seed;
-            out["diagonal"] = result.diagonal;
-            out["absolute"] = summary_dict(result.absolute);
-            out["relative_to_diagonal"] = summary_dict(result.relative);
-            py::list scores;
-            for (const FScore& f : result.fscores)
-                scores.append(py::dict(py::arg("threshold") = f.threshold,
-                                       py::arg("absolute_threshold") = f.absolute_threshold,
-                                       py::arg("precision") = f.precision,
-                                       py::arg("recall") = f.recall, py::arg("f") = f.f));
-            out["fscore"] = scores;
             return out;
         },
         py::arg("a"), py::arg("b"), py::kw_only(), py::arg("samples") = 100000, py::arg("seed") = 1,

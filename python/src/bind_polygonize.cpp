@@ -7,6 +7,7 @@
 #include "pointform/io/hierarchy.h"
 #include "pointform/polygonize/reconstruct.h"
 #include "pointform/polygonize/scene_mesh.h"
+#include "pointform/report/report_json.h"
 
 #include "common.h"
 
@@ -74,116 +75,11 @@ std::optional<std::size_t> optional_count(const std::optional<long long>& value,
     return non_negative(*value, name);
 }
 
-py::dict level_dict(const RefineLevelStats& s, double diagonal)
-{
-    py::dict out;
-    out["level"] = s.level;
-    out["faces"] = s.faces;
-    out["vertices"] = s.vertices;
-    out["new_vertices"] = s.new_vertices;
-    out["hausdorff"] = s.hausdorff.value_or(0.0);
-    out["hausdorff_relative"] = diagonal > 0.0 ? s.hausdorff.value_or(0.0) / diagonal : 0.0;
-    out["mean_distance"] = s.mean_distance.value_or(0.0);
-    out["robust_distance"] = s.robust_distance.value_or(0.0);
-    out["p90_distance"] = s.p90_distance.value_or(0.0);
-    if (s.next_detail)
-        out["next_detail"] = *s.next_detail;
-    out["fold_vertices"] = s.fold_vertices;
-    out["folds_fixed_by_ven"] = s.folds_fixed_by_ven;
-    out["folds_unresolved"] = s.folds_unresolved;
-    out["unprojected"] = s.unprojected;
-    out["relaxed"] = s.relaxed;
-    out["relax_undone"] = s.relax_undone;
-    out["folded_faces"] = s.folded_faces;
-    out["seconds"] = s.seconds;
-    return out;
-}
-
-py::dict base_mesh_dict(const BaseMeshStats& stats)
-{
-    py::dict out;
-    out["source"] = "automatic";
-    out["input_faces"] = stats.input_faces;
-    out["target_faces"] = stats.target_faces;
-    out["faces"] = stats.faces;
-    out["vertices"] = stats.vertices;
-    out["min_angle_degrees"] = stats.min_angle_degrees;
-    out["mean_min_angle_degrees"] = stats.mean_min_angle_degrees;
-    out["share_below_20_degrees"] = stats.share_below_20_degrees;
-    out["share_below_20_degrees_off_boundary"] = stats.share_below_20_degrees_off_boundary;
-    out["smoothing_rounds"] = stats.smoothing_rounds;
-    out["flips"] = stats.flips;
-    out["boundary_tolerance"] = stats.boundary_tolerance;
-    out["unprojected"] = stats.unprojected;
-    out["max_vertex_move"] = stats.max_vertex_move;
-    out["topology_kept"] = stats.topology_kept;
-    out["topology_change"] = stats.topology_change;
-    out["euler_characteristic"] = stats.topology_after.euler_characteristic;
-    out["boundary_loops"] = stats.topology_after.boundary_loops;
-    out["components"] = stats.topology_after.components;
-    out["seconds"] = stats.seconds;
-    return out;
-}
-
 py::dict seconds_dict(const std::vector<std::pair<std::string, double>>& stages)
 {
     py::dict out;
     for (const auto& [stage, seconds] : stages)
         out[py::str(stage)] = seconds;
-    return out;
-}
-
-/// The refinement's figures, with the keys of the CLI's JSON report (`--json`).
-py::dict semi_regular_dict(const SemiRegularReport& r)
-{
-    py::dict out;
-    out["samples"] = r.sample_count;
-    out["sampling_density"] = r.refinement.sampling_density;
-    out["diagonal"] = r.diagonal;
-    py::list levels;
-    py::dict base;
-    base["level"] = 0;
-    base["faces"] = r.hierarchy.face_count(0);
-    base["vertices"] = r.hierarchy.vertex_count(0);
-    base["hausdorff"] = r.refinement.initial_hausdorff;
-    base["hausdorff_relative"] =
-        r.diagonal > 0.0 ? r.refinement.initial_hausdorff / r.diagonal : 0.0;
-    base["mean_distance"] = r.refinement.initial_mean_distance;
-    base["robust_distance"] = r.refinement.initial_robust_distance;
-    base["p90_distance"] = r.refinement.initial_p90_distance;
-    if (r.refinement.stop_rule == StopRule::Automatic)
-        base["next_detail"] = r.refinement.initial_next_detail;
-    base["folds_fixed_by_ven"] = 0;
-    base["unprojected"] = r.base_unprojected;
-    base["seconds"] = r.base_seconds;
-    levels.append(base);
-    for (const RefineLevelStats& s : r.refinement.levels)
-        levels.append(level_dict(s, r.diagonal));
-    out["levels"] = levels;
-    out["dropped_level"] = r.refinement.dropped
-                               ? py::object(level_dict(*r.refinement.dropped, r.diagonal))
-                               : py::object(py::none());
-    out["finest_level"] = r.hierarchy.finest_level();
-    out["faces"] = r.hierarchy.face_count(r.hierarchy.finest_level());
-    out["vertices"] = r.hierarchy.vertex_count();
-    out["exact_levels"] = r.exact_levels;
-    out["level_cap"] = r.level_cap;
-    out["level_cap_from_memory"] = r.cap_from_memory;
-    out["stop"] =
-        r.exact_levels ? std::string("levels") : std::string(to_string(r.refinement.stop));
-    out["stop_rule"] =
-        r.exact_levels ? std::string("levels") : std::string(to_string(r.refinement.stop_rule));
-    if (!r.exact_levels && r.refinement.stop_rule == StopRule::Automatic)
-    {
-        out["vertex_budget"] = r.refinement.vertex_budget;
-        out["field_residual"] = r.refinement.field_residual;
-        out["detail_threshold"] = r.refinement.detail_threshold;
-    }
-    out["paper_rule_level"] = r.refinement.paper_level
-                                  ? py::object(py::int_(*r.refinement.paper_level))
-                                  : py::object(py::none());
-    if (r.base)
-        out["base_mesh"] = base_mesh_dict(*r.base);
     return out;
 }
 
@@ -386,40 +282,10 @@ void bind_polygonize(py::module_& m)
                 options.progress = progress;
                 return reconstruct(std::move(input.surfels), options);
             });
-            py::dict out = semi_regular_dict(report.semi_regular);
-            out["estimated_normals"] = input.estimated_normals;
-            out["surfels"] = py::dict(
-                py::arg("components") = input.components, py::arg("flipped") = input.flipped,
-                py::arg("degenerate") = input.degenerate, py::arg("unoriented") = input.unoriented);
-            out["fit"] = fit;
-            if (report.semi_regular.base)
-            {
-                out["cell"] = report.cell;
-                out["intermediate_coarsening"] = report.coarsening;
-                out["intermediate_undefined_triangles"] = report.undefined_triangles;
-                out["intermediate_cell_vertices"] = report.cell_vertices;
-                out["intermediate_faces"] = report.intermediate_faces;
-                out["intermediate_vertices"] = report.intermediate_vertices;
-                out["degenerate_triangles"] = report.degenerate_triangles;
-                out["degenerate_kept"] = report.degenerate_kept;
-                out["debris"] =
-                    py::dict(py::arg("components") = report.debris.components,
-                             py::arg("removed_components") = report.debris.removed_components,
-                             py::arg("removed_faces") = report.debris.removed_faces,
-                             py::arg("min_samples") = report.debris.min_samples);
-            }
-            else if (report.picked)
-            {
-                py::dict b;
-                b["source"] = options.base_mesh.string();
-                b["faces"] = report.picked->mesh.face_count();
-                b["vertices"] = report.picked->mesh.vertex_count();
-                b["reoriented_faces"] = report.picked->reoriented_faces;
-                b["max_snap_distance"] = report.picked->max_snap_distance;
-                b["min_angle_degrees"] = report.picked_angles.min_degrees;
-                b["share_below_20_degrees"] = report.picked_angles.sliver_share;
-                out["base_mesh"] = b;
-            }
+            nlohmann::json figures = report_json(report, options);
+            figures["estimated_normals"] = input.estimated_normals;
+            figures["surfels"] = report_json(input);
+            py::dict out = to_python(figures);
             out["stage_seconds"] = seconds_dict(report.stage_seconds);
             return std::make_shared<Hierarchy>(std::move(report.semi_regular.hierarchy), out);
         },
@@ -462,10 +328,7 @@ void bind_polygonize(py::module_& m)
                 options.progress = progress;
                 return remesh(*mesh, options);
             });
-            py::dict out = semi_regular_dict(report.semi_regular);
-            out["vertex_surfels"] = report.vertex_surfels;
-            out["area_surfels"] = report.area_surfels;
-            out["fit"] = fit;
+            py::dict out = to_python(report_json(report, options));
             out["stage_seconds"] = seconds_dict(report.stage_seconds);
             return std::make_shared<Hierarchy>(std::move(report.semi_regular.hierarchy), out);
         },

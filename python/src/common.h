@@ -14,6 +14,8 @@
 #include "pointform/geometry/point_cloud.h"
 #include "pointform/geometry/tri_mesh.h"
 
+#include <nlohmann/json.hpp>
+
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
@@ -166,6 +168,10 @@ inline std::shared_ptr<Cloud> owned_cloud(PointCloud cloud)
 std::shared_ptr<Cloud> make_cloud(const py::handle& positions, const py::handle& normals,
                                   const py::handle& colors, const py::handle& radii,
                                   const py::handle& origin, bool in_place = true);
+
+/// \brief A report of the library (report_json()) as Python objects: objects as dicts, arrays
+/// as lists, numbers, strings, booleans and None; the same figures the CLI's --json prints.
+py::object to_python(const nlohmann::json& value);
 
 /// \brief Triangles from an F by 3 integer array, each index below `vertices`.
 std::vector<Triangle> triangles_from(const py::handle& faces, std::size_t vertices);

@@ -97,6 +97,42 @@ void bind_errors(py::module_& m)
 
 } // namespace
 
+py::object to_python(const nlohmann::json& value)
+{
+    switch (value.type())
+    {
+        case nlohmann::json::value_t::object:
+        {
+            py::dict out;
+            for (const auto& [key, item] : value.items())
+                out[py::str(key)] = to_python(item);
+            return std::move(out);
+        }
+        case nlohmann::json::value_t::array:
+        {
+            py::list out;
+            for (const auto& item : value)
+                out.append(to_python(item));
+            return std::move(out);
+        }
+        case nlohmann::json::value_t::string:
+            return py::str(value.get_ref<const std::string&>());
+        case nlohmann::json::value_t::boolean:
+            return py::bool_(value.get<bool>());
+        case nlohmann::json::value_t::number_integer:
+            return py::int_(value.get<std::int64_t>());
+        case nlohmann::json::value_t::number_unsigned:
+            return py::int_(value.get<std::uint64_t>());
+        case nlohmann::json::value_t::number_float:
+            return py::float_(value.get<double>());
+        case nlohmann::json::value_t::null:
+        case nlohmann::json::value_t::binary:
+        case nlohmann::json::value_t::discarded:
+            break;
+    }
+    return py::none();
+}
+
 } // namespace pointform::python
 
 PYBIND11_MODULE(_pointform, m)

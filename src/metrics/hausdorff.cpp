@@ -206,4 +206,17 @@ DistanceComparison compare(const ShapeRef& a, const ShapeRef& b, const CompareOp
     return result;
 }
 
+std::size_t compare_sample_count(const ShapeRef& shape, std::size_t samples, bool include_vertices)
+{
+    if (shape.mesh == nullptr)
+        return shape.points.size();
+    if (!include_vertices)
+        return samples;
+    std::vector<bool> used(shape.mesh->vertex_count(), false);
+    for (const Triangle& t : shape.mesh->triangles)
+        for (const std::uint32_t v : t)
+            used[v] = true;
+    return samples + static_cast<std::size_t>(std::count(used.begin(), used.end(), true));
+}
+
 } // namespace pointform

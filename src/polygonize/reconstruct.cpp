@@ -308,6 +308,8 @@ RemeshReport remesh(const TriMesh& mesh, const RemeshOptions& options)
     check_semi_regular_options(options.semi_regular);
     check_remesh_input(mesh);
     RemeshReport report;
+    report.input_faces = mesh.face_count();
+    report.input_vertices = mesh.vertex_count();
     StageClock clock(report.stage_seconds);
     const std::size_t count =
         options.surfels.samples > 0 ? options.surfels.samples : mesh.vertex_count();

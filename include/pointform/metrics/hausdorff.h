@@ -151,4 +151,9 @@ struct ShapeRef
 [[nodiscard]] DistanceComparison compare(const ShapeRef& a, const ShapeRef& b,
                                          const CompareOptions& options = {});
 
+/// \brief How many points measure `shape` in compare(): a point set's points, or a mesh's
+/// `samples` area samples plus, with include_vertices, the vertices its triangles use.
+[[nodiscard]] std::size_t compare_sample_count(const ShapeRef& shape, std::size_t samples,
+                                               bool include_vertices = true);
+
 } // namespace pointform

@@ -212,6 +212,9 @@ struct RemeshOptions
 struct RemeshReport
 {
     SemiRegularReport semi_regular;
+    /// The input mesh's faces and vertices.
+    std::size_t input_faces = 0;
+    std::size_t input_vertices = 0;
     /// Surfels at the vertices and area-uniform ones (SurfelsFromMesh).
     std::size_t vertex_surfels = 0;
     std::size_t area_surfels = 0;
