@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -27,17 +28,6 @@ namespace {
 /// seed's upward orientation.
 constexpr double flux_decision_threshold = 0.1;
 
-/// An undirected edge of the Riemannian graph with its cost. The cost is a non-negative float, so
-/// its bit pattern orders like its value.
-struct WeightedEdge
-{
-    std::uint32_t cost_bits;
-    std::uint32_t a;
-    std::uint32_t b;
-
-    [[nodiscard]] float cost() const { return std::bit_cast<float>(cost_bits); }
-};
-
 /// Columns of the neighbour table that make the Riemannian graph (OrientationOptions::k).
 std::size_t graph_columns(const OrientationOptions& options, const KnnTable& neighbors)
 {
@@ -48,29 +38,6 @@ bool row_contains(const KnnTable& table, std::size_t row, std::size_t columns, s
 {
     const auto nbrs = table.neighbors(row).first(columns);
     return std::find(nbrs.begin(), nbrs.end(), value) != nbrs.end();
-}
-
-/// Stable LSD radix sort of edges by cost (three 11-bit digits): ties keep their order.
-void sort_by_cost(std::vector<WeightedEdge>& edges)
-{
-    constexpr unsigned digit_bits = 11;
-    constexpr std::size_t buckets = std::size_t{1} << digit_bits;
-    std::vector<WeightedEdge> buffer(edges.size());
-    std::vector<std::size_t> count(buckets);
-    for (unsigned shift = 0; shift < 32; shift += digit_bits)
-    {
-        std::fill(count.begin(), count.end(), 0);
-        for (const auto& e : edges)
-            ++count[(e.cost_bits >> shift) & (buckets - 1)];
-        if (count[(edges.front().cost_bits >> shift) & (buckets - 1)] == edges.size())
-            continue; // every key has this digit: the pass would not move anything
-        std::size_t sum = 0;
-        for (auto& c : count)
-            sum += std::exchange(c, sum);
-        for (const auto& e : edges)
-            buffer[count[(e.cost_bits >> shift) & (buckets - 1)]++] = e;
-        edges.swap(buffer);
-    }
 }
 
 bool usable(const Vec3f& n)
@@ -326,54 +293,147 @@ RiemannianForest riemannian_spanning_forest(std::span<const Vec3f> positions,
     ProgressReporter progress(options.progress, "orientation");
     const std::size_t columns = graph_columns(options, neighbors);
 
-    // 1. The Riemannian graph's edges, each once: {i, j} from row i unless row j lists i too and
-    //    j < i. Built in parallel blocks and concatenated in order (deterministic).
+    // 1. The Riemannian graph's edges, each once, in the neighbour table's layout: {i, j} is
+    //    edge (i, c) when j is column c of row i, unless row j lists i too and j < i. Its cost
+    //    is stored there (not_an_edge elsewhere); no edge list is built.
     constexpr std::size_t block = 8192;
-    std::vector<std::vector<WeightedEdge>> parts((n + block - 1) / block);
+    constexpr std::uint32_t not_an_edge = 0xFFFFFFFFU;
+    if (static_cast<double>(n) * static_cast<double>(columns) >= 0x1p33)
+        throw InvalidInput("orientation: too many points times graph neighbours (" +
+                           std::to_string(n) + " x " + std::to_string(columns) + ")");
+    std::vector<std::uint32_t> cost_bits(n * columns);
     parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
-        auto& part = parts[begin / block];
-        part.reserve((end - begin) * columns);
         for (std::size_t i = begin; i < end; ++i)
         {
             const auto a = static_cast<std::uint32_t>(i);
-            for (const std::uint32_t b : neighbors.neighbors(i).first(columns))
+            const auto row = neighbors.neighbors(i).first(columns);
+            for (std::size_t c = 0; c < columns; ++c)
             {
-                if (b == a || (b < a && row_contains(neighbors, b, columns, a)))
-                    continue;
-                const float cost = edge_cost(positions, normals, options.rule, a, b);
-                part.push_back({std::bit_cast<std::uint32_t>(cost), a, b});
+                const std::uint32_t b = row[c];
+                cost_bits[i * columns + c] =
+                    b == a || (b < a && row_contains(neighbors, b, columns, a))
+                        ? not_an_edge
+                        : std::bit_cast<std::uint32_t>(
+                              edge_cost(positions, normals, options.rule, a, b));
             }
         }
     });
-    std::vector<WeightedEdge> edges;
-    std::size_t total = 0;
-    for (const auto& part : parts)
-        total += part.size();
-    edges.reserve(total);
-    for (auto& part : parts)
-    {
-        edges.insert(edges.end(), part.begin(), part.end());
-        std::vector<WeightedEdge>().swap(part);
-    }
     progress.update(0.3, 1.0);
 
-    // 2. Kruskal: cheapest edges first, keep those that join two trees.
-    if (!edges.empty())
-        sort_by_cost(edges);
-    progress.update(0.6, 1.0);
+    // 2. Borůvka: each round, every component takes its cheapest edge to another component,
+    //    found in parallel by atomic minima of 64-bit keys (cost, then edge index: the order of
+    //    a stable sort of the edges by cost), so the forest is the one Kruskal's algorithm makes
+    //    with that order, whatever the thread count. Components at least halve every round.
+    //    Costs are in [0, 2], so their bits fit in 31 and the edge index gets the other 33.
+    constexpr std::uint64_t no_key = ~std::uint64_t{0};
+    const auto key_of = [](std::uint32_t bits, std::size_t edge) {
+        return (std::uint64_t{bits} << 33) | edge;
+    };
+    const auto edge_of = [](std::uint64_t key) {
+        return static_cast<std::size_t>(key & ((std::uint64_t{1} << 33) - 1));
+    };
+    const auto lower = [](std::uint64_t& slot, std::uint64_t key) {
+        std::atomic_ref<std::uint64_t> shared(slot);
+        std::uint64_t seen = shared.load(std::memory_order_relaxed);
+        while (key < seen && !shared.compare_exchange_weak(seen, key, std::memory_order_relaxed))
+        {}
+    };
     DisjointSets sets(n);
+    std::vector<std::uint32_t> label(n); // the component of each sample: a representative
+    std::iota(label.begin(), label.end(), 0U);
+    std::vector<std::uint32_t> alive(n); // the labels of this round's components
+    std::iota(alive.begin(), alive.end(), 0U);
+    std::vector<std::uint64_t> cheapest(n, no_key); // by label
+    std::vector<std::uint8_t> internal(n, 0);       // every edge of the row is inside one component
+    std::vector<std::uint64_t> tree_keys;
+    tree_keys.reserve(n);
+    for (bool merged = true; merged;)
+    {
+        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                if (internal[i] != 0)
+                    continue;
+                const std::uint32_t la = label[i];
+                const auto row = neighbors.neighbors(i).first(columns);
+                std::uint32_t* costs = cost_bits.data() + i * columns;
+                std::uint64_t own = no_key; // the row's cheapest edge out of la
+                bool leaves = false;
+                for (std::size_t c = 0; c < columns; ++c)
+                {
+                    if (costs[c] == not_an_edge)
+                        continue;
+                    const std::uint32_t lb = label[row[c]];
+                    if (lb == la)
+                    {
+                        costs[c] = not_an_edge; // inside a component from now on
+                        continue;
+                    }
+                    leaves = true;
+                    const std::uint64_t key = key_of(costs[c], i * columns + c);
+                    own = std::min(own, key);
+                    lower(cheapest[lb], key);
+                }
+                if (leaves)
+                    lower(cheapest[la], own);
+                else
+                    internal[i] = 1; // components only grow: it stays so
+            }
+        });
+        merged = false;
+        for (const std::uint32_t l : alive)
+        {
+            const std::uint64_t key = std::exchange(cheapest[l], no_key);
+            if (key == no_key)
+                continue;
+            const std::size_t edge = edge_of(key);
+            if (sets.unite(edge / columns, neighbors.neighbors(edge / columns)[edge % columns]))
+            {
+                tree_keys.push_back(key);
+                merged = true;
+            }
+        }
+        // Relabel: every component's new representative, then every sample.
+        std::vector<std::uint32_t> next;
+        for (const std::uint32_t l : alive)
+        {
+            const auto root = static_cast<std::uint32_t>(sets.find(l));
+            if (root == l)
+                next.push_back(l);
+            cheapest[l] = root; // borrowed as the relabelling map until the next round
+        }
+        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i)
+                label[i] = static_cast<std::uint32_t>(cheapest[label[i]]);
+        });
+        for (const std::uint32_t l : alive)
+            cheapest[l] = no_key;
+        alive.swap(next);
+    }
+    std::vector<std::uint32_t>().swap(cost_bits);
+    std::vector<std::uint32_t>().swap(label);
+    std::vector<std::uint32_t>().swap(alive);
+    std::vector<std::uint64_t>().swap(cheapest);
+    std::vector<std::uint8_t>().swap(internal);
+    progress.update(0.6, 1.0);
+
+    //    The tree edges in Kruskal's order: the costs summed and the trees walked as it would.
+    parallel_sort(tree_keys);
     std::vector<std::uint32_t> degree(n + 1, 0);
     std::vector<std::pair<std::uint32_t, std::uint32_t>> tree_edges;
-    tree_edges.reserve(n);
-    for (const auto& e : edges)
-        if (sets.unite(e.a, e.b))
-        {
-            tree_edges.emplace_back(e.a, e.b);
-            forest.total_cost += static_cast<double>(e.cost());
-            ++degree[e.a + 1];
-            ++degree[e.b + 1];
-        }
-    std::vector<WeightedEdge>().swap(edges);
+    tree_edges.reserve(tree_keys.size());
+    for (const std::uint64_t key : tree_keys)
+    {
+        const std::size_t edge = edge_of(key);
+        const auto a = static_cast<std::uint32_t>(edge / columns);
+        const std::uint32_t b = neighbors.neighbors(a)[edge % columns];
+        tree_edges.emplace_back(a, b);
+        forest.total_cost +=
+            static_cast<double>(std::bit_cast<float>(static_cast<std::uint32_t>(key >> 33)));
+        ++degree[a + 1];
+        ++degree[b + 1];
+    }
+    std::vector<std::uint64_t>().swap(tree_keys);
 
     // 3. Components numbered by smallest sample; root = highest sample with a usable normal.
     std::vector<std::uint32_t> label_of_set(n, RiemannianForest::none);

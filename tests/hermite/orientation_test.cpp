@@ -3,19 +3,23 @@
 
 #include "pointform/hermite/orientation.h"
 
+#include "pointform/core/disjoint_sets.h"
 #include "pointform/core/error.h"
 #include "pointform/geometry/shapes.h"
 #include "pointform/hermite/normals.h"
 #include "pointform/spatial/kd_tree.h"
 
 #include "support/test_support.h"
+#include "support/thread_counts.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <numeric>
 #include <set>
+#include <tuple>
 
 namespace pointform {
 namespace {
@@ -289,6 +293,71 @@ TEST(RiemannianForest, WeightMatchesBruteForceKruskal)
                 seen[v] = true;
             }
         }
+}
+
+/// The tree edges {parent, child} of a forest, each as (smaller, larger).
+std::set<std::pair<std::uint32_t, std::uint32_t>> tree_edges_of(const RiemannianForest& forest)
+{
+    std::set<std::pair<std::uint32_t, std::uint32_t>> edges;
+    for (std::uint32_t v = 0; v < forest.parent.size(); ++v)
+        if (forest.parent[v] != v && forest.parent[v] != RiemannianForest::none)
+            edges.emplace(std::min(v, forest.parent[v]), std::max(v, forest.parent[v]));
+    return edges;
+}
+
+TEST(RiemannianForest, IsKruskalsInTheTablesEdgeOrderWhateverTheThreadCount)
+{
+    // A flat grid (every PCA normal the same: every cost 0, so only the tie order decides) and a
+    // noisy torus, large enough for many parallel blocks.
+    PointCloud grid;
+    for (int y = 0; y < 150; ++y)
+        for (int x = 0; x < 150; ++x)
+            grid.positions.emplace_back(0.01F * static_cast<float>(x),
+                                        0.01F * static_cast<float>(y), 0.0F);
+    const PointCloud torus =
+        sample_shape(Shape::Torus, {.count = 30000, .seed = 4, .noise = 0.002});
+    for (const PointCloud* cloud : {static_cast<const PointCloud*>(&grid), &torus})
+    {
+        const Prepared p = prepare(*cloud, 11);
+        const std::size_t columns = 10;
+        // Kruskal over the edges in the table's order ({i, j} from row i unless row j lists i
+        // and j < i), stably sorted by the float cost.
+        const auto& n = p.normals.normals;
+        std::vector<std::tuple<float, std::size_t, std::uint32_t, std::uint32_t>> edges;
+        for (std::uint32_t i = 0; i < cloud->size(); ++i)
+        {
+            const auto row = p.table.neighbors(i).first(columns);
+            for (std::size_t c = 0; c < columns; ++c)
+            {
+                const std::uint32_t j = row[c];
+                const auto other = p.table.neighbors(j).first(columns);
+                if (j == i || (j < i && std::find(other.begin(), other.end(), i) != other.end()))
+                    continue;
+                const float cost = std::max(0.0F, 1.0F - std::abs(n[i].dot(n[j])));
+                edges.emplace_back(cost, edges.size(), i, j);
+            }
+        }
+        std::sort(edges.begin(), edges.end());
+        DisjointSets sets(cloud->size());
+        std::set<std::pair<std::uint32_t, std::uint32_t>> expected;
+        for (const auto& [cost, order, a, b] : edges)
+            if (sets.unite(a, b))
+                expected.emplace(std::min(a, b), std::max(a, b));
+
+        const auto forests = test::at_thread_counts(
+            [&] {
+                return riemannian_spanning_forest(cloud->positions, n, p.table, {.k = columns});
+            },
+            {.min_multi_block_loops = 2});
+        for (const RiemannianForest& forest : forests)
+        {
+            EXPECT_EQ(tree_edges_of(forest), expected);
+            EXPECT_EQ(forest.parent, forests[0].parent);
+            EXPECT_EQ(forest.order, forests[0].order);
+            EXPECT_EQ(std::bit_cast<std::uint64_t>(forest.total_cost),
+                      std::bit_cast<std::uint64_t>(forests[0].total_cost));
+        }
+    }
 }
 
 TEST(SimpleOrientations, TowardsAlongAndFlip)
