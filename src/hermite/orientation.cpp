@@ -698,7 +698,7 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
     for (std::size_t i = 0; i < n; ++i)
     {
         const std::uint32_t c = forest.component[i];
-        const double area = neighbors.distances2(i).back();
+        const double area = neighbors.farthest2(i);
         const Vec3d d = positions[i].cast<double>() - centroid[c];
         flux[c] += area * result.normals[i].cast<double>().dot(d);
         magnitude[c] += area * d.norm();

@@ -98,12 +98,11 @@ std::vector<float> influence_radii(const KnnTable& neighbors, double scale)
     if (!(scale > 0.0) || !std::isfinite(scale))
         throw InvalidInput("influence radius: scale must be positive and finite, got " +
                            std::to_string(scale));
-    check_same_size("influence_radii", "the neighbour table's squared_distances",
-                    neighbors.squared_distances.size(), neighbors.indices.size());
+    check_knn_table_shape(neighbors, neighbors.rows(), "influence_radii");
     std::vector<float> radii(neighbors.rows());
     for (std::size_t i = 0; i < radii.size(); ++i)
-        radii[i] = static_cast<float>(
-            scale * std::sqrt(static_cast<double>(neighbors.distances2(i).back())));
+        radii[i] =
+            static_cast<float>(scale * std::sqrt(static_cast<double>(neighbors.farthest2(i))));
     return radii;
 }
 

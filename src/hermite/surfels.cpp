@@ -92,10 +92,15 @@ SurfelResult compute_surfels(const PointCloudView& cloud, const SurfelOptions& o
     const std::span<const Vec3f> positions = sorted;
     timer.lap("spatial sort");
 
-    const KdTree tree(positions);
-    timer.lap("kd-tree");
-    const KnnTable table =
-        knn_batch(tree, positions, options.k + 1, {.progress = options.progress});
+    // Only the k-th distance is needed (radii, the orientation's flux); the tree goes once the
+    // table is made.
+    KnnTable table;
+    {
+        const KdTree tree(positions);
+        timer.lap("kd-tree");
+        table = knn_batch(tree, positions, options.k + 1,
+                          {.farthest_distance_only = true, .progress = options.progress});
+    }
     timer.lap("knn");
     Normals normals = estimate_normals(positions, table, options.progress);
     result.degenerate = normals.degenerate.size();

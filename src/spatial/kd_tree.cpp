@@ -140,8 +140,9 @@ void check_knn_table_shape(const KnnTable& table, std::size_t rows, const char* 
     if (table.rows() != rows)
         throw InvalidInput(name + ": neighbour table has " + std::to_string(table.rows()) +
                            " rows for " + std::to_string(rows) + " points");
-    check_same_size(function, "the neighbour table's squared_distances",
-                    table.squared_distances.size(), table.indices.size());
+    if (table.squared_distances.size() != table.rows() || table.k == 1)
+        check_same_size(function, "the neighbour table's squared_distances",
+                        table.squared_distances.size(), table.indices.size());
 }
 
 void check_knn_table(const KnnTable& table, std::size_t rows, std::size_t points,
@@ -265,14 +266,22 @@ KnnTable knn_batch(const KdTree& tree, std::span<const Vec3f> queries, std::size
     KnnTable table;
     table.k = k;
     table.indices.resize(queries.size() * k);
-    table.squared_distances.resize(queries.size() * k);
+    const bool all = !options.farthest_distance_only;
+    table.squared_distances.resize(all ? queries.size() * k : queries.size());
     ProgressReporter progress(options.progress, "k-nearest neighbours");
     parallel_blocks(
         queries.size(), query_block,
         [&](std::size_t begin, std::size_t end) {
+            std::vector<float> row(all ? 0 : k);
             for (std::size_t i = begin; i < end; ++i)
-                tree.knn(queries[i], k, {table.indices.data() + i * k, k},
-                         {table.squared_distances.data() + i * k, k});
+            {
+                const std::span<float> distances =
+                    all ? std::span<float>(table.squared_distances.data() + i * k, k)
+                        : std::span<float>(row);
+                tree.knn(queries[i], k, {table.indices.data() + i * k, k}, distances);
+                if (!all)
+                    table.squared_distances[i] = row[k - 1];
+            }
         },
         &progress);
     progress.finish();

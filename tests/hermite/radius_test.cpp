@@ -34,6 +34,9 @@ TEST(InfluenceRadii, DistanceToKthNeighbourTimesScale)
     const std::vector<float> radii = influence_radii(table, 1.5);
     const std::size_t interior = 10 * 20 + 10;
     EXPECT_NEAR(radii[interior], 1.5 * std::sqrt(2.0), 1e-6);
+    // The same from a table that keeps only the farthest distances.
+    EXPECT_EQ(influence_radii(knn_batch(tree, points, 9, {.farthest_distance_only = true}), 1.5),
+              radii);
     EXPECT_THROW((void)influence_radii(table, 0.0), InvalidInput);
     EXPECT_THROW((void)influence_radii(table, std::nan("")), InvalidInput);
 }

@@ -60,6 +60,28 @@ TEST(KdTree, KnnMatchesBruteForce)
     }
 }
 
+TEST(KdTree, FarthestDistanceOnlyKeepsTheKthOfEveryRow)
+{
+    const auto points = random_points(5000, 9);
+    const KdTree tree(points);
+    constexpr std::size_t k = 9;
+    const KnnTable all = knn_batch(tree, points, k);
+    const KnnTable farthest = knn_batch(tree, points, k, {.farthest_distance_only = true});
+    ASSERT_TRUE(all.has_all_distances());
+    ASSERT_FALSE(farthest.has_all_distances());
+    ASSERT_EQ(farthest.squared_distances.size(), points.size());
+    EXPECT_EQ(farthest.indices, all.indices);
+    for (std::size_t i = 0; i < points.size(); ++i)
+    {
+        ASSERT_EQ(farthest.farthest2(i), all.distances2(i).back());
+        ASSERT_EQ(all.farthest2(i), all.distances2(i).back());
+    }
+    EXPECT_NO_THROW(check_knn_table(farthest, points.size(), points.size(), "test"));
+    KnnTable odd = farthest;
+    odd.squared_distances.push_back(0.0F); // neither one a row nor one an index
+    EXPECT_THROW(check_knn_table(odd, points.size(), points.size(), "test"), InvalidInput);
+}
+
 TEST(KdTree, NearestWithinFactorWithAndWithoutAStart)
 {
     // Samples of a unit sphere; queries deep inside (where every sample is nearly as far) and

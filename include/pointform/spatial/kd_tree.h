@@ -25,6 +25,8 @@ struct KdTreeOptions
 /// \brief Options for batch queries.
 struct KnnOptions
 {
+    /// knn_batch(): keep only each row's farthest squared distance (KnnTable).
+    bool farthest_distance_only = false;
     /// Optional progress report, called from one thread.
     ProgressCallback progress;
 };

@@ -11,23 +11,36 @@
 namespace pointform {
 
 /// \brief k nearest neighbours of N query points as a flat N by k table (row i lists the
-/// neighbours of query i, nearest first) with the matching squared distances.
+/// neighbours of query i, nearest first) with the matching squared distances, or only each
+/// row's farthest one (KnnOptions::farthest_distance_only: 4 bytes a row instead of 4 k, for
+/// callers that need the k-th distance alone, such as the influence radius).
 struct KnnTable
 {
     KnnTable() = default; // not an aggregate: `{.k = 16}` means options, never a table
 
     std::size_t k = 0;
-    std::vector<std::uint32_t> indices;   ///< N*k, row-major
-    std::vector<float> squared_distances; ///< N*k, row-major, non-decreasing within a row
+    std::vector<std::uint32_t> indices; ///< N*k, row-major
+    /// N*k, row-major, non-decreasing within a row; or N, each row's farthest.
+    std::vector<float> squared_distances;
 
     [[nodiscard]] std::size_t rows() const { return k == 0 ? 0 : indices.size() / k; }
     [[nodiscard]] std::span<const std::uint32_t> neighbors(std::size_t i) const
     {
         return {indices.data() + i * k, k};
     }
+    /// \pre has_all_distances()
     [[nodiscard]] std::span<const float> distances2(std::size_t i) const
     {
         return {squared_distances.data() + i * k, k};
+    }
+    /// \brief The squared distance to row i's farthest (k-th) neighbour, in either layout.
+    [[nodiscard]] float farthest2(std::size_t i) const
+    {
+        return has_all_distances() ? squared_distances[i * k + k - 1] : squared_distances[i];
+    }
+    [[nodiscard]] bool has_all_distances() const
+    {
+        return squared_distances.size() == indices.size();
     }
 };
 
