@@ -90,7 +90,7 @@ def thread_scaling(args) -> int:
         write_points(raw, load_points(work / "with_normals.ply"))
         print(f"| command | samples | threads | wall s | peak MiB | bytes per sample | result |")
         print("|---|---|---|---|---|---|---|")
-        for command in ("normals", "reconstruct"):
+        for command in args.commands.split(","):
             for threads in counts:
                 out = work / f"{command}_{threads}.ply"
                 status, wall, peak, report = run_measured(
@@ -122,6 +122,8 @@ def main(argv=None) -> int:
                          "of the field: its cells would be larger than the influence radii)")
     ap.add_argument("--timeout", type=float, default=1800)
     ap.add_argument("--no-poisson", action="store_true", help="skip Open3D Poisson (slow)")
+    ap.add_argument("--commands", default="normals,reconstruct",
+                    help="with --scaling: the commands to time, comma-separated")
     ap.add_argument("--scaling", type=int, default=0, metavar="N",
                     help="only the thread-scaling table: normals and reconstruct of a clean "
                          "blobby of N samples at 1, 2, ... threads (up to the cores)")
