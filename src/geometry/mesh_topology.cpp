@@ -292,46 +292,30 @@ std::size_t split_nonmanifold_vertices(TriMesh& mesh)
 std::size_t keep_faces(TriMesh& mesh, std::span<const std::uint8_t> keep)
 {
     PF_ASSERT(keep.size() == mesh.face_count());
-    constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
-    const std::size_t nv = mesh.vertex_count();
-    std::vector<std::uint32_t> remap(nv, none);
+    std::vector<std::uint8_t> used(mesh.vertex_count(), 0);
     std::size_t kept = 0;
     for (std::size_t f = 0; f < mesh.face_count(); ++f)
         if (keep[f] != 0)
         {
             mesh.triangles[kept++] = mesh.triangles[f];
             for (const std::uint32_t v : mesh.triangles[f])
-                remap[v] = 0;
+                used[v] = 1;
         }
     const std::size_t removed = mesh.face_count() - kept;
     mesh.triangles.resize(kept);
     if (removed == 0)
         return 0;
-    PointCloud& vertices = mesh.vertices;
+    std::vector<std::uint32_t> remap(used.size()); // new index of each used vertex
     std::uint32_t next = 0;
-    for (std::size_t v = 0; v < nv; ++v)
-        if (remap[v] != none)
-        {
-            remap[v] = next;
-            vertices.positions[next] = vertices.positions[v];
-            if (!vertices.normals.empty())
-                vertices.normals[next] = vertices.normals[v];
-            if (!vertices.colors.empty())
-                vertices.colors[next] = vertices.colors[v];
-            if (!vertices.radii.empty())
-                vertices.radii[next] = vertices.radii[v];
-            ++next;
-        }
-    vertices.positions.resize(next);
-    if (!vertices.normals.empty())
-        vertices.normals.resize(next);
-    if (!vertices.colors.empty())
-        vertices.colors.resize(next);
-    if (!vertices.radii.empty())
-        vertices.radii.resize(next);
+    for (std::size_t v = 0; v < used.size(); ++v)
+    {
+        remap[v] = next;
+        next += used[v];
+    }
     for (Triangle& t : mesh.triangles)
         for (std::uint32_t& v : t)
             v = remap[v];
+    keep_points(mesh.vertices, used);
     return removed;
 }
 

@@ -38,6 +38,26 @@ PointCloud to_point_cloud(const PointCloudView& view)
     return cloud;
 }
 
+std::size_t keep_points(PointCloud& cloud, std::span<const std::uint8_t> keep)
+{
+    PF_ASSERT(keep.size() == cloud.size());
+    const auto compact = [&](auto& values) {
+        if (values.empty())
+            return;
+        std::size_t kept = 0;
+        for (std::size_t i = 0; i < keep.size(); ++i)
+            if (keep[i] != 0)
+                values[kept++] = values[i];
+        values.resize(kept);
+    };
+    const std::size_t before = cloud.size();
+    compact(cloud.positions);
+    compact(cloud.normals);
+    compact(cloud.colors);
+    compact(cloud.radii);
+    return before - cloud.size();
+}
+
 Vec3d choose_origin(const Vec3d& first)
 {
     return {std::round(first.x()), std::round(first.y()), std::round(first.z())};

@@ -21,28 +21,13 @@ namespace {
 /// \return how many were removed
 std::size_t drop_unoriented(PointCloud& cloud)
 {
-    std::size_t kept = 0;
+    std::vector<std::uint8_t> usable(cloud.size());
     for (std::size_t i = 0; i < cloud.size(); ++i)
     {
         const float norm = cloud.normals[i].norm();
-        if (!(norm > 0.5F) || !std::isfinite(norm))
-            continue;
-        cloud.positions[kept] = cloud.positions[i];
-        cloud.normals[kept] = cloud.normals[i];
-        if (cloud.has_colors())
-            cloud.colors[kept] = cloud.colors[i];
-        if (cloud.has_radii())
-            cloud.radii[kept] = cloud.radii[i];
-        ++kept;
+        usable[i] = norm > 0.5F && std::isfinite(norm) ? 1 : 0;
     }
-    const std::size_t dropped = cloud.size() - kept;
-    cloud.positions.resize(kept);
-    cloud.normals.resize(kept);
-    if (cloud.has_colors())
-        cloud.colors.resize(kept);
-    if (cloud.has_radii())
-        cloud.radii.resize(kept);
-    return dropped;
+    return keep_points(cloud, usable);
 }
 
 void check_radius_scale(double scale)
@@ -55,7 +40,7 @@ void check_radius_scale(double scale)
 std::vector<float> automatic_radii(const PointCloudView& cloud, std::size_t k, double scale)
 {
     const KdTree tree(cloud.positions);
-    const KnnTable knn = knn_batch(tree, cloud.positions, k + 1);
+    const KnnTable knn = knn_batch(tree, cloud.positions, k + 1, {.farthest_distance_only = true});
     return influence_radii(knn, scale);
 }
 

@@ -113,6 +113,30 @@ double solid_value(Shape shape, const Vec3d& p)
     return value;
 }
 
+TEST(PointCloud, KeepPointsKeepsEveryAttributeInOrder)
+{
+    PointCloud cloud;
+    for (int i = 0; i < 5; ++i)
+    {
+        const auto f = static_cast<float>(i);
+        cloud.positions.emplace_back(f, 0.0F, 0.0F);
+        cloud.normals.emplace_back(0.0F, f, 0.0F);
+        cloud.colors.push_back({static_cast<std::uint8_t>(i), 0, 0});
+    }
+    const std::vector<std::uint8_t> keep = {0, 1, 0, 1, 1};
+    EXPECT_EQ(keep_points(cloud, keep), 2U);
+    ASSERT_EQ(cloud.size(), 3U);
+    EXPECT_TRUE(cloud.radii.empty()); // absent attributes stay absent
+    const int kept[] = {1, 3, 4};
+    for (std::size_t i = 0; i < 3; ++i)
+    {
+        EXPECT_EQ(cloud.positions[i].x(), static_cast<float>(kept[i]));
+        EXPECT_EQ(cloud.normals[i].y(), static_cast<float>(kept[i]));
+        EXPECT_EQ(cloud.colors[i].r, kept[i]);
+    }
+    validate(cloud);
+}
+
 TEST(Shapes, BlobbyAndPartSamplesLieOnTheSolidsSurfaceWithOutwardNormals)
 {
     for (const Shape shape : {Shape::Blobby, Shape::Part})

@@ -7,6 +7,7 @@
 #include "pointform/geometry/aabb.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -69,6 +70,11 @@ struct PointCloudView
 
 /// \brief A cloud that owns copies of the view's arrays.
 [[nodiscard]] PointCloud to_point_cloud(const PointCloudView& view);
+
+/// \brief Keeps the points whose `keep[i]` is non-zero, in order, with every attribute.
+/// \pre keep.size() == cloud.size()
+/// \return the number of points removed
+std::size_t keep_points(PointCloud& cloud, std::span<const std::uint8_t> keep);
 
 /// \brief Picks the float storage origin for a cloud whose first point is `first`: the point
 /// rounded to whole units, so that small models (within about ±0.5 unit of zero) keep origin 0

@@ -95,9 +95,10 @@ struct RiemannianForest
 /// `neighbors`) and its minimum spanning forest by Borůvka's algorithm in parallel, over the
 /// table itself (no edge list: 4 bytes an edge for its cost), ties broken by edge order, so the
 /// forest is the one Kruskal's algorithm makes and does not depend on the thread count; one
-/// tree a component, each rooted at the component's highest sample with a usable normal. Edge costs
-/// (`options.rule`) depend only on the lines the normals span, not on their signs. \param positions
-/// N points \param normals    N normals (unit, or zero where undefined; zero ones are reached last)
+/// tree a component, each rooted at the component's highest sample with a usable normal. Edge
+/// costs (`options.rule`) depend only on the lines the normals span, not on their signs.
+/// \param positions  N points
+/// \param normals    N normals (unit, or zero where undefined; zero ones are reached last)
 /// \param neighbors  an N by k neighbour table of the points
 [[nodiscard]] RiemannianForest riemannian_spanning_forest(std::span<const Vec3f> positions,
                                                           std::span<const Vec3f> normals,
