@@ -5,6 +5,7 @@
 #include "pointform/geometry/mesh_topology.h"
 #include "pointform/io/hierarchy.h"
 #include "pointform/io/io.h"
+#include "pointform/multires/level_of_detail.h"
 
 #include "common.h"
 #include "output_transaction.h"
@@ -15,6 +16,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 
 namespace pointform::cli {
 namespace {
@@ -32,14 +34,21 @@ struct LodOptions
 /// The level asked for, or the finest; any other value is an error that lists the levels.
 std::size_t choose_level(const LodOptions& options, const MultiresMesh& mesh)
 {
-    const std::size_t finest = mesh.finest_level();
     if (!options.level_given)
-        return finest;
-    if (options.level < 0 || static_cast<unsigned long long>(options.level) > finest)
-        throw InvalidInput(
-            "level " + std::to_string(options.level) + " does not exist: " + options.input +
-            " has " + std::to_string(mesh.level_count()) +
-            (finest == 0 ? " level (level 0)" : " levels (0 to " + std::to_string(finest) + ")"));
+        return mesh.finest_level();
+    if (options.level < 0)
+        throw InvalidInput(options.input + ": level " + std::to_string(options.level) +
+                           " does not exist: the hierarchy has " +
+                           std::to_string(mesh.level_count()) + " levels (0 to " +
+                           std::to_string(mesh.finest_level()) + ")");
+    try
+    {
+        check_level(mesh, static_cast<std::size_t>(options.level));
+    }
+    catch (const InvalidInput& e)
+    {
+        throw InvalidInput(options.input + ": " + e.what());
+    }
     return static_cast<std::size_t>(options.level);
 }
 
@@ -54,8 +63,9 @@ void run_lod(const LodOptions& options, const GlobalOptions& global)
     MeshTopology topo;
     if (!options.output.empty())
     {
-        extracted = mesh.level_mesh(level);
-        topo = analyze_topology(*extracted);
+        LevelOfDetail lod = extract_level(mesh, level);
+        extracted = std::move(lod.mesh);
+        topo = lod.topology;
         timings.lap("extract");
         write_output(options.output, [&](const std::filesystem::path& path) {
             write_mesh(path, *extracted, {.ascii = options.ascii});

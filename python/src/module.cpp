@@ -106,14 +106,14 @@ py::object to_python(const nlohmann::json& value)
             py::dict out;
             for (const auto& [key, item] : value.items())
                 out[py::str(key)] = to_python(item);
-            return std::move(out);
+            return out;
         }
         case nlohmann::json::value_t::array:
         {
             py::list out;
             for (const auto& item : value)
                 out.append(to_python(item));
-            return std::move(out);
+            return out;
         }
         case nlohmann::json::value_t::string:
             return py::str(value.get_ref<const std::string&>());

@@ -140,6 +140,21 @@ std::vector<Triangle> split_faces(std::span<const Triangle> faces,
 
 } // namespace
 
+Predictor parse_predictor(std::string_view text)
+{
+    if (text == "midpoint")
+        return Predictor::Midpoint;
+    if (text == "butterfly")
+        return Predictor::Butterfly;
+    throw InvalidInput("unknown predictor '" + std::string(text) +
+                       "' (expected midpoint or butterfly)");
+}
+
+std::string_view to_string(Predictor predictor)
+{
+    return predictor == Predictor::Butterfly ? "butterfly" : "midpoint";
+}
+
 MultiresMesh::MultiresMesh(const TriMesh& base)
 {
     parts_.origin = base.vertices.origin;

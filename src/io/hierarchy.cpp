@@ -99,18 +99,24 @@ MultiresMesh decode(const std::filesystem::path& path, std::string_view bytes)
     }
     detail::ByteCursor cursor(path, bytes, magic.size());
     const auto version = cursor.read_le<std::uint32_t>("the format version");
-    if (version != hierarchy_format_version)
+    if (version != hierarchy_format_version && version != 1)
         fail(path,
              "pointform hierarchy format version " + std::to_string(version) +
-                 " is not supported (this build reads version " +
+                 " is not supported (this build reads versions 1 and " +
                  std::to_string(hierarchy_format_version) + ")",
              Location::at_byte(8));
     cursor.require(header_bytes - cursor.offset(), "the hierarchy header");
-    const auto flags = cursor.read_le<std::uint32_t>("the flags");
-    if (flags != 0)
-        fail(path, "corrupt hierarchy: unknown flags " + hex(flags) + " (version 1 has none)",
+    const auto word = cursor.read_le<std::uint32_t>(version == 1 ? "the flags" : "the predictor");
+    if (version == 1 && word != 0)
+        fail(path, "corrupt hierarchy: unknown flags " + hex(word) + " (version 1 has none)",
+             Location::at_byte(12));
+    if (version != 1 && word > 1)
+        fail(path,
+             "corrupt hierarchy: unknown predictor " + std::to_string(word) +
+                 " (0 midpoint, 1 butterfly)",
              Location::at_byte(12));
     MultiresParts parts;
+    parts.predictor = word == 1 && version != 1 ? Predictor::Butterfly : Predictor::Midpoint;
     for (int axis = 0; axis < 3; ++axis)
         parts.origin[axis] = cursor.read_le<double>("the origin");
     const std::uint64_t levels = cursor.read_le<std::uint32_t>("the level count");
@@ -188,7 +194,7 @@ void write_hierarchy(const std::filesystem::path& path, const MultiresMesh& mesh
     out.reserve(static_cast<std::size_t>(file_bytes(levels, vertices, base_faces, parent_edges)));
     out.append(magic_bytes());
     append_le(out, hierarchy_format_version);
-    append_le(out, std::uint32_t{0}); // flags
+    append_le(out, std::uint32_t{p.predictor == Predictor::Butterfly ? 1U : 0U});
     for (int axis = 0; axis < 3; ++axis)
         append_le(out, p.origin[axis]);
     append_le(out, levels);

@@ -5,6 +5,7 @@
 
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
+#include "pointform/geometry/level_topology.h"
 #include "pointform/polygonize/projection.h"
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/triangle_bvh.h"
@@ -25,189 +26,14 @@ namespace {
 constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
 constexpr std::size_t vertex_block = 512;
 
-/// Halfedge h = 3f + k of a level goes from corner k to corner k + 1 of face f.
-constexpr std::uint32_t next_of(std::uint32_t h)
-{
-    return h - h % 3 + (h % 3 + 1) % 3;
-}
-constexpr std::uint32_t prev_of(std::uint32_t h)
-{
-    return h - h % 3 + (h % 3 + 2) % 3;
-}
-
-/// The connectivity of level i and how level i + 1 splits it.
-struct Level
-{
-    std::vector<Triangle> faces;            ///< level i
-    std::vector<std::uint32_t> edge_vertex; ///< halfedge → vertex of level i + 1 on its edge
-    std::vector<std::uint32_t> twin;        ///< halfedge → opposite halfedge, or none
-    std::vector<std::array<std::uint32_t, 2>> halfedges; ///< new vertex j → its 1 or 2 halfedges
-    std::vector<std::uint32_t> outgoing; ///< vertex → an outgoing halfedge (a boundary one
-                                         ///< on the boundary), or none if unused
-    std::uint32_t first_new = 0;         ///< index of the first vertex of level i + 1
-
-    [[nodiscard]] std::uint32_t from(std::uint32_t h) const { return faces[h / 3][h % 3]; }
-    [[nodiscard]] std::uint32_t to(std::uint32_t h) const { return from(next_of(h)); }
-    /// The vertex of a face opposite halfedge h.
-    [[nodiscard]] std::uint32_t opposite(std::uint32_t h) const { return from(prev_of(h)); }
-
-    /// The 1-ring of v in counter-clockwise order, starting with the end of its outgoing
-    /// halfedge `start`; `closed` says whether v is interior. For a boundary vertex `start` must
-    /// be its boundary halfedge.
-    void ring(std::uint32_t start, std::vector<std::uint32_t>& out, bool& closed) const
-    {
-        out.clear();
-        std::uint32_t h = start;
-        closed = true;
-        for (std::size_t guard = 0; guard <= faces.size(); ++guard)
-        {
-            out.push_back(to(h));
-            const std::uint32_t p = prev_of(h);
-            if (twin[p] == none)
-            {
-                out.push_back(from(p));
-                closed = false;
-                return;
-            }
-            h = twin[p];
-            if (h == start)
-                return;
-        }
-    }
-};
-
-Level build_level(const MultiresMesh& mesh, MultiresMesh::SplitResult split)
-{
-    const std::size_t i = split.level - 1;
-    Level level;
-    level.faces = std::move(split.faces);
-    level.edge_vertex = std::move(split.edge_vertices);
-    level.first_new = static_cast<std::uint32_t>(mesh.level_offsets()[i + 1]);
-    const std::size_t added = mesh.vertex_count(i + 1) - level.first_new;
-    const auto halfedge_count = static_cast<std::uint32_t>(level.edge_vertex.size());
-    level.halfedges.assign(added, {none, none});
-    for (std::uint32_t h = 0; h < halfedge_count; ++h)
-    {
-        auto& slot = level.halfedges[level.edge_vertex[h] - level.first_new];
-        (slot[0] == none ? slot[0] : slot[1]) = h;
-    }
-    level.twin.assign(halfedge_count, none);
-    for (const auto& [h1, h2] : level.halfedges)
-        if (h2 != none)
-        {
-            level.twin[h1] = h2;
-            level.twin[h2] = h1;
-        }
-    level.outgoing.assign(mesh.vertex_count(i), none);
-    for (std::uint32_t h = 0; h < halfedge_count; ++h)
-    {
-        std::uint32_t& out = level.outgoing[level.from(h)];
-        if (out == none || level.twin[h] == none)
-            out = h;
-    }
-    return level;
-}
+using Level = LevelTopology;
+constexpr auto next_of = LevelTopology::next_of;
+constexpr auto prev_of = LevelTopology::prev_of;
 
 /// u × v of a triangle: twice its area times its unit normal.
 Vec3d area_normal(const Vec3d& a, const Vec3d& b, const Vec3d& c)
 {
     return (b - a).cross(c - b);
-}
-
-/// Weights of the modified butterfly's extraordinary-vertex stencil for valence n (Zorin et al.
-/// 1996): the centre gets 3/4, ring vertex j (j = 0 the other end of the edge) gets s[j].
-std::vector<double> extraordinary_weights(std::size_t n)
-{
-    std::vector<double> s(n, 0.0);
-    if (n == 3)
-        s = {5.0 / 12.0, -1.0 / 12.0, -1.0 / 12.0};
-    else if (n == 4)
-        s = {3.0 / 8.0, 0.0, -1.0 / 8.0, 0.0};
-    else
-        for (std::size_t j = 0; j < n; ++j)
-        {
-            const double t =
-                2.0 * std::numbers::pi * static_cast<double>(j) / static_cast<double>(n);
-            s[j] = (0.25 + std::cos(t) + 0.5 * std::cos(2.0 * t)) / static_cast<double>(n);
-        }
-    return s;
-}
-
-/// The butterfly prediction of the edge of halfedge h1 (h2 its twin or none).
-Vec3d butterfly(const Level& level, std::span<const Vec3d> x, std::uint32_t h1, std::uint32_t h2,
-                std::vector<std::uint32_t>& ring)
-{
-    const std::uint32_t a = level.from(h1);
-    const std::uint32_t b = level.to(h1);
-    const Vec3d midpoint = 0.5 * (x[a] + x[b]);
-    if (h2 == none)
-    {
-        // Boundary edge: the 4-point rule along the boundary.
-        // Previous boundary vertex before a: rotate clockwise around a to its incoming boundary
-        // halfedge; next after b: b's outgoing boundary halfedge.
-        const std::uint32_t out_b = level.outgoing[b];
-        if (out_b == none || level.twin[out_b] != none)
-            return midpoint;
-        const std::uint32_t next_vertex = level.to(out_b);
-        std::uint32_t h = prev_of(h1); // into a
-        for (std::size_t guard = 0; level.twin[h] != none && guard <= level.faces.size(); ++guard)
-            h = prev_of(level.twin[h]);
-        if (level.twin[h] != none)
-            return midpoint;
-        const std::uint32_t prev_vertex = level.from(h);
-        return (9.0 / 16.0) * (x[a] + x[b]) - (1.0 / 16.0) * (x[prev_vertex] + x[next_vertex]);
-    }
-
-    // Interior edge: the stencil of each interior end, starting its ring at the other end.
-    bool closed = false;
-    const auto stencil = [&](std::uint32_t centre, std::uint32_t other,
-                             std::size_t& valence) -> std::optional<Vec3d> {
-        const std::uint32_t start = level.outgoing[centre];
-        level.ring(start, ring, closed);
-        if (!closed)
-            return std::nullopt;
-        valence = ring.size();
-        const auto it = std::find(ring.begin(), ring.end(), other);
-        if (it == ring.end())
-            return std::nullopt;
-        std::rotate(ring.begin(), it, ring.end());
-        const std::vector<double> s = extraordinary_weights(ring.size());
-        Vec3d p = 0.75 * x[centre];
-        for (std::size_t j = 0; j < ring.size(); ++j)
-            p += s[j] * x[ring[j]];
-        return p;
-    };
-    std::size_t valence_a = 0;
-    std::size_t valence_b = 0;
-    const std::optional<Vec3d> from_a = stencil(a, b, valence_a);
-    const std::optional<Vec3d> from_b = stencil(b, a, valence_b);
-    const bool regular_a = from_a && valence_a == 6;
-    const bool regular_b = from_b && valence_b == 6;
-    if ((regular_a && regular_b) || (regular_a && !from_b) || (regular_b && !from_a))
-    {
-        // Regular ends (one may lie on the boundary): the 8-point butterfly, if its wings exist.
-        const std::uint32_t c = level.opposite(h1);
-        const std::uint32_t d = level.opposite(h2);
-        const std::array<std::uint32_t, 4> sides = {next_of(h1), prev_of(h1), next_of(h2),
-                                                    prev_of(h2)};
-        if (std::all_of(sides.begin(), sides.end(),
-                        [&](std::uint32_t h) { return level.twin[h] != none; }))
-        {
-            Vec3d wings = Vec3d::Zero();
-            for (const std::uint32_t h : sides)
-                wings += x[level.opposite(level.twin[h])];
-            return 0.5 * (x[a] + x[b]) + 0.125 * (x[c] + x[d]) - 0.0625 * wings;
-        }
-        return regular_a && regular_b ? 0.5 * (*from_a + *from_b) : midpoint;
-    }
-    // An irregular interior end: its stencil (both irregular: the average).
-    if (from_a && from_b && !regular_a && !regular_b)
-        return 0.5 * (*from_a + *from_b);
-    if (from_a && !regular_a)
-        return *from_a;
-    if (from_b && !regular_b)
-        return *from_b;
-    return midpoint;
 }
 
 enum class State : std::uint8_t
@@ -404,7 +230,7 @@ std::vector<Triangle> refine_split_level(MultiresMesh& mesh, MultiresMesh::Split
                                          const Field& field, const RefineOptions& options,
                                          RefineLevelStats& stats)
 {
-    const Level level = build_level(mesh, std::move(split));
+    const Level level = level_topology(mesh, std::move(split));
     const std::span<Vec3d> new_positions = mesh.finest_new_positions();
     const std::span<const Vec3d> x = mesh.positions(); // all vertices; new ones change below
     const std::size_t added = new_positions.size();
@@ -437,14 +263,14 @@ std::vector<Triangle> refine_split_level(MultiresMesh& mesh, MultiresMesh::Split
             added, vertex_block,
             [&](std::size_t begin, std::size_t end) {
                 std::vector<std::uint32_t> ring;
+                std::vector<StencilTerm> stencil;
                 for (std::size_t j = begin; j < end; ++j)
                 {
                     const auto [h1, h2] = level.halfedges[j];
                     const std::uint32_t a = level.from(h1);
                     const std::uint32_t b = level.to(h1);
-                    prediction[j] = options.predictor == Predictor::Butterfly
-                                        ? butterfly(level, x, h1, h2, ring)
-                                        : Vec3d(0.5 * (x[a] + x[b]));
+                    prediction_stencil(level, j, options.predictor, stencil, ring);
+                    prediction[j] = apply_stencil(stencil, x);
                     Vec3d n = face_normal[h1 / 3];
                     if (h2 != none)
                         n += face_normal[h2 / 3];
@@ -672,21 +498,6 @@ std::vector<Triangle> refine_split_level(MultiresMesh& mesh, MultiresMesh::Split
 
 } // namespace
 
-Predictor parse_predictor(std::string_view text)
-{
-    if (text == "midpoint")
-        return Predictor::Midpoint;
-    if (text == "butterfly")
-        return Predictor::Butterfly;
-    throw InvalidInput("unknown predictor '" + std::string(text) +
-                       "' (expected midpoint or butterfly)");
-}
-
-std::string_view to_string(Predictor predictor)
-{
-    return predictor == Predictor::Butterfly ? "butterfly" : "midpoint";
-}
-
 Relaxation parse_relaxation(std::string_view text)
 {
     if (text == "across")
@@ -754,6 +565,13 @@ RefineLevelStats refine_once(MultiresMesh& mesh, const Field& field, const Refin
     check_options(options);
     if (mesh.level_count() == 0)
         throw InvalidInput("refine: the hierarchy is empty");
+    if (mesh.finest_level() == 0)
+        mesh.set_predictor(options.predictor);
+    else if (mesh.predictor() != options.predictor)
+        throw InvalidInput("refine: the hierarchy's levels were predicted by the " +
+                           std::string(to_string(mesh.predictor())) +
+                           " rule; a level predicted by the " +
+                           std::string(to_string(options.predictor)) + " rule cannot follow them");
     const auto start = std::chrono::steady_clock::now();
     const std::size_t previous = mesh.finest_level();
     RefineLevelStats stats;

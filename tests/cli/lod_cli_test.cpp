@@ -172,10 +172,10 @@ TEST(LodCli, DamagedFilesGiveFileErrorsAndWriteNothing)
     test::write_file(dir / "cut.pfh", bytes.substr(0, bytes.size() - 100));
     expect_failure(dir / "cut.pfh", "truncated");
 
-    std::string v2 = bytes;
-    v2[8] = 2;
-    test::write_file(dir / "v2.pfh", v2);
-    expect_failure(dir / "v2.pfh", "version 2 is not supported");
+    std::string v9 = bytes;
+    v9[8] = 9;
+    test::write_file(dir / "v9.pfh", v9);
+    expect_failure(dir / "v9.pfh", "version 9 is not supported");
 
     write_mesh(dir / "mesh.ply", test::icosphere(1));
     expect_failure(dir / "mesh.ply", "not a pointform hierarchy");

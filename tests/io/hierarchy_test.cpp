@@ -291,7 +291,7 @@ TEST(Hierarchy, OtherVersionsNameBothVersions)
     test::TempDir dir;
     const auto path = dir / "v.pfh";
     write_hierarchy(path, tiny_hierarchy());
-    for (const std::uint32_t version : {0U, 2U, 77U})
+    for (const std::uint32_t version : {0U, 3U, 77U})
     {
         std::string bytes = test::read_file(path);
         put_le(bytes, 8, version);
@@ -300,7 +300,7 @@ TEST(Hierarchy, OtherVersionsNameBothVersions)
         test::write_file(other, bytes);
         EXPECT_TRUE(is_hierarchy_file(other));
         expect_read_error(other, "format version " + std::to_string(version) +
-                                     " is not supported (this build reads version 1)");
+                                     " is not supported (this build reads versions 1 and 2)");
     }
 }
 
@@ -406,6 +406,38 @@ TEST(Hierarchy, WritingFailsCleanly)
     for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir.path()))
         ++entries;
     EXPECT_EQ(entries, 1U);
+}
+
+TEST(Hierarchy, RecordsThePredictorAndReadsVersionOneAsMidpoint)
+{
+    test::TempDir dir;
+    const auto path = dir / "p.pfh";
+    MultiresMesh mesh = tiny_hierarchy();
+    mesh.set_predictor(Predictor::Butterfly);
+    write_hierarchy(path, mesh);
+    EXPECT_EQ(read_hierarchy(path).predictor(), Predictor::Butterfly);
+
+    std::string bytes = test::read_file(path);
+    EXPECT_EQ(get_le<std::uint32_t>(bytes, 12), 1U);
+    put_le(bytes, 12, 7U);
+    reseal(bytes);
+    const auto unknown = dir / "unknown.pfh";
+    test::write_file(unknown, bytes);
+    expect_read_error(unknown, "unknown predictor 7");
+
+    // Version 1: the word at offset 12 is flags (0), and the hierarchy reads as midpoint.
+    put_le(bytes, 8, 1U);
+    put_le(bytes, 12, 0U);
+    reseal(bytes);
+    const auto v1 = dir / "v1.pfh";
+    test::write_file(v1, bytes);
+    const MultiresMesh old = read_hierarchy(v1);
+    EXPECT_EQ(old.predictor(), Predictor::Midpoint);
+    EXPECT_EQ(old.vertex_count(), mesh.vertex_count());
+    put_le(bytes, 12, 1U);
+    reseal(bytes);
+    test::write_file(v1, bytes);
+    expect_read_error(v1, "unknown flags");
 }
 
 } // namespace

@@ -430,6 +430,17 @@ TEST(Refine, ButterflyPredictsBetterThanTheMidpoint)
     }
 }
 
+TEST(Refine, RecordsItsPredictorAndKeepsIt)
+{
+    const NowhereField nowhere;
+    MultiresMesh flat(test::square_grid(2));
+    refine_once(flat, nowhere, {.predictor = Predictor::Butterfly});
+    EXPECT_EQ(flat.predictor(), Predictor::Butterfly);
+    refine_once(flat, nowhere, {.predictor = Predictor::Butterfly});
+    EXPECT_THROW(refine_once(flat, nowhere, {.predictor = Predictor::Midpoint}), InvalidInput);
+    EXPECT_EQ(flat.level_count(), 3U);
+}
+
 /// `count` samples of the unit sphere with isotropic Gaussian noise of `sigma` (absolute), with
 /// the true normals.
 PointCloud noisy_sphere(std::size_t count, double sigma)

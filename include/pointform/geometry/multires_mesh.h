@@ -11,9 +11,31 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string_view>
 #include <vector>
 
 namespace pointform {
+
+/// \brief Where a refinement first puts a new edge vertex, before projecting it (§5.2), and what
+/// the details of a hierarchy are measured from (pointform/multires/details.h).
+enum class Predictor
+{
+    /// The midpoint of the parent edge.
+    Midpoint,
+    /// The modified butterfly subdivision rule (Zorin, Schröder and Sweldens 1996): the 8-point
+    /// stencil where the edge's interior ends are regular (valence 6; one end may lie on the
+    /// boundary if the stencil's wings exist), the extraordinary-vertex stencil of an irregular
+    /// interior end (averaged when both are irregular), the 4-point rule along boundary edges,
+    /// and the midpoint for an interior edge whose two ends lie on the boundary (a simplification
+    /// of Zorin's boundary rules). Projecting the prediction gives the paper's "displaced
+    /// butterfly" refinement. The stencils are those of prediction_stencil()
+    /// (pointform/geometry/level_topology.h).
+    Butterfly,
+};
+
+/// \brief Parses "midpoint" or "butterfly". \throw InvalidInput otherwise
+[[nodiscard]] Predictor parse_predictor(std::string_view text);
+[[nodiscard]] std::string_view to_string(Predictor predictor);
 
 /// \brief The two level-i vertices of the edge that a vertex of level i + 1 splits.
 struct ParentEdge
@@ -41,6 +63,9 @@ struct MultiresParts
     /// One entry per vertex added by a split, i.e. for vertex v ≥ level_offsets[1] the entry
     /// v − level_offsets[1]: the edge of level i it splits, where v belongs to level i + 1.
     std::vector<ParentEdge> parent_edges;
+    /// The predictor the refinement used for every level above the base (hierarchy files of
+    /// format version 1 did not record it and read as Midpoint).
+    Predictor predictor = Predictor::Midpoint;
 };
 
 /// \brief Level 3: a semi-regular multiresolution triangle mesh, a base mesh M0 and its nested
@@ -114,6 +139,10 @@ public:
     [[nodiscard]] ParentEdge parent_edge(std::uint32_t v) const;
     /// \brief The parent edges of every non-base vertex (entry v − vertex_count(0)).
     [[nodiscard]] std::span<const ParentEdge> parent_edges() const { return parts_.parent_edges; }
+    /// \brief The predictor the refinement used, which the details are measured from.
+    [[nodiscard]] Predictor predictor() const { return parts_.predictor; }
+    /// \brief Records the predictor of the levels above the base (refine_once() does).
+    void set_predictor(Predictor predictor) { parts_.predictor = predictor; }
     /// \brief The raw data, e.g. to write it to a file.
     [[nodiscard]] const MultiresParts& parts() const { return parts_; }
 
@@ -156,6 +185,11 @@ public:
     /// \brief Positions of the vertices added by the finest level, writable (relative to
     /// origin()); coarser vertices cannot be moved. Empty if the hierarchy has only its base.
     [[nodiscard]] std::span<Vec3d> finest_new_positions();
+
+    /// \brief Every position (relative to origin()), writable, for Level 3 editing: moving
+    /// vertices keeps the hierarchy nested (nesting is in the connectivity, which cannot change).
+    /// The caller keeps them finite (validate() checks).
+    [[nodiscard]] std::span<Vec3d> mutable_positions() { return parts_.positions; }
 
     /// \brief Drops every level above `level` (keeping levels 0 … level).
     /// \throw InvalidInput if the level does not exist

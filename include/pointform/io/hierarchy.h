@@ -16,15 +16,18 @@ namespace pointform {
 /// level's parent edges and every position, in one versioned binary file
 /// (docs/hierarchy-format.md).
 ///
-/// Layout of format version 1. Every integer is unsigned little-endian, every real an IEEE-754
-/// binary64 little-endian; there is no padding. V is the number of vertices of the finest level,
-/// L the number of levels (J + 1), F0 the number of base faces and P = V − V0 the number of
-/// vertices added by splits (V0 = the base's vertex count).
+/// Layout of format version 2 (version 1, which this reader still reads, is the same with a u32
+/// "flags" word of 0 at offset 12 and no record of the predictor: it reads as Midpoint). Every
+/// integer is unsigned little-endian, every real an IEEE-754 binary64 little-endian; there is no
+/// padding. V is the number of vertices of the finest level, L the number of levels (J + 1), F0 the
+/// number of base faces and P = V − V0 the number of vertices added by splits (V0 = the base's
+/// vertex count).
 ///
 ///     offset           size     field
 ///     0                8        magic: 89 50 46 48 0D 0A 1A 0A  ("\x89PFH\r\n\x1a\n")
-///     8                4        u32 format version: 1
-///     12               4        u32 flags: 0 (reserved; a version-1 reader rejects others)
+///     8                4        u32 format version: 2
+///     12               4        u32 predictor of the levels above the base: 0 midpoint,
+///                               1 butterfly (others are rejected)
 ///     16               24       f64 × 3 origin x, y, z (world = origin + position)
 ///     40               4        u32 L, number of levels (≥ 1)
 ///     44               4        u32 V, number of vertices of the finest level
@@ -45,15 +48,15 @@ namespace pointform {
 /// stored: they follow from the base faces and the parent edges by the 1-to-4 split that
 /// MultiresMesh documents (child 4f … 4f+3 of face f).
 ///
-/// A reader checks, in this order: the magic, the version, the flags, that the file has exactly
-/// the size the counts announce (before allocating anything for them), the checksum, and then
-/// every structural invariant through MultiresMesh's constructor (base an oriented manifold,
-/// one new vertex per edge of the level below, parent edges naming each edge once, finite
-/// positions, …). A version-2 writer must change the version number; readers reject versions
-/// they do not know.
+/// A reader checks, in this order: the magic, the version, the predictor (version 1: the flags),
+/// that the file has exactly the size the counts announce (before allocating anything for them),
+/// the checksum, and then every structural invariant through MultiresMesh's constructor (base an
+/// oriented manifold, one new vertex per edge of the level below, parent edges naming each edge
+/// once, finite positions, …). A version-2 writer must change the version number; readers reject
+/// versions they do not know.
 
-/// \brief The format version write_hierarchy() writes and read_hierarchy() reads.
-inline constexpr std::uint32_t hierarchy_format_version = 1;
+/// \brief The format version write_hierarchy() writes; read_hierarchy() reads it and version 1.
+inline constexpr std::uint32_t hierarchy_format_version = 2;
 
 /// \brief The 8 magic bytes a hierarchy file starts with.
 inline constexpr std::array<std::uint8_t, 8> hierarchy_magic = {0x89, 'P',  'F',  'H',
@@ -68,7 +71,7 @@ void write_hierarchy(const std::filesystem::path& path, const MultiresMesh& mesh
 
 /// \brief Reads a hierarchy file, trusting nothing in it (see the checks above).
 /// \throw IoError naming the file: missing or unreadable; "not a pointform hierarchy" (wrong
-///        magic); a version other than hierarchy_format_version (both named); truncated or with
+///        magic); a version other than 1 and hierarchy_format_version (named); truncated or with
 ///        trailing bytes; "corrupt" (checksum mismatch, unknown flags); or a structure that
 ///        MultiresMesh rejects (its message, with the file's name)
 [[nodiscard]] MultiresMesh read_hierarchy(const std::filesystem::path& path);

@@ -16,25 +16,6 @@
 
 namespace pointform {
 
-/// \brief Where a refinement first puts a new edge vertex, before projecting it (§5.2).
-enum class Predictor
-{
-    /// The midpoint of the parent edge.
-    Midpoint,
-    /// The modified butterfly subdivision rule (Zorin, Schröder and Sweldens 1996): the 8-point
-    /// stencil where the edge's interior ends are regular (valence 6; one end may lie on the
-    /// boundary if the stencil's wings exist), the extraordinary-vertex stencil of an irregular
-    /// interior end (averaged when both are irregular), the 4-point rule along boundary edges,
-    /// and the midpoint for an interior edge whose two ends lie on the boundary (a simplification
-    /// of Zorin's boundary rules). Projecting the prediction gives the paper's "displaced
-    /// butterfly" refinement.
-    Butterfly,
-};
-
-/// \brief Parses "midpoint" or "butterfly". \throw InvalidInput otherwise
-[[nodiscard]] Predictor parse_predictor(std::string_view text);
-[[nodiscard]] std::string_view to_string(Predictor predictor);
-
 /// \brief Which tangential move the relaxation (§5.2.3) makes with a new vertex.
 enum class Relaxation
 {
@@ -99,6 +80,8 @@ enum class StopRule
 /// \brief Options of refine_once() and refine().
 struct RefineOptions
 {
+    /// Where new vertices start (Predictor, pointform/geometry/multires_mesh.h). A hierarchy
+    /// records it when its first level is made; later levels must use the same.
     Predictor predictor = Predictor::Midpoint;
     /// The search for the zero crossing along ±(edge normal) from the prediction reaches at most
     /// this multiple of the parent edge's length (§5.2.2: "bounded by the local edge length").
