@@ -94,6 +94,7 @@ void register_distance(CLI::App& app, const GlobalOptions& global);
 void register_model(CLI::App& app, const GlobalOptions& global);
 void register_morph(CLI::App& app, const GlobalOptions& global);
 void register_lod(CLI::App& app, const GlobalOptions& global);
+void register_deform(CLI::App& app, const GlobalOptions& global);
 void register_reconstruct(CLI::App& app, const GlobalOptions& global);
 void register_remesh(CLI::App& app, const GlobalOptions& global);
 

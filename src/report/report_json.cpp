@@ -311,4 +311,45 @@ nlohmann::json report_json(const ShapeRef& shape, std::size_t samples)
             {"samples", compare_sample_count(shape, samples)}};
 }
 
+nlohmann::json report_json(const DeformReport& report, double diagonal)
+{
+    nlohmann::json out;
+    out["level"] = report.level;
+    out["region_vertices"] = report.region_vertices;
+    out["handle_vertices"] = report.handle_vertices;
+    out["free_vertices"] = report.free_vertices;
+    out["unconstrained_vertices"] = report.unconstrained_vertices;
+    out["largest_displacement"] = report.largest_displacement;
+    out["largest_displacement_relative"] =
+        diagonal > 0.0 ? report.largest_displacement / diagonal : 0.0;
+    nlohmann::json levels = nlohmann::json::array();
+    for (const LevelMotion& motion : report.levels)
+        levels.push_back({{"level", motion.level},
+                          {"vertices", motion.vertices},
+                          {"moved", motion.moved},
+                          {"largest", motion.largest}});
+    out["levels"] = levels;
+    return out;
+}
+
+nlohmann::json report_json(const std::vector<DetailLevelStats>& levels, double normal_tolerance)
+{
+    nlohmann::json out;
+    out["normal_tolerance"] = normal_tolerance;
+    out["definition"] =
+        "a detail is almost a pure normal offset when its tangential part is at "
+        "most normal_tolerance times its length";
+    nlohmann::json rows = nlohmann::json::array();
+    for (const DetailLevelStats& s : levels)
+        rows.push_back({{"level", s.level},
+                        {"details", s.details},
+                        {"mean_length", s.mean_length},
+                        {"max_length", s.max_length},
+                        {"mean_normal", s.mean_normal},
+                        {"mean_tangent", s.mean_tangent},
+                        {"normal_share", s.normal_share}});
+    out["levels"] = rows;
+    return out;
+}
+
 } // namespace pointform

@@ -5,7 +5,10 @@
 // and `model --semi-regular` run on the Stanford bunny at -j 1, 2 and 3, their JSON reports'
 // "parallel" figures showing the work really was split into blocks run by several threads.
 
+#include "pointform/io/hierarchy.h"
+
 #include "cli_run.h"
+#include "multires/multires_fixtures.h"
 #include "support/test_support.h"
 
 #include <gtest/gtest.h>
@@ -104,6 +107,32 @@ TEST(DeterminismCli, ModelSemiRegular)
                           " --semi-regular --levels 2 --save-hierarchy " +
                           quoted(dir / "s{j}.pfh") + " --json",
                       {"s{j}.ply", "s{j}.pfh"}, dir);
+}
+
+TEST(DeterminismCli, DeformEditAndLattice)
+{
+    test::TempDir dir;
+    // Level 6 of the bumpy sphere adds 122,880 vertices: 30 blocks per synthesis loop.
+    const MultiresMesh mesh = test::relief_sphere(6, Predictor::Butterfly);
+    write_hierarchy(dir / "in.pfh", mesh);
+    const Vec3d c = mesh.world(3);
+    test::write_file(dir / "edit.json",
+                     R"({"level": 0, "handles": [{"vertices": [3], "translate": [0.05, 0, 0.1]}],
+                         "region": {"ball": {"center": [)" +
+                         std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " +
+                         std::to_string(c.z()) + R"(], "radius": 1.2}}})");
+    expect_same_bytes("deform " + quoted(dir / "in.pfh") + " -o " + quoted(dir / "e{j}.pfh") +
+                          " --mesh " + quoted(dir / "e{j}.ply") + " --edit " +
+                          quoted(dir / "edit.json") + " --json",
+                      {"e{j}.pfh", "e{j}.ply"}, dir);
+    test::write_file(dir / "lattice.json",
+                     R"({"min": [-1.2, -1.2, -1.2], "max": [1.2, 1.2, 1.2], "degree": [1, 1, 1],
+                         "level": 2, "control_points": [[-1.2, -1.2, -1.2], [1.4, -1.2, -1.2],
+                         [-1.2, 1.2, -1.2], [1.2, 1.2, -1.2], [-1.2, -1.2, 1.2],
+                         [1.2, -1.2, 1.2], [-1.2, 1.2, 1.2], [1.2, 1.5, 1.6]]})");
+    expect_same_bytes("deform " + quoted(dir / "in.pfh") + " -o " + quoted(dir / "l{j}.pfh") +
+                          " --lattice " + quoted(dir / "lattice.json") + " --json",
+                      {"l{j}.pfh"}, dir);
 }
 
 } // namespace

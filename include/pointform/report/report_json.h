@@ -9,6 +9,8 @@
 
 #include "pointform/hermite/surfels.h"
 #include "pointform/metrics/hausdorff.h"
+#include "pointform/multires/deformation.h"
+#include "pointform/multires/details.h"
 #include "pointform/polygonize/base_mesh.h"
 #include "pointform/polygonize/reconstruct.h"
 #include "pointform/polygonize/refine.h"
@@ -72,5 +74,15 @@ inline constexpr const char* hausdorff_definition =
 /// \brief A shape compare() measured: its kind ("mesh" or "points"), points, faces, and how
 /// many samples measure it with `samples` area samples a mesh (its used vertices added).
 [[nodiscard]] nlohmann::json report_json(const ShapeRef& shape, std::size_t samples);
+
+/// \brief A deformation's report: level, region_vertices, handle_vertices, free_vertices,
+/// unconstrained_vertices, largest_displacement (also relative to `diagonal`) and per level
+/// (vertices, moved, largest).
+[[nodiscard]] nlohmann::json report_json(const DeformReport& report, double diagonal);
+
+/// \brief The details' statistics per level (details, mean_length, max_length, mean_normal,
+/// mean_tangent, normal_share) and the tolerance that defines an almost pure normal detail.
+[[nodiscard]] nlohmann::json report_json(const std::vector<DetailLevelStats>& levels,
+                                         double normal_tolerance);
 
 } // namespace pointform
