@@ -36,48 +36,23 @@ struct DeformOptions
     bool json = false;
 };
 
-/// Length of the diagonal of the bounding box of every vertex.
-double diagonal_of(const MultiresMesh& mesh)
-{
-    Vec3d lo = Vec3d::Constant(std::numeric_limits<double>::infinity());
-    Vec3d hi = -lo;
-    for (const Vec3d& p : mesh.positions())
-    {
-        lo = lo.cwiseMin(p);
-        hi = hi.cwiseMax(p);
-    }
-    return mesh.vertex_count() > 0 ? (hi - lo).norm() : 0.0;
-}
-
 void run_deform(const DeformOptions& options, const GlobalOptions& global)
 {
     set_thread_count(global.threads);
     Timings timings;
     MultiresMesh mesh = read_hierarchy(options.input);
-    const double diagonal = diagonal_of(mesh);
     timings.lap("read");
-    // The details of the input, which the edit keeps: their statistics go in the report.
-    constexpr double normal_tolerance = 0.1;
-    const std::vector<DetailLevelStats> details = detail_statistics(analyze_details(mesh));
-    timings.lap("details");
-
-    DeformReport report;
-    std::string mode;
+    DeformRequest request;
     if (!options.edit.empty())
-    {
-        const MultiresEdit edit = read_multires_edit(options.edit);
-        timings.lap("parse");
-        report = deform(mesh, edit);
-        mode = "edit";
-    }
+        request.edit = read_multires_edit(options.edit);
     else
-    {
-        const LatticeEdit lattice = read_lattice(options.lattice);
-        timings.lap("parse");
-        report = apply_lattice(mesh, lattice.lattice, lattice.level,
-                               options.plain ? LatticeMode::Plain : LatticeMode::Details);
-        mode = options.plain ? "lattice (plain)" : "lattice (details)";
-    }
+        request.lattice = read_lattice(options.lattice);
+    request.lattice_mode = options.plain ? LatticeMode::Plain : LatticeMode::Details;
+    timings.lap("parse");
+    const DeformOutcome outcome = deform_hierarchy(mesh, request);
+    const DeformReport& report = outcome.deformation;
+    const std::vector<DetailLevelStats>& details = outcome.details;
+    const double diagonal = outcome.diagonal;
     timings.lap("deform");
 
     OutputTransaction outputs;
@@ -92,16 +67,11 @@ void run_deform(const DeformOptions& options, const GlobalOptions& global)
 
     if (options.json)
     {
-        nlohmann::json out;
+        nlohmann::json out = report_json(outcome);
         out["input"] = options.input;
         out["output"] = options.output;
         if (!options.mesh.empty())
             out["mesh"] = options.mesh;
-        out["mode"] = mode;
-        out["predictor"] = std::string(to_string(mesh.predictor()));
-        out["diagonal"] = diagonal;
-        out["deformation"] = report_json(report, diagonal);
-        out["details"] = report_json(details, normal_tolerance);
         add_run_report(out, timings);
         std::printf("%s\n", out.dump(2).c_str());
         return;
@@ -109,7 +79,7 @@ void run_deform(const DeformOptions& options, const GlobalOptions& global)
     if (global.quiet)
         return;
     std::printf("%s -> %s: %s of level %zu, %s predictor\n", options.input.c_str(),
-                options.output.c_str(), mode.c_str(), report.level,
+                options.output.c_str(), outcome.mode.c_str(), report.level,
                 std::string(to_string(mesh.predictor())).c_str());
     if (!options.edit.empty())
     {

@@ -205,6 +205,7 @@ void bind_io(py::module_& m);
 void bind_hermite(py::module_& m);
 void bind_implicit(py::module_& m);
 void bind_polygonize(py::module_& m);
+void bind_multires(py::module_& m);
 void bind_metrics(py::module_& m);
 
 } // namespace pointform::python

@@ -166,5 +166,6 @@ PYBIND11_MODULE(_pointform, m)
     pf::bind_hermite(m);
     pf::bind_implicit(m);
     pf::bind_polygonize(m);
+    pf::bind_multires(m);
     pf::bind_metrics(m);
 }

@@ -314,4 +314,38 @@ LatticeEdit read_lattice(const std::filesystem::path& path)
     return parse_lattice(read_text(path, "a lattice file"), path.string());
 }
 
+DeformOutcome deform_hierarchy(MultiresMesh& mesh, const DeformRequest& request)
+{
+    if (request.edit.has_value() == request.lattice.has_value())
+        throw InvalidInput("deform: give exactly one of an edit and a lattice");
+    DeformOutcome out;
+    out.predictor = mesh.predictor();
+    if (mesh.vertex_count() > 0)
+    {
+        Vec3d lo = mesh.positions()[0];
+        Vec3d hi = lo;
+        for (const Vec3d& p : mesh.positions())
+        {
+            lo = lo.cwiseMin(p);
+            hi = hi.cwiseMax(p);
+        }
+        out.diagonal = (hi - lo).norm();
+    }
+    if (mesh.level_count() > 0)
+        out.details = detail_statistics(analyze_details(mesh), out.normal_tolerance);
+    if (request.edit)
+    {
+        out.mode = "edit";
+        out.deformation = deform(mesh, *request.edit);
+    }
+    else
+    {
+        const bool plain = request.lattice_mode == LatticeMode::Plain;
+        out.mode = plain ? "lattice (plain)" : "lattice (details)";
+        out.deformation = apply_lattice(mesh, request.lattice->lattice, request.lattice->level,
+                                        request.lattice_mode);
+    }
+    return out;
+}
+
 } // namespace pointform

@@ -352,4 +352,15 @@ nlohmann::json report_json(const std::vector<DetailLevelStats>& levels, double n
     return out;
 }
 
+nlohmann::json report_json(const DeformOutcome& outcome)
+{
+    nlohmann::json out;
+    out["mode"] = outcome.mode;
+    out["predictor"] = std::string(to_string(outcome.predictor));
+    out["diagonal"] = outcome.diagonal;
+    out["deformation"] = report_json(outcome.deformation, outcome.diagonal);
+    out["details"] = report_json(outcome.details, outcome.normal_tolerance);
+    return out;
+}
+
 } // namespace pointform

@@ -4,12 +4,15 @@
 #pragma once
 
 #include "pointform/multires/deformation.h"
+#include "pointform/multires/details.h"
 #include "pointform/multires/lattice.h"
 
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace pointform {
 
@@ -38,6 +41,31 @@ struct LatticeEdit
     std::size_t level = 0;
     Lattice lattice;
 };
+
+/// \brief What `pointform deform` does: one edit, or one lattice in a mode.
+struct DeformRequest
+{
+    std::optional<MultiresEdit> edit;
+    std::optional<LatticeEdit> lattice;
+    LatticeMode lattice_mode = LatticeMode::Details;
+};
+
+/// \brief What deform_hierarchy() did, with the figures every front end reports.
+struct DeformOutcome
+{
+    std::string mode; ///< "edit", "lattice (details)" or "lattice (plain)"
+    Predictor predictor = Predictor::Midpoint;
+    double diagonal = 0.0; ///< of the input's bounding box
+    DeformReport deformation;
+    double normal_tolerance = 0.1;         ///< as detail_statistics()
+    std::vector<DetailLevelStats> details; ///< of the input, per level 1 … J
+};
+
+/// \brief Deforms `mesh` as `request` asks (deform() or apply_lattice()), with the statistics of
+/// the input's details and its diagonal: the one call behind the CLI's and Python's deform.
+/// \throw InvalidInput unless exactly one of edit and lattice is set, or as deform() and
+/// apply_lattice()
+DeformOutcome deform_hierarchy(MultiresMesh& mesh, const DeformRequest& request);
 
 /// \brief The largest edit or lattice file read: 256 MiB.
 inline constexpr std::size_t max_edit_file_bytes = std::size_t{256} << 20;

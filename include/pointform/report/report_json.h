@@ -11,6 +11,7 @@
 #include "pointform/metrics/hausdorff.h"
 #include "pointform/multires/deformation.h"
 #include "pointform/multires/details.h"
+#include "pointform/multires/edit_file.h"
 #include "pointform/polygonize/base_mesh.h"
 #include "pointform/polygonize/reconstruct.h"
 #include "pointform/polygonize/refine.h"
@@ -84,5 +85,9 @@ inline constexpr const char* hausdorff_definition =
 /// mean_tangent, normal_share) and the tolerance that defines an almost pure normal detail.
 [[nodiscard]] nlohmann::json report_json(const std::vector<DetailLevelStats>& levels,
                                          double normal_tolerance);
+
+/// \brief deform_hierarchy()'s outcome: mode, predictor, diagonal, deformation (as above) and
+/// details (the input's, as above).
+[[nodiscard]] nlohmann::json report_json(const DeformOutcome& outcome);
 
 } // namespace pointform
