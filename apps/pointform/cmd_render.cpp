@@ -31,6 +31,7 @@ struct RenderCommandOptions
     std::string size = "1024,768";
     std::string view = "30,20";
     std::string up = "y";
+    std::string frame;
     bool wireframe = false;
     bool orthographic = false;
     double field_of_view = 30.0;
@@ -127,6 +128,8 @@ void run_render(const RenderCommandOptions& options, const GlobalOptions& global
     render_options.projection =
         options.orthographic ? Projection::Orthographic : Projection::Perspective;
     render_options.field_of_view = options.field_of_view;
+    if (!options.frame.empty())
+        render_options.frame = parse_box(options.frame, "--frame");
     render_options.supersampling = options.supersampling;
     check_memory(estimate_render_bytes(render_options.width, render_options.height,
                                        render_options.supersampling),
@@ -205,6 +208,9 @@ void register_render(CLI::App& app, const GlobalOptions& global)
         ->capture_default_str();
     cmd->add_option("--up", options->up, "Up axis of the model: x, y, z, -x, -y, -z or X,Y,Z")
         ->capture_default_str();
+    cmd->add_option("--frame", options->frame,
+                    "XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX: frame this world box instead of the object, "
+                    "so pictures of several objects (before and after an edit) share one camera");
     cmd->add_flag("--wireframe", options->wireframe, "Draw the edges of the visible faces");
     cmd->add_flag("--ortho", options->orthographic, "Orthographic instead of perspective");
     cmd->add_option("--fov", options->field_of_view,

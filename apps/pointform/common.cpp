@@ -10,6 +10,8 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -133,6 +135,40 @@ void print_timings(const Timings& timings)
         times += (times.empty() ? "" : ", ") + stage + " " + format_number(seconds);
     }
     print_row("seconds", times + " (total " + format_number(timings.total()) + ")");
+}
+
+Aabb parse_box(const std::string& text, const std::string& option)
+{
+    std::istringstream in(text);
+    std::array<double, 6> v{};
+    for (std::size_t i = 0; i < v.size(); ++i)
+    {
+        char comma = ',';
+        if (!(in >> v[i]) || (i + 1 < v.size() && !(in >> comma)) || comma != ',' ||
+            !std::isfinite(v[i]))
+        {
+            throw CLI::ValidationError(option,
+                                       "expected six finite numbers "
+                                       "xmin,ymin,zmin,xmax,ymax,zmax, got '" +
+                                           text + "'");
+        }
+    }
+    if (!(in >> std::ws).eof())
+    {
+        throw CLI::ValidationError(option,
+                                   "expected six numbers xmin,ymin,zmin,xmax,ymax,zmax, "
+                                   "got '" +
+                                       text + "'");
+    }
+    Aabb box;
+    box.min = Vec3d(v[0], v[1], v[2]);
+    box.max = Vec3d(v[3], v[4], v[5]);
+    if (!(box.min.array() < box.max.array()).all())
+    {
+        throw CLI::ValidationError(option,
+                                   "each minimum must be below its maximum, got '" + text + "'");
+    }
+    return box;
 }
 
 } // namespace pointform::cli

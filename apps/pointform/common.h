@@ -5,6 +5,7 @@
 
 #include "pointform/core/progress.h"
 #include "pointform/core/types.h"
+#include "pointform/geometry/aabb.h"
 #include "pointform/report/report_json.h" // format_number
 
 #include <CLI/CLI.hpp>
@@ -73,6 +74,10 @@ void print_timings(const Timings& timings);
 
 /// \brief Peak resident memory of this process so far, in bytes.
 [[nodiscard]] std::size_t peak_rss_bytes();
+
+/// \brief Parses "XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX" (six finite numbers, each minimum below its
+/// maximum) for `option`. \throw CLI::ValidationError naming the option
+[[nodiscard]] Aabb parse_box(const std::string& text, const std::string& option);
 
 /// \brief Parses "X,Y,Z" into a vector. \throw CLI::ValidationError on malformed input.
 [[nodiscard]] Vec3d parse_vec3(const std::string& text, const std::string& what);

@@ -6,6 +6,7 @@
 #include "pointform/core/error.h"
 #include "pointform/io/io.h"
 
+#include "common.h"
 #include "options.h"
 
 #include <cmath>
@@ -14,43 +15,7 @@
 #include <utility>
 
 namespace pointform::cli {
-namespace {
-
-Aabb parse_bounds(const std::string& text)
-{
-    std::istringstream in(text);
-    std::array<double, 6> v{};
-    for (std::size_t i = 0; i < v.size(); ++i)
-    {
-        char comma = ',';
-        if (!(in >> v[i]) || (i + 1 < v.size() && !(in >> comma)) || comma != ',' ||
-            !std::isfinite(v[i]))
-        {
-            throw CLI::ValidationError("--bounds",
-                                       "expected six finite numbers "
-                                       "xmin,ymin,zmin,xmax,ymax,zmax, got '" +
-                                           text + "'");
-        }
-    }
-    if (!(in >> std::ws).eof())
-    {
-        throw CLI::ValidationError("--bounds",
-                                   "expected six numbers xmin,ymin,zmin,xmax,ymax,zmax, "
-                                   "got '" +
-                                       text + "'");
-    }
-    Aabb box;
-    box.min = Vec3d(v[0], v[1], v[2]);
-    box.max = Vec3d(v[3], v[4], v[5]);
-    if (!(box.min.array() < box.max.array()).all())
-    {
-        throw CLI::ValidationError("--bounds",
-                                   "each minimum must be below its maximum, got '" + text + "'");
-    }
-    return box;
-}
-
-} // namespace
+namespace {} // namespace
 
 void add_scene_command_options(CLI::App& cmd, SceneCommandOptions& options)
 {
@@ -64,7 +29,7 @@ void add_scene_command_options(CLI::App& cmd, SceneCommandOptions& options)
         ->excludes(resolution);
     cmd.add_option_function<std::string>(
         "--bounds",
-        [&options](const std::string& text) { options.grid.bounds = parse_bounds(text); },
+        [&options](const std::string& text) { options.grid.bounds = parse_box(text, "--bounds"); },
         "Box to polygonize, xmin,ymin,zmin,xmax,ymax,zmax (default: the scene's "
         "bounds; required when the scene is unbounded, e.g. a half_space in a union)");
     add_fit_option(cmd, options.scans.field.fit,

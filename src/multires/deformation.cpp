@@ -5,6 +5,7 @@
 
 #include "pointform/core/disjoint_sets.h"
 #include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -456,13 +457,29 @@ std::vector<LevelMotion> level_motion(const MultiresMesh& before, const Multires
         const std::size_t first = before.level_offsets()[level];
         const std::size_t last = before.level_offsets()[level + 1];
         motion.vertices = last - first;
-        for (std::size_t v = first; v < last; ++v)
+        // Per block: how many moved and the largest move; combined in block order (a sum and a
+        // maximum: the same whatever the thread count).
+        constexpr std::size_t block = 16384;
+        const std::size_t blocks = (motion.vertices + block - 1) / block;
+        std::vector<std::pair<std::size_t, double>> partial(blocks, {0, 0.0});
+        parallel_blocks(blocks, 1, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t b = begin; b < end; ++b)
+                for (std::size_t v = first + b * block; v < std::min(last, first + (b + 1) * block);
+                     ++v)
+                {
+                    const auto id = static_cast<std::uint32_t>(v);
+                    if (before.positions()[v] == after.positions()[v] &&
+                        before.origin() == after.origin())
+                        continue;
+                    ++partial[b].first;
+                    partial[b].second =
+                        std::max(partial[b].second, (after.world(id) - before.world(id)).norm());
+                }
+        });
+        for (const auto& [moved, largest] : partial)
         {
-            const auto id = static_cast<std::uint32_t>(v);
-            if (before.positions()[v] == after.positions()[v] && before.origin() == after.origin())
-                continue;
-            ++motion.moved;
-            motion.largest = std::max(motion.largest, (after.world(id) - before.world(id)).norm());
+            motion.moved += moved;
+            motion.largest = std::max(motion.largest, largest);
         }
         out.push_back(motion);
     }

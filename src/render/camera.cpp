@@ -57,11 +57,27 @@ void validate(const RenderOptions& options)
             options.line_opacity, "[0, 1]");
     require(options.splat_radius >= 0.0 && std::isfinite(options.splat_radius), "splat_radius",
             options.splat_radius, ">= 0 (0 = automatic)");
+    require(!options.frame || (options.frame->min.allFinite() && options.frame->max.allFinite() &&
+                               !options.frame->is_empty()),
+            "frame", options.frame ? options.frame->diagonal() : 0.0,
+            "a finite box with min <= max");
     require(options.splat_scale > 0.0 && std::isfinite(options.splat_scale), "splat_scale",
             options.splat_scale, "> 0");
 }
 
 namespace detail {
+
+std::vector<Vec3f> box_corners(const Aabb& box)
+{
+    std::vector<Vec3f> corners;
+    const Vec3d half = 0.5 * (box.max - box.min);
+    for (int k = 0; k < 8; ++k)
+        corners.push_back(Vec3d((k & 1) != 0 ? half.x() : -half.x(),
+                                (k & 2) != 0 ? half.y() : -half.y(),
+                                (k & 4) != 0 ? half.z() : -half.z())
+                              .cast<float>());
+    return corners;
+}
 
 Camera fit_camera(std::span<const Vec3f> points, const RenderOptions& options)
 {

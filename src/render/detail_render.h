@@ -82,6 +82,10 @@ struct Camera
 /// unit around the centre.
 [[nodiscard]] Camera fit_camera(std::span<const Vec3f> points, const RenderOptions& options);
 
+/// The eight corners of `box` relative to its centre: what the camera fits to with
+/// RenderOptions::frame.
+[[nodiscard]] std::vector<Vec3f> box_corners(const Aabb& box);
+
 /// Two-sided Lambert with ambient, key light and headlight. `normal` need not face the viewer;
 /// `front` selects the colour.
 [[nodiscard]] inline Vec3d shade(const Camera& camera, const RenderOptions& options,

@@ -155,6 +155,8 @@ Image render_mesh(const TriMesh& mesh, const RenderOptions& options)
     for (std::size_t i = 0; i < vertex_count; ++i)
         if (used[i] != 0)
             box.extend(mesh.vertices.world(i));
+    if (options.frame)
+        box = *options.frame;
     const Vec3d shift = mesh.vertices.origin - box.center();
     // Embree reads vertices with 16-byte loads: one float of padding after the last.
     std::vector<float> vertices(3 * vertex_count + 1, 0.0F);
@@ -178,6 +180,8 @@ Image render_mesh(const TriMesh& mesh, const RenderOptions& options)
     for (std::size_t f = 0; f < face_count; ++f)
         std::copy(mesh.triangles[f].begin(), mesh.triangles[f].end(), indices.begin() + 3 * f);
 
+    if (options.frame)
+        fit_points = detail::box_corners(*options.frame);
     const detail::Camera camera = detail::fit_camera(fit_points, options);
     fit_points = {};
 

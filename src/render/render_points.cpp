@@ -119,12 +119,13 @@ Image render_points(const PointCloudView& cloud, const RenderOptions& options)
                            " samples each is too large; lower the size or the supersampling");
 
     const std::size_t n = cloud.size();
-    const Aabb box = cloud.bounds();
+    const Aabb box = options.frame ? *options.frame : cloud.bounds();
     const Vec3d shift = cloud.origin - box.center();
     std::vector<Vec3f> centers(n);
     for (std::size_t i = 0; i < n; ++i)
         centers[i] = (cloud.positions[i].cast<double>() + shift).cast<float>();
-    const detail::Camera camera = detail::fit_camera(centers, options);
+    const detail::Camera camera =
+        detail::fit_camera(options.frame ? detail::box_corners(*options.frame) : centers, options);
 
     const std::vector<Vec3f> normals = shading_normals(cloud, options);
     const std::vector<float> radii =

@@ -254,6 +254,30 @@ TEST(RenderMesh, WireframeLineWidthIsInPixels)
     EXPECT_NEAR(thick / thin, 2.0, 0.3);
 }
 
+TEST(RenderMesh, AFrameFixesTheCameraForSeveralObjects)
+{
+    // Orthographic front view: a unit sphere framed by the box [-2, 2]³ spans half the height it
+    // spans framed by itself, a quarter of the area; moved inside the same frame it keeps its
+    // size (the camera stays), and a frame that is not a box is refused.
+    RenderOptions options = front_orthographic();
+    options.supersampling = 1;
+    const auto pixels = [&](const TriMesh& mesh, const RenderOptions& o) {
+        return static_cast<double>(object_pixels(render_mesh(mesh, o), o));
+    };
+    const TriMesh sphere = test::icosphere(4, Vec3d::Zero(), 1.0);
+    const double alone = pixels(sphere, options);
+    Aabb frame;
+    frame.min = Vec3d::Constant(-2.0);
+    frame.max = Vec3d::Constant(2.0);
+    options.frame = frame;
+    const double framed = pixels(sphere, options);
+    EXPECT_NEAR(framed / alone, 0.25, 0.01);
+    EXPECT_NEAR(pixels(test::icosphere(4, Vec3d(0.5, 0.5, 0.5), 1.0), options), framed,
+                0.01 * framed);
+    options.frame->min.x() = 3.0;
+    EXPECT_THROW((void)render_mesh(sphere, options), InvalidInput);
+}
+
 TEST(RenderMesh, PerspectiveFramesTheObject)
 {
     // Any view: the object lies within the image, centred, touching the margin on one axis.

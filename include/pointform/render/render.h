@@ -4,11 +4,13 @@
 #pragma once
 
 #include "pointform/core/types.h"
+#include "pointform/geometry/aabb.h"
 #include "pointform/geometry/point_cloud.h"
 #include "pointform/geometry/tri_mesh.h"
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 namespace pointform {
@@ -40,6 +42,10 @@ struct RenderOptions
     Projection projection = Projection::Perspective;
     /// Perspective only: full opening angle, in degrees, across the image's shorter side (0..170).
     double field_of_view = 30.0;
+    /// Frame this world box (its eight corners) instead of the object: pictures of several
+    /// objects, such as a shape before and after an edit, then share one camera. Finite, with
+    /// min ≤ max on every axis.
+    std::optional<Aabb> frame;
     /// Empty border around the object, as a fraction of the image's half-size, in [0, 0.9).
     double margin = 0.05;
     /// Anti-aliasing: samples per pixel along each axis (s×s samples a pixel, box filter), 1..8.
