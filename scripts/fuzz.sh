@@ -48,23 +48,18 @@ done
 regressions read_fuzz readers
 "$harnesses/read_fuzz" -max_total_time="$readers_seconds" -max_len=65536 "${common[@]}" "$corpus"
 
-hierarchy_corpus=build/fuzz/corpus-hierarchy
-mkdir -p "$hierarchy_corpus"
-cp tests/fuzz/seeds/hierarchy/* "$hierarchy_corpus"/
-regressions hierarchy_fuzz hierarchy
-"$harnesses/hierarchy_fuzz" -max_total_time="$other_seconds" -max_len=65536 "${common[@]}" \
-  "$hierarchy_corpus"
-
-scene_corpus=build/fuzz/corpus-scene
-mkdir -p "$scene_corpus"
-cp tests/fuzz/seeds/scene/* "$scene_corpus"/
-regressions scene_fuzz scene
-"$harnesses/scene_fuzz" -max_total_time="$other_seconds" -max_len=16384 \
-  -dict=tests/fuzz/scene.dict "${common[@]}" "$scene_corpus"
-
-edit_corpus=build/fuzz/corpus-edit
-mkdir -p "$edit_corpus"
-cp tests/fuzz/seeds/edit/* "$edit_corpus"/
-regressions edit_fuzz edit
-"$harnesses/edit_fuzz" -max_total_time="$other_seconds" -max_len=16384 "${common[@]}" \
-  "$edit_corpus"
+# seeded NAME MAX_LEN [OPTIONS...]: fuzzes harness NAME_fuzz for other_seconds from the seeds in
+# tests/fuzz/seeds/NAME/, after the regressions named NAME-*.
+seeded() {
+  local name="$1" max_len="$2"
+  shift 2
+  local seed_corpus="build/fuzz/corpus-$name"
+  mkdir -p "$seed_corpus"
+  cp "tests/fuzz/seeds/$name"/* "$seed_corpus"/
+  regressions "${name}_fuzz" "$name"
+  "$harnesses/${name}_fuzz" -max_total_time="$other_seconds" -max_len="$max_len" "$@" \
+    "${common[@]}" "$seed_corpus"
+}
+seeded hierarchy 65536
+seeded scene 16384 -dict=tests/fuzz/scene.dict
+seeded edit 16384

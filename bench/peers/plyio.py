@@ -33,7 +33,7 @@ def _parse_header(path, f):
     if f.readline().strip() != b"ply":
         raise PlyError(f"{path}: not a PLY file (missing 'ply' magic)")
     fmt = None
-    elements = []  # [name, count, [(prop name, type or None for lists)]]
+    elements = []  # [name, count, [(prop name, type or None for lists, list types or None)]]
     while True:
         line = f.readline()
         if not line:
@@ -51,11 +51,13 @@ def _parse_header(path, f):
             if not elements:
                 raise PlyError(f"{path}: property before any element")
             if words[1] == "list":
-                elements[-1][2].append((words[4], None))
+                if words[2] not in _TYPES or words[3] not in _TYPES:
+                    raise PlyError(f"{path}: unsupported list types '{words[2]} {words[3]}'")
+                elements[-1][2].append((words[4], None, (_TYPES[words[2]], _TYPES[words[3]])))
             else:
                 if words[1] not in _TYPES:
                     raise PlyError(f"{path}: unsupported property type '{words[1]}'")
-                elements[-1][2].append((words[2], _TYPES[words[1]]))
+                elements[-1][2].append((words[2], _TYPES[words[1]], None))
     if fmt not in ("ascii", "binary_little_endian", "binary_big_endian"):
         raise PlyError(f"{path}: unsupported format '{fmt}'")
     return fmt, elements
@@ -70,26 +72,55 @@ def read_ply(path) -> dict:
             row = 0
             for name, count, props in elements:
                 if name == "vertex":
-                    if any(t is None for _, t in props):
+                    if any(t is None for _, t, _ in props):
                         raise PlyError(f"{path}: list property in the vertex element")
                     table = np.loadtxt(lines[row:row + count], ndmin=2,
                                        dtype=np.float64).reshape(count, len(props))
-                    return {p: table[:, i].astype(t) for i, (p, t) in enumerate(props)}
+                    return {p: table[:, i].astype(t) for i, (p, t, _) in enumerate(props)}
                 row += count
             raise PlyError(f"{path}: no vertex element")
         endian = "<" if fmt == "binary_little_endian" else ">"
         for name, count, props in elements:
-            if any(t is None for _, t in props):
+            if any(t is None for _, t, _ in props):
                 raise PlyError(f"{path}: list property in element '{name}' before the vertices")
-            dtype = np.dtype([(p, endian + t) for p, t in props])
+            dtype = np.dtype([(p, endian + t) for p, t, _ in props])
             if name != "vertex":
                 f.seek(count * dtype.itemsize, 1)
                 continue
             data = np.fromfile(f, dtype=dtype, count=count)
             if data.shape[0] != count:
                 raise PlyError(f"{path}: truncated ({data.shape[0]} of {count} vertices)")
-            return {p: data[p].astype(np.dtype(t)) for p, t in props}
+            return {p: data[p].astype(np.dtype(t)) for p, t, _ in props}
         raise PlyError(f"{path}: no vertex element")
+
+
+def read_mesh_ply(path) -> tuple[np.ndarray, np.ndarray]:
+    """A binary triangle mesh: vertex positions (N x 3 float64) and faces (F x 3 int64); the
+    vertex element's scalar properties and one list property of triangles in the face element
+    (what pointform's write_mesh and the CGAL peers write)."""
+    with open(path, "rb") as f:
+        fmt, elements = _parse_header(path, f)
+        if fmt == "ascii":
+            raise PlyError(f"{path}: only binary PLY meshes are read here")
+        endian = "<" if fmt == "binary_little_endian" else ">"
+        positions = faces = None
+        for name, count, props in elements:
+            if name == "vertex":
+                dtype = np.dtype([(p, endian + t) for p, t, _ in props])
+                v = np.fromfile(f, dtype=dtype, count=count)
+                positions = np.stack([v["x"], v["y"], v["z"]], axis=1).astype(np.float64)
+            elif name == "face" and len(props) == 1 and props[0][1] is None:
+                count_type, index_type = props[0][2]
+                dtype = np.dtype([("n", endian + count_type), ("i", endian + index_type, (3,))])
+                fc = np.fromfile(f, dtype=dtype, count=count)
+                if np.any(fc["n"] != 3):
+                    raise PlyError(f"{path}: faces that are not triangles")
+                faces = fc["i"].astype(np.int64)
+            else:
+                raise PlyError(f"{path}: unexpected element '{name}'")
+        if positions is None or faces is None:
+            raise PlyError(f"{path}: no vertices or no faces")
+        return positions, faces
 
 
 def write_ply(path, columns: dict, comment: str | None = None) -> None:

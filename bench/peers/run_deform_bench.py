@@ -48,6 +48,8 @@ from pathlib import Path
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+from plyio import read_mesh_ply  # noqa: E402  (a sibling module, found through the line above)
 REPO = HERE.parent.parent
 
 # ---------------------------------------------------------------------------------------------
@@ -112,55 +114,6 @@ def make_hierarchy(pointform: Path, source: Path, levels: int, vertices: int, pr
 
 # ---------------------------------------------------------------------------------------------
 # Meshes and the relief measure
-
-
-def read_mesh_ply(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """Binary little-endian PLY: vertex x y z (float or double), faces as uchar-counted triangles
-    of int or uint (what pointform's write_mesh and cgal_deform write)."""
-    types = {"float": "<f4", "double": "<f8", "int": "<i4", "uint": "<u4", "uchar": "u1",
-             "float32": "<f4", "float64": "<f8", "int32": "<i4", "uint32": "<u4",
-             "uint8": "u1"}
-    with open(path, "rb") as f:
-        if f.readline().strip() != b"ply":
-            raise ValueError(f"{path}: not a PLY file")
-        elements, fmt = [], None
-        while True:
-            line = f.readline().decode("ascii").strip()
-            if line == "end_header":
-                break
-            parts = line.split()
-            if not parts:
-                continue
-            if parts[0] == "format":
-                fmt = parts[1]
-            elif parts[0] == "element":
-                elements.append([parts[1], int(parts[2]), []])
-            elif parts[0] == "property":
-                elements[-1][2].append(parts[1:])
-        if fmt != "binary_little_endian":
-            raise ValueError(f"{path}: only binary_little_endian PLY is read here")
-        data = f.read()
-    offset = 0
-    positions = faces = None
-    for name, count, props in elements:
-        if name == "vertex":
-            dtype = np.dtype([(p[1], types[p[0]]) for p in props])
-            v = np.frombuffer(data, dtype=dtype, count=count, offset=offset)
-            offset += dtype.itemsize * count
-            positions = np.stack([v["x"], v["y"], v["z"]], axis=1).astype(np.float64)
-        elif name == "face":
-            if len(props) != 1 or props[0][0] != "list":
-                raise ValueError(f"{path}: unsupported face element")
-            index_type = types[props[0][2]]
-            dtype = np.dtype([("n", "u1"), ("i", index_type, (3,))])
-            fc = np.frombuffer(data, dtype=dtype, count=count, offset=offset)
-            if np.any(fc["n"] != 3):
-                raise ValueError(f"{path}: faces that are not triangles")
-            offset += dtype.itemsize * count
-            faces = fc["i"].astype(np.int64)
-        else:
-            raise ValueError(f"{path}: unexpected element {name}")
-    return positions, faces
 
 
 def vertex_normals(x: np.ndarray, faces: np.ndarray) -> np.ndarray:

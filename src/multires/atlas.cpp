@@ -1,0 +1,416 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/multires/atlas.h"
+
+#include "pointform/core/error.h"
+#include "pointform/core/memory.h"
+#include "pointform/core/parallel.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <numeric>
+#include <string>
+
+namespace pointform {
+
+namespace {
+
+/// A base triangle in its own plane: corner `first` at (0, 0), the next at (length, 0), the last
+/// at (apex_x, height), height > 0; `first` starts the longest edge.
+struct ChartShape
+{
+    int first = 0;
+    double length = 0.0;
+    double apex_x = 0.0;
+    double height = 0.0;
+};
+
+/// Shelf packing of the charts' boxes at `scale` texels a world unit: rows left to right, the
+/// tallest first; false if they do not fit in size × size. Fills `origin` (texel coordinates of
+/// each box's top-left corner).
+bool pack(std::span<const ChartShape> shapes, std::span<const std::uint32_t> order, double scale,
+          int size, int gutter, std::vector<Vec2d>& origin)
+{
+    const double side = size;
+    double x = 0.0;
+    double y = 0.0;
+    double row = 0.0;
+    for (const std::uint32_t f : order)
+    {
+        const double w = shapes[f].length * scale + gutter;
+        const double h = shapes[f].height * scale + gutter;
+        if (w > side)
+            return false;
+        if (x + w > side)
+        {
+            y += row;
+            x = 0.0;
+            row = 0.0;
+        }
+        origin[f] = Vec2d(x, y);
+        x += w;
+        row = std::max(row, h);
+        if (y + row > side)
+            return false;
+    }
+    return true;
+}
+
+std::size_t next_power_of_two(double value)
+{
+    return std::bit_ceil(static_cast<std::size_t>(std::ceil(std::max(value, 1.0))));
+}
+
+void check_levels(const MultiresMesh& mesh, std::span<const std::size_t> levels, const char* what)
+{
+    if (levels.empty())
+        throw InvalidInput(std::string(what) + ": no levels");
+    for (std::size_t i = 0; i < levels.size(); ++i)
+    {
+        if (levels[i] >= mesh.level_count())
+            throw InvalidInput(std::string(what) + ": level " + std::to_string(levels[i]) +
+                               " does not exist (the hierarchy has levels 0 to " +
+                               std::to_string(mesh.finest_level()) + ")");
+        if (i > 0 && levels[i] <= levels[i - 1])
+            throw InvalidInput(std::string(what) + ": the levels must increase");
+    }
+}
+
+/// (u, v) with v pointing up: the orientation in which charts are counter-clockwise.
+Vec2d upright(const Vec2d& uv)
+{
+    return {uv.x(), -uv.y()};
+}
+
+double cross2(const Vec2d& a, const Vec2d& b)
+{
+    return a.x() * b.y() - a.y() * b.x();
+}
+
+} // namespace
+
+Atlas make_atlas(const MultiresMesh& mesh, std::size_t level, const AtlasOptions& options)
+{
+    if (mesh.level_count() == 0)
+        throw InvalidInput("atlas: the hierarchy is empty");
+    if (level >= mesh.level_count())
+        throw InvalidInput("atlas: level " + std::to_string(level) +
+                           " does not exist (the hierarchy has levels 0 to " +
+                           std::to_string(mesh.finest_level()) + ")");
+    if (options.size != 0 && (options.size < min_atlas_size || options.size > max_atlas_size))
+        throw InvalidInput("atlas: texture size " + std::to_string(options.size) + " is outside " +
+                           std::to_string(min_atlas_size) + " to " +
+                           std::to_string(max_atlas_size));
+    if (options.gutter < 1 || options.gutter > 64)
+        throw InvalidInput("atlas: gutter " + std::to_string(options.gutter) +
+                           " is outside 1 to 64 texels");
+    const std::span<const Triangle> faces = mesh.base_faces();
+    std::vector<ChartShape> shapes(faces.size());
+    double largest = 0.0;
+    for (std::size_t f = 0; f < faces.size(); ++f)
+    {
+        std::array<Vec3d, 3> p;
+        for (int k = 0; k < 3; ++k)
+            p[static_cast<std::size_t>(k)] =
+                mesh.positions()[faces[f][static_cast<std::size_t>(k)]];
+        ChartShape& s = shapes[f];
+        for (int k = 0; k < 3; ++k)
+        {
+            const double l =
+                (p[static_cast<std::size_t>((k + 1) % 3)] - p[static_cast<std::size_t>(k)]).norm();
+            if (l > s.length)
+            {
+                s.length = l;
+                s.first = k;
+            }
+        }
+        const Vec3d& a = p[static_cast<std::size_t>(s.first)];
+        const Vec3d& b = p[static_cast<std::size_t>((s.first + 1) % 3)];
+        const Vec3d& c = p[static_cast<std::size_t>((s.first + 2) % 3)];
+        const Vec3d along = (b - a) / s.length;
+        s.apex_x = (c - a).dot(along);
+        s.height = (c - a).cross(along).norm();
+        if (!(s.height > 1e-12 * s.length) || !std::isfinite(s.height))
+            throw InvalidInput("atlas: base face " + std::to_string(f) +
+                               " has no area: it cannot be a chart");
+        largest = std::max(largest, s.length);
+    }
+
+    Atlas atlas;
+    atlas.gutter = options.gutter;
+    if (options.size != 0)
+        atlas.size = options.size;
+    else
+    {
+        // About 8 texels a face of the level, every chart at least 16 texels across, for a
+        // shelf packing that covers about 45% of the texture.
+        const double by_faces = std::sqrt(8.0 * static_cast<double>(mesh.face_count(level)) / 0.45);
+        const double by_charts = std::sqrt(128.0 * static_cast<double>(faces.size()) / 0.45);
+        atlas.size = static_cast<int>(
+            std::clamp<std::size_t>(next_power_of_two(std::max(by_faces, by_charts)), 256, 8192));
+    }
+    // The colour texture, a normal map and the baking's per-texel buffers.
+    const double texels = static_cast<double>(atlas.size) * atlas.size;
+    check_memory(texels * 40.0,
+                 "a texture of " + std::to_string(atlas.size) + " x " + std::to_string(atlas.size) +
+                     " texels",
+                 "choose a smaller --size");
+
+    // The tallest charts first; the largest scale at which the shelves fit (bisection).
+    std::vector<std::uint32_t> order(faces.size());
+    std::iota(order.begin(), order.end(), 0U);
+    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return shapes[a].height > shapes[b].height;
+    });
+    std::vector<Vec2d> origin(faces.size());
+    double lo = 0.0;
+    double hi = (atlas.size - atlas.gutter) / largest;
+    if (!pack(shapes, order, 0.0, atlas.size, atlas.gutter, origin))
+        throw InvalidInput("atlas: " + std::to_string(faces.size()) + " charts with gutters of " +
+                           std::to_string(atlas.gutter) + " texels do not fit in " +
+                           std::to_string(atlas.size) + " x " + std::to_string(atlas.size) +
+                           " texels; choose a larger --size");
+    for (int step = 0; step < 60; ++step)
+    {
+        const double mid = 0.5 * (lo + hi);
+        (pack(shapes, order, mid, atlas.size, atlas.gutter, origin) ? lo : hi) = mid;
+    }
+    (void)pack(shapes, order, lo, atlas.size, atlas.gutter, origin);
+    atlas.texels_per_unit = lo;
+
+    atlas.corners.resize(faces.size());
+    double covered = 0.0;
+    const double inset = 0.5 * atlas.gutter;
+    for (std::size_t f = 0; f < faces.size(); ++f)
+    {
+        const ChartShape& s = shapes[f];
+        const Vec2d o = origin[f] + Vec2d(inset, inset);
+        const double base_v = o.y() + s.height * lo; // v grows downwards: the edge at the bottom
+        auto& c = atlas.corners[f];
+        c[static_cast<std::size_t>(s.first)] = Vec2d(o.x(), base_v) / atlas.size;
+        c[static_cast<std::size_t>((s.first + 1) % 3)] =
+            Vec2d(o.x() + s.length * lo, base_v) / atlas.size;
+        c[static_cast<std::size_t>((s.first + 2) % 3)] =
+            Vec2d(o.x() + s.apex_x * lo, o.y()) / atlas.size;
+        covered += 0.5 * s.length * s.height * lo * lo;
+    }
+    atlas.texel_usage = covered / texels;
+    return atlas;
+}
+
+TexturedMesh textured_levels(const MultiresMesh& mesh, const Parameterization& parameterization,
+                             const Atlas& atlas, std::span<const std::size_t> levels)
+{
+    check_levels(mesh, levels, "textured_levels");
+    const std::size_t finest = levels.back();
+    const std::vector<Triangle> faces = mesh.faces(finest);
+    const unsigned shift = static_cast<unsigned>(2 * finest);
+
+    // One vertex per (vertex, chart) pair, sorted by vertex: vertex ids grow with the level, so
+    // each level's pairs are a prefix.
+    std::vector<std::uint64_t> keys;
+    keys.reserve(3 * faces.size() / 2 + 16);
+    for (std::size_t f = 0; f < faces.size(); ++f)
+    {
+        const auto chart = static_cast<std::uint64_t>(f >> shift);
+        for (const std::uint32_t v : faces[f])
+            keys.push_back((std::uint64_t{v} << 32) | chart);
+    }
+    parallel_sort(keys);
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    const auto index_of = [&](std::uint32_t v, std::uint64_t chart) {
+        const std::uint64_t key = (std::uint64_t{v} << 32) | chart;
+        return static_cast<std::uint32_t>(std::lower_bound(keys.begin(), keys.end(), key) -
+                                          keys.begin());
+    };
+
+    TexturedMesh out;
+    out.origin = mesh.origin();
+    const std::size_t n = keys.size();
+    out.positions.resize(n);
+    out.uvs.resize(n);
+    parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            const auto v = static_cast<std::uint32_t>(keys[i] >> 32);
+            const auto chart = static_cast<std::uint32_t>(keys[i] & 0xffffffffU);
+            out.positions[i] = mesh.positions()[v].cast<float>();
+            out.uvs[i] = atlas.uv(chart, parameterization.coordinates_in(chart, v)).cast<float>();
+        }
+    });
+    for (const std::size_t level : levels)
+    {
+        const std::vector<Triangle> level_faces = level == finest ? faces : mesh.faces(level);
+        const unsigned level_shift = static_cast<unsigned>(2 * level);
+        std::vector<Triangle> triangles(level_faces.size());
+        parallel_blocks(level_faces.size(), 4096, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t f = begin; f < end; ++f)
+                for (int k = 0; k < 3; ++k)
+                    triangles[f][static_cast<std::size_t>(k)] =
+                        index_of(level_faces[f][static_cast<std::size_t>(k)], f >> level_shift);
+        });
+        out.lods.push_back(std::move(triangles));
+        out.lod_vertex_counts.push_back(static_cast<std::size_t>(
+            std::lower_bound(keys.begin(), keys.end(),
+                             std::uint64_t{mesh.vertex_count(level)} << 32) -
+            keys.begin()));
+        out.lod_levels.push_back(level);
+    }
+
+    // Normals: area-weighted over the finest level's faces, per hierarchy vertex (serial sums:
+    // the same whatever the thread count). Tangents: per (vertex, chart), the area-weighted
+    // surface direction of +u, and the sign of image-up (−v).
+    const std::span<const Vec3d> x = mesh.positions();
+    std::vector<Vec3d> vertex_normal(mesh.vertex_count(finest), Vec3d::Zero());
+    std::vector<Vec3d> tangent(n, Vec3d::Zero());
+    std::vector<Vec3d> bitangent(n, Vec3d::Zero());
+    const std::vector<Triangle>& finest_triangles = out.lods.back();
+    for (std::size_t f = 0; f < faces.size(); ++f)
+    {
+        const Triangle& t = faces[f];
+        const Vec3d e1 = x[t[1]] - x[t[0]];
+        const Vec3d e2 = x[t[2]] - x[t[0]];
+        const Vec3d area_normal = e1.cross(e2);
+        for (const std::uint32_t v : t)
+            vertex_normal[v] += area_normal;
+        const Triangle& c = finest_triangles[f];
+        const Vec2d d1 = (out.uvs[c[1]] - out.uvs[c[0]]).cast<double>();
+        const Vec2d d2 = (out.uvs[c[2]] - out.uvs[c[0]]).cast<double>();
+        const double det = cross2(d1, d2);
+        if (det == 0.0)
+            continue;
+        const Vec3d along_u = (e1 * d2.y() - e2 * d1.y()) / det;
+        const Vec3d along_v = (e2 * d1.x() - e1 * d2.x()) / det;
+        const double weight = 0.5 * area_normal.norm();
+        for (const std::uint32_t i : c)
+        {
+            tangent[i] += weight * along_u;
+            bitangent[i] -= weight * along_v; // image up
+        }
+    }
+    out.normals.resize(n);
+    out.tangents.resize(n);
+    parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            const auto v = static_cast<std::uint32_t>(keys[i] >> 32);
+            Vec3d normal = vertex_normal[v];
+            normal = normal.norm() > 0.0 ? Vec3d(normal.normalized()) : Vec3d::UnitZ();
+            Vec3d t = tangent[i] - tangent[i].dot(normal) * normal;
+            if (!(t.norm() > 0.0))
+                t = normal.unitOrthogonal();
+            t.normalize();
+            const double w = normal.cross(t).dot(bitangent[i]) < 0.0 ? -1.0 : 1.0;
+            out.normals[i] = normal.cast<float>();
+            out.tangents[i] = Eigen::Vector4f(static_cast<float>(t.x()), static_cast<float>(t.y()),
+                                              static_cast<float>(t.z()), static_cast<float>(w));
+        }
+    });
+    return out;
+}
+
+std::vector<AtlasDistortion> atlas_distortion(const MultiresMesh& mesh,
+                                              const Parameterization& parameterization,
+                                              const Atlas& atlas,
+                                              std::span<const std::size_t> levels)
+{
+    check_levels(mesh, levels, "atlas_distortion");
+    std::vector<AtlasDistortion> out;
+    const std::span<const Vec3d> x = mesh.positions();
+    for (const std::size_t level : levels)
+    {
+        const std::vector<Triangle> faces = mesh.faces(level);
+        const unsigned shift = static_cast<unsigned>(2 * level);
+        struct FaceStretch
+        {
+            double area3 = 0.0; // surface area
+            double area2 = 0.0; // texture area (0 if flipped)
+            double sum2 = 0.0;  // (Γ² + γ²) / 2, unnormalised
+            double big = 0.0;   // Γ
+            double small = 0.0; // γ
+            bool flipped = false;
+        };
+        std::vector<FaceStretch> per(faces.size());
+        parallel_blocks(faces.size(), 4096, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t f = begin; f < end; ++f)
+            {
+                const auto chart = static_cast<std::uint32_t>(f >> shift);
+                std::array<Vec2d, 3> s;
+                for (int k = 0; k < 3; ++k)
+                    s[static_cast<std::size_t>(k)] =
+                        upright(atlas.uv(chart, parameterization.coordinates_in(
+                                                    chart, faces[f][static_cast<std::size_t>(k)])));
+                const Vec3d& q0 = x[faces[f][0]];
+                const Vec3d& q1 = x[faces[f][1]];
+                const Vec3d& q2 = x[faces[f][2]];
+                FaceStretch& r = per[f];
+                r.area3 = 0.5 * (q1 - q0).cross(q2 - q0).norm();
+                const double area2 = 0.5 * cross2(s[1] - s[0], s[2] - s[0]);
+                if (!(area2 > 0.0))
+                {
+                    r.flipped = true;
+                    continue;
+                }
+                r.area2 = area2;
+                // Sander et al.: the partial derivatives of the surface point along s and t.
+                const Vec3d ds = (q0 * (s[1].y() - s[2].y()) + q1 * (s[2].y() - s[0].y()) +
+                                  q2 * (s[0].y() - s[1].y())) /
+                                 (2.0 * area2);
+                const Vec3d dt = (q0 * (s[2].x() - s[1].x()) + q1 * (s[0].x() - s[2].x()) +
+                                  q2 * (s[1].x() - s[0].x())) /
+                                 (2.0 * area2);
+                const double a = ds.dot(ds);
+                const double b = ds.dot(dt);
+                const double c = dt.dot(dt);
+                const double root = std::sqrt((a - c) * (a - c) + 4.0 * b * b);
+                r.sum2 = 0.5 * (a + c);
+                r.big = std::sqrt(std::max(0.0, 0.5 * (a + c + root)));
+                r.small = std::sqrt(std::max(0.0, 0.5 * (a + c - root)));
+            }
+        });
+        AtlasDistortion d;
+        d.level = level;
+        d.faces = faces.size();
+        double total3 = 0.0;
+        double total2 = 0.0;
+        for (const FaceStretch& r : per)
+        {
+            total3 += r.area3;
+            total2 += r.area2;
+        }
+        // Normalise so that the texture's total area matches the surface's.
+        const double scale = total3 > 0.0 ? std::sqrt(total2 / total3) : 1.0;
+        double weighted = 0.0;
+        double weight = 0.0;
+        std::size_t measured = 0;
+        for (const FaceStretch& r : per)
+        {
+            if (r.flipped)
+            {
+                ++d.flipped;
+                continue;
+            }
+            weighted += r.area3 * r.sum2 * scale * scale;
+            weight += r.area3;
+            d.linf_stretch = std::max(d.linf_stretch, r.big * scale);
+            if (r.small > 0.0)
+            {
+                d.angle_distortion += r.big / r.small - 1.0;
+                d.area_distortion += std::abs(std::log(r.big * r.small * scale * scale));
+                ++measured;
+            }
+        }
+        d.l2_stretch = weight > 0.0 ? std::sqrt(weighted / weight) : 0.0;
+        if (measured > 0)
+        {
+            d.angle_distortion /= static_cast<double>(measured);
+            d.area_distortion /= static_cast<double>(measured);
+        }
+        out.push_back(d);
+    }
+    return out;
+}
+
+} // namespace pointform

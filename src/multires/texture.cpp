@@ -1,0 +1,366 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/multires/texture.h"
+
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+#include "pointform/spatial/kd_tree.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+
+namespace pointform {
+
+namespace {
+
+TextureImage blank(const Atlas& atlas)
+{
+    TextureImage image;
+    image.width = atlas.size;
+    image.height = atlas.size;
+    image.channels = 3;
+    image.pixels.assign(static_cast<std::size_t>(atlas.size) * atlas.size * 3, 0);
+    return image;
+}
+
+/// Calls texel(x, y, chart, barycentric) for every texel whose centre lies in a chart (its
+/// barycentric coordinates in the chart's base face), charts in parallel (they never share a
+/// texel: gutters of at least one texel lie between them).
+template <typename Texel>
+void for_each_chart_texel(const Atlas& atlas, Texel texel)
+{
+    const double size = atlas.size;
+    parallel_blocks(atlas.corners.size(), 8, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t f = begin; f < end; ++f)
+        {
+            const auto& c = atlas.corners[f];
+            const Vec2d a = c[0] * size;
+            const Vec2d b = c[1] * size;
+            const Vec2d d = c[2] * size;
+            const double area = (b - a).x() * (d - a).y() - (b - a).y() * (d - a).x();
+            if (area == 0.0)
+                continue;
+            const Vec2d lo = a.cwiseMin(b).cwiseMin(d);
+            const Vec2d hi = a.cwiseMax(b).cwiseMax(d);
+            const int x0 = std::max(0, static_cast<int>(std::floor(lo.x())));
+            const int y0 = std::max(0, static_cast<int>(std::floor(lo.y())));
+            const int x1 = std::min(atlas.size - 1, static_cast<int>(std::ceil(hi.x())));
+            const int y1 = std::min(atlas.size - 1, static_cast<int>(std::ceil(hi.y())));
+            for (int y = y0; y <= y1; ++y)
+                for (int x = x0; x <= x1; ++x)
+                {
+                    const Vec2d p(x + 0.5, y + 0.5);
+                    const double w1 =
+                        ((p - a).x() * (d - a).y() - (p - a).y() * (d - a).x()) / area;
+                    const double w2 =
+                        ((b - a).x() * (p - a).y() - (b - a).y() * (p - a).x()) / area;
+                    const double w0 = 1.0 - w1 - w2;
+                    if (w0 < 0.0 || w1 < 0.0 || w2 < 0.0)
+                        continue;
+                    texel(x, y, static_cast<std::uint32_t>(f), Vec3d(w0, w1, w2));
+                }
+        }
+    });
+}
+
+std::size_t texel_index(const TextureImage& image, int x, int y)
+{
+    return (static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width) +
+            static_cast<std::size_t>(x)) *
+           static_cast<std::size_t>(image.channels);
+}
+
+std::uint8_t to_byte(double value)
+{
+    return static_cast<std::uint8_t>(std::clamp(std::lround(value), 0L, 255L));
+}
+
+/// Bilinear sample of channel values at texture coordinates (u, v), clamped at the borders.
+Vec3d sample(const TextureImage& image, const Vec2d& uv)
+{
+    const double x = std::clamp(uv.x() * image.width - 0.5, 0.0, image.width - 1.0);
+    const double y = std::clamp(uv.y() * image.height - 0.5, 0.0, image.height - 1.0);
+    const int x0 = static_cast<int>(x);
+    const int y0 = static_cast<int>(y);
+    const int x1 = std::min(x0 + 1, image.width - 1);
+    const int y1 = std::min(y0 + 1, image.height - 1);
+    const double fx = x - x0;
+    const double fy = y - y0;
+    Vec3d out = Vec3d::Zero();
+    for (int c = 0; c < 3; ++c)
+    {
+        const int channel = std::min(c, image.channels - 1);
+        const auto at = [&](int px, int py) {
+            return static_cast<double>(image.pixels[texel_index(image, px, py) + channel]);
+        };
+        out[c] = (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) +
+                 fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
+    }
+    return out;
+}
+
+/// Area-weighted unit vertex normals of one level (serial sums: thread-count independent).
+std::vector<Vec3d> level_normals(const MultiresMesh& mesh, std::size_t level)
+{
+    const std::vector<Triangle> faces = mesh.faces(level);
+    const std::span<const Vec3d> x = mesh.positions();
+    std::vector<Vec3d> normals(mesh.vertex_count(level), Vec3d::Zero());
+    for (const Triangle& t : faces)
+    {
+        const Vec3d n = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
+        for (const std::uint32_t v : t)
+            normals[v] += n;
+    }
+    for (Vec3d& n : normals)
+        n = n.norm() > 0.0 ? Vec3d(n.normalized()) : Vec3d::UnitZ();
+    return normals;
+}
+
+void check_level(const MultiresMesh& mesh, std::size_t level, const char* what)
+{
+    if (level >= mesh.level_count())
+        throw InvalidInput(std::string(what) + ": level " + std::to_string(level) +
+                           " does not exist (the hierarchy has levels 0 to " +
+                           std::to_string(mesh.level_count() == 0 ? 0 : mesh.finest_level()) + ")");
+}
+
+} // namespace
+
+std::size_t dilate(TextureImage& image, std::vector<std::uint8_t>& mask, int rounds)
+{
+    std::size_t filled = 0;
+    const int w = image.width;
+    const int h = image.height;
+    const int channels = image.channels;
+    for (int round = 0; round < rounds; ++round)
+    {
+        std::vector<std::uint8_t> next = mask;
+        std::vector<std::uint8_t> pixels = image.pixels;
+        std::size_t this_round = 0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+            {
+                const std::size_t i = static_cast<std::size_t>(y) * w + x;
+                if (mask[i] != 0)
+                    continue;
+                std::array<int, 4> sum{};
+                int count = 0;
+                const std::array<std::pair<int, int>, 4> around = {
+                    std::pair{x - 1, y}, std::pair{x + 1, y}, std::pair{x, y - 1},
+                    std::pair{x, y + 1}};
+                for (const auto& [nx, ny] : around)
+                {
+                    if (nx < 0 || ny < 0 || nx >= w || ny >= h)
+                        continue;
+                    const std::size_t j = static_cast<std::size_t>(ny) * w + nx;
+                    if (mask[j] == 0)
+                        continue;
+                    for (int c = 0; c < channels; ++c)
+                        sum[static_cast<std::size_t>(c)] +=
+                            image.pixels[j * static_cast<std::size_t>(channels) + c];
+                    ++count;
+                }
+                if (count == 0)
+                    continue;
+                for (int c = 0; c < channels; ++c)
+                    pixels[i * static_cast<std::size_t>(channels) + c] = static_cast<std::uint8_t>(
+                        (sum[static_cast<std::size_t>(c)] + count / 2) / count);
+                next[i] = 1;
+                ++this_round;
+            }
+        mask.swap(next);
+        image.pixels.swap(pixels);
+        filled += this_round;
+        if (this_round == 0)
+            break;
+    }
+    return filled;
+}
+
+TextureImage checker_texture(const Atlas& atlas, int square)
+{
+    if (square <= 0)
+        square = std::max(2, atlas.size / 64);
+    TextureImage image = blank(atlas);
+    for (int y = 0; y < atlas.size; ++y)
+        for (int x = 0; x < atlas.size; ++x)
+        {
+            const bool dark = ((x / square) + (y / square)) % 2 == 0;
+            const std::size_t i = texel_index(image, x, y);
+            image.pixels[i] = dark ? 70 : 225;
+            image.pixels[i + 1] = dark ? 80 : 225;
+            image.pixels[i + 2] = dark ? 110 : 215;
+        }
+    return image;
+}
+
+TextureImage atlas_image(const Atlas& atlas, const TextureImage& image)
+{
+    if (image.empty() || image.width <= 0 || image.height <= 0)
+        throw InvalidInput("texture: the image is empty");
+    TextureImage out = blank(atlas);
+    parallel_blocks(static_cast<std::size_t>(atlas.size), 16,
+                    [&](std::size_t begin, std::size_t end) {
+                        for (std::size_t y = begin; y < end; ++y)
+                            for (int x = 0; x < atlas.size; ++x)
+                            {
+                                const Vec2d uv((x + 0.5) / atlas.size,
+                                               (static_cast<double>(y) + 0.5) / atlas.size);
+                                const Vec3d c = sample(image, uv);
+                                const std::size_t i = texel_index(out, x, static_cast<int>(y));
+                                for (int k = 0; k < 3; ++k)
+                                    out.pixels[i + static_cast<std::size_t>(k)] = to_byte(c[k]);
+                            }
+                    });
+    return out;
+}
+
+TextureImage bake_colors(const MultiresMesh& mesh, const Parameterization& parameterization,
+                         const Atlas& atlas, std::size_t level, const PointCloudView& samples,
+                         const BakeOptions& options, BakeReport* report)
+{
+    check_level(mesh, level, "bake_colors");
+    if (samples.size() == 0)
+        throw InvalidInput("bake_colors: the samples are empty");
+    if (!samples.has_colors())
+        throw InvalidInput("bake_colors: the samples have no colours (red, green, blue)");
+    if (options.neighbors == 0 || options.neighbors > 64)
+        throw InvalidInput("bake_colors: neighbors must lie in 1 to 64");
+    const KdTree tree(samples.positions);
+    const std::size_t k = std::min(options.neighbors, samples.size());
+    const std::vector<Triangle> faces = mesh.faces(level);
+    const std::span<const Vec3d> x = mesh.positions();
+    const Vec3d shift = mesh.origin() - samples.origin;
+
+    TextureImage image = blank(atlas);
+    std::vector<std::uint8_t> mask(static_cast<std::size_t>(atlas.size) * atlas.size, 0);
+    std::vector<double> distance(mask.size(), 0.0);
+    for_each_chart_texel(atlas, [&](int tx, int ty, std::uint32_t chart, const Vec3d& beta) {
+        const Parameterization::Location at = Parameterization::locate(chart, beta, level);
+        const Triangle& t = faces[at.face];
+        const Vec3d p = at.barycentric.x() * x[t[0]] + at.barycentric.y() * x[t[1]] +
+                        at.barycentric.z() * x[t[2]] + shift;
+        std::array<std::uint32_t, 64> ids{};
+        std::array<float, 64> d2{};
+        const std::size_t found =
+            tree.knn(p.cast<float>(), k, std::span(ids).first(k), std::span(d2).first(k));
+        Vec3d colour = Vec3d::Zero();
+        double total = 0.0;
+        const double eps = 1e-12 + 1e-6 * std::sqrt(static_cast<double>(d2[found - 1]));
+        for (std::size_t i = 0; i < found; ++i)
+        {
+            const double w = 1.0 / std::pow(std::sqrt(static_cast<double>(d2[i])) + eps, 2.0);
+            const Color& c = samples.colors[ids[i]];
+            colour += w * Vec3d(c.r, c.g, c.b);
+            total += w;
+        }
+        colour /= total;
+        const std::size_t i = texel_index(image, tx, ty);
+        for (int c = 0; c < 3; ++c)
+            image.pixels[i + static_cast<std::size_t>(c)] = to_byte(colour[c]);
+        const std::size_t m = static_cast<std::size_t>(ty) * atlas.size + tx;
+        mask[m] = 1;
+        distance[m] = std::sqrt(static_cast<double>(d2[0]));
+    });
+    BakeReport r;
+    double distance_sum = 0.0;
+    for (std::size_t m = 0; m < mask.size(); ++m)
+        if (mask[m] != 0)
+        {
+            ++r.texels;
+            distance_sum += distance[m];
+        }
+    r.mean_distance = r.texels > 0 ? distance_sum / static_cast<double>(r.texels) : 0.0;
+    r.dilated = dilate(image, mask, atlas.gutter + 1);
+
+    if (report != nullptr)
+    {
+        // Each sample against the texture at the nearest vertex of the level.
+        std::vector<Vec3f> vertices(mesh.vertex_count(level));
+        for (std::size_t v = 0; v < vertices.size(); ++v)
+            vertices[v] = (x[v] + shift).cast<float>();
+        const KdTree near(vertices);
+        std::vector<double> squared(samples.size(), 0.0);
+        parallel_blocks(samples.size(), 4096, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t s = begin; s < end; ++s)
+            {
+                const PointId v = near.nearest(samples.positions[s]);
+                const BaseCoordinates& bc = parameterization.coordinates()[v.value];
+                const Vec3d baked = sample(image, atlas.uv(bc.face, bc.barycentric));
+                const Color& c = samples.colors[s];
+                squared[s] = (baked - Vec3d(c.r, c.g, c.b)).squaredNorm() / 3.0;
+            }
+        });
+        double sum = 0.0;
+        for (const double q : squared)
+            sum += q;
+        r.rms_color_error = std::sqrt(sum / static_cast<double>(samples.size()));
+        *report = r;
+    }
+    return image;
+}
+
+TextureImage bake_normal_map(const MultiresMesh& mesh, const Parameterization& parameterization,
+                             const Atlas& atlas, const TexturedMesh& coarse, std::size_t fine)
+{
+    if (coarse.lods.size() != 1 || coarse.lod_levels.size() != 1 || coarse.normals.empty() ||
+        coarse.tangents.empty())
+        throw InvalidInput(
+            "bake_normal_map: the coarse mesh must be one textured level with "
+            "normals and tangents");
+    const std::size_t level = coarse.lod_levels[0];
+    check_level(mesh, fine, "bake_normal_map");
+    if (fine <= level)
+        throw InvalidInput("bake_normal_map: the fine level " + std::to_string(fine) +
+                           " must be finer than the textured level " + std::to_string(level));
+    (void)parameterization;
+    const std::vector<Triangle> fine_faces = mesh.faces(fine);
+    const std::vector<Vec3d> fine_normals = level_normals(mesh, fine);
+    const std::vector<Triangle>& coarse_faces = coarse.lods[0];
+
+    // Texels outside every chart (beyond the dilated gutters) hold the unperturbed normal.
+    TextureImage image = blank(atlas);
+    for (std::size_t i = 0; i < image.pixels.size(); i += 3)
+    {
+        image.pixels[i] = 128;
+        image.pixels[i + 1] = 128;
+        image.pixels[i + 2] = 255;
+    }
+    std::vector<std::uint8_t> mask(static_cast<std::size_t>(atlas.size) * atlas.size, 0);
+    for_each_chart_texel(atlas, [&](int tx, int ty, std::uint32_t chart, const Vec3d& beta) {
+        const Parameterization::Location at_coarse = Parameterization::locate(chart, beta, level);
+        const Parameterization::Location at_fine = Parameterization::locate(chart, beta, fine);
+        const Triangle& c = coarse_faces[at_coarse.face];
+        const Vec3d& m = at_coarse.barycentric;
+        Vec3d normal = Vec3d::Zero();
+        Vec3d tangent = Vec3d::Zero();
+        for (int k = 0; k < 3; ++k)
+        {
+            const std::uint32_t i = c[static_cast<std::size_t>(k)];
+            normal += m[k] * coarse.normals[i].cast<double>();
+            tangent += m[k] * coarse.tangents[i].head<3>().cast<double>();
+        }
+        normal.normalize();
+        tangent -= tangent.dot(normal) * normal;
+        tangent = tangent.norm() > 0.0 ? Vec3d(tangent.normalized()) : normal.unitOrthogonal();
+        const Vec3d bitangent =
+            normal.cross(tangent) * static_cast<double>(coarse.tangents[c[0]].w());
+        const Triangle& f = fine_faces[at_fine.face];
+        const Vec3d& u = at_fine.barycentric;
+        const Vec3d n =
+            (u.x() * fine_normals[f[0]] + u.y() * fine_normals[f[1]] + u.z() * fine_normals[f[2]])
+                .normalized();
+        const Vec3d local(n.dot(tangent), n.dot(bitangent), n.dot(normal));
+        const std::size_t i = texel_index(image, tx, ty);
+        for (int k = 0; k < 3; ++k)
+            image.pixels[i + static_cast<std::size_t>(k)] = to_byte(127.5 * (local[k] + 1.0));
+        mask[static_cast<std::size_t>(ty) * atlas.size + tx] = 1;
+    });
+    (void)dilate(image, mask, atlas.gutter + 1);
+    return image;
+}
+
+} // namespace pointform
