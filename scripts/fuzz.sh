@@ -2,19 +2,19 @@
 # SPDX-License-Identifier: MIT
 # Builds the libFuzzer harnesses (Clang, ASan + UBSan) and fuzzes for SECONDS in all (default
 # 60): every reader (half the time, seeded with the small files in data/), the hierarchy reader,
-# the scene language and the edit and lattice files of `deform` (a sixth each, seeded from
-# tests/fuzz/seeds/). Fails on any crash, hang or sanitizer report.
+# the scene language, the edit and lattice files of `deform` and the PNG decoder (an eighth each,
+# at most, seeded from tests/fuzz/seeds/). Fails on any crash, hang or sanitizer report.
 #   bash scripts/fuzz.sh [SECONDS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-60}"
 readers_seconds=$(( (seconds + 1) / 2 ))
-other_seconds=$(( (seconds - readers_seconds + 2) / 3 ))
+other_seconds=$(( (seconds - readers_seconds) / 4 ))
 other_seconds=$(( other_seconds > 0 ? other_seconds : 1 ))
 
 bash scripts/setup.sh --fuzz
 cmake --preset fuzz
-cmake --build --preset fuzz --target read_fuzz hierarchy_fuzz scene_fuzz edit_fuzz
+cmake --build --preset fuzz --target read_fuzz hierarchy_fuzz scene_fuzz edit_fuzz png_fuzz
 harnesses=build/fuzz/tests/fuzz
 common=(-timeout=10 -rss_limit_mb=4096 -print_final_stats=1 -artifact_prefix=build/fuzz/)
 # regressions HARNESS PREFIX: runs the inputs in tests/fuzz/regressions/ that once found a bug in
@@ -23,7 +23,7 @@ regressions() {
   local files=()
   if [[ "$2" == readers ]]; then
     mapfile -d '' files < <(find tests/fuzz/regressions -maxdepth 1 -type f \
-      ! -name 'hierarchy-*' ! -name 'scene-*' ! -name 'edit-*' -print0 | sort -z)
+      ! -name 'hierarchy-*' ! -name 'scene-*' ! -name 'edit-*' ! -name 'png-*' -print0 | sort -z)
   else
     mapfile -d '' files < <(find tests/fuzz/regressions -maxdepth 1 -type f -name "$2-*" -print0 |
       sort -z)
@@ -63,3 +63,4 @@ seeded() {
 seeded hierarchy 65536
 seeded scene 16384 -dict=tests/fuzz/scene.dict
 seeded edit 16384
+seeded png 65536

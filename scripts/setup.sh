@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # Installs everything pointform needs from Debian 12 packages. Run as root (or with sudo).
+# Then installs the Khronos glTF validator (npm gltf-validator, pinned by
+# tests/gltf/package-lock.json) into tests/gltf/node_modules with `npm ci`, for the test
+# gltf_validator; Node.js and npm come from Debian (nodejs, npm) unless node and npm are there.
 #   bash scripts/setup.sh          build and test dependencies
 #   bash scripts/setup.sh --peers  also the peers of the side-by-side benchmarks (Open3D, CGAL)
 #   bash scripts/setup.sh --fuzz   also Clang and libFuzzer for scripts/fuzz.sh
@@ -9,7 +12,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libnanoflann-dev libcli11-dev nlohmann-json3-dev
-  libembree-dev libstb-dev libopenmesh-dev
+  libembree-dev libpng-dev libopenmesh-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format
   python3 python3-dev python3-numpy python3-pybind11 python3-pytest
@@ -21,19 +24,38 @@ case "${1:-}" in
   *) echo "setup: unknown option $1 (expected --peers or --fuzz)" >&2; exit 2 ;;
 esac
 
+# Node.js and npm (the glTF validator's runtime): Debian's, unless both are already on the PATH
+# (another build of Node.js, such as NodeSource's, which Debian's npm package would conflict with).
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  packages+=(nodejs npm)
+fi
+
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if ((${#missing[@]} == 0)); then
   echo "setup: all ${#packages[@]} packages already installed"
-  exit 0
+else
+  sudo_cmd=()
+  if [[ $(id -u) -ne 0 ]]; then
+    sudo_cmd=(sudo)
+  fi
+  echo "setup: installing ${missing[*]}"
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-sudo_cmd=()
-if [[ $(id -u) -ne 0 ]]; then
-  sudo_cmd=(sudo)
+# The glTF validator, exactly as tests/gltf/package-lock.json pins it; again only when the lock
+# file changed since the last install. Without it the test gltf_validator reports "skipped".
+gltf_dir="$(dirname "$0")/../tests/gltf"
+installed_lock="$gltf_dir/node_modules/.package-lock.json"
+if [[ ! -f "$gltf_dir/node_modules/gltf-validator/package.json" ||
+      "$gltf_dir/package-lock.json" -nt "$installed_lock" ]]; then
+  echo "setup: installing the glTF validator (npm ci in tests/gltf)"
+  if ! (cd "$gltf_dir" && npm ci --no-audit --no-fund --loglevel=error); then
+    echo "setup: warning: npm ci failed in tests/gltf; the test gltf_validator will be skipped" >&2
+  fi
+else
+  echo "setup: glTF validator already installed (tests/gltf/node_modules)"
 fi
-echo "setup: installing ${missing[*]}"
-"${sudo_cmd[@]}" apt-get update -qq
-DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -3,9 +3,10 @@
 # Builds and runs the whole test suite.
 #   bash scripts/test.sh         release build (build/release)
 #   bash scripts/test.sh asan    AddressSanitizer + UndefinedBehaviorSanitizer build (build/asan)
-# The release build also runs the Python package's pytest suite (python/tests) with Debian's
-# /usr/bin/python3; the asan build has no Python module (an instrumented extension cannot load
-# into an uninstrumented interpreter).
+# ctest includes gltf_validator (the Khronos glTF validator, which setup.sh installs with npm ci;
+# "skipped" without node or the validator). The release build also runs the Python package's
+# pytest suite (python/tests) with Debian's /usr/bin/python3; the asan build has no Python module
+# (an instrumented extension cannot load into an uninstrumented interpreter).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset="${1:-release}"

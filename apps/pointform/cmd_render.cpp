@@ -43,20 +43,6 @@ struct RenderCommandOptions
     bool json = false;
 };
 
-/// Parses "A,B" into two numbers. \throw CLI::ValidationError naming the option.
-std::pair<double, double> parse_pair(const std::string& text, const std::string& option,
-                                     const std::string& expected)
-{
-    std::istringstream in(text);
-    double a = 0.0;
-    double b = 0.0;
-    char comma = 0;
-    if (!(in >> a >> comma >> b) || comma != ',' || !(in >> std::ws).eof() || !std::isfinite(a) ||
-        !std::isfinite(b))
-        throw CLI::ValidationError(option, "expected " + expected + ", got '" + text + "'");
-    return {a, b};
-}
-
 /// Parses --size "W,H": whole numbers of pixels, 1..16384 each.
 std::pair<int, int> parse_size(const std::string& text)
 {

@@ -171,4 +171,17 @@ Aabb parse_box(const std::string& text, const std::string& option)
     return box;
 }
 
+std::pair<double, double> parse_pair(const std::string& text, const std::string& option,
+                                     const std::string& expected)
+{
+    std::istringstream in(text);
+    double a = 0.0;
+    double b = 0.0;
+    char comma = 0;
+    if (!(in >> a >> comma >> b) || comma != ',' || !(in >> std::ws).eof() || !std::isfinite(a) ||
+        !std::isfinite(b))
+        throw CLI::ValidationError(option, "expected " + expected + ", got '" + text + "'");
+    return {a, b};
+}
+
 } // namespace pointform::cli

@@ -79,6 +79,12 @@ void print_timings(const Timings& timings);
 /// maximum) for `option`. \throw CLI::ValidationError naming the option
 [[nodiscard]] Aabb parse_box(const std::string& text, const std::string& option);
 
+/// \brief Parses "A,B" into two finite numbers for `option`; `expected` describes them.
+/// \throw CLI::ValidationError naming the option
+[[nodiscard]] std::pair<double, double> parse_pair(const std::string& text,
+                                                   const std::string& option,
+                                                   const std::string& expected);
+
 /// \brief Parses "X,Y,Z" into a vector. \throw CLI::ValidationError on malformed input.
 [[nodiscard]] Vec3d parse_vec3(const std::string& text, const std::string& what);
 
@@ -99,6 +105,8 @@ void register_distance(CLI::App& app, const GlobalOptions& global);
 void register_model(CLI::App& app, const GlobalOptions& global);
 void register_morph(CLI::App& app, const GlobalOptions& global);
 void register_lod(CLI::App& app, const GlobalOptions& global);
+void register_export(CLI::App& app, const GlobalOptions& global);
+void register_texture(CLI::App& app, const GlobalOptions& global);
 void register_deform(CLI::App& app, const GlobalOptions& global);
 void register_reconstruct(CLI::App& app, const GlobalOptions& global);
 void register_remesh(CLI::App& app, const GlobalOptions& global);

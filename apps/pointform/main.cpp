@@ -77,6 +77,8 @@ int run(int argc, char** argv)
     pointform::cli::register_model(app, global);
     pointform::cli::register_morph(app, global);
     pointform::cli::register_lod(app, global);
+    pointform::cli::register_export(app, global);
+    pointform::cli::register_texture(app, global);
     pointform::cli::register_deform(app, global);
     pointform::cli::register_reconstruct(app, global);
     pointform::cli::register_remesh(app, global);

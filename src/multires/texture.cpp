@@ -78,30 +78,6 @@ std::uint8_t to_byte(double value)
     return static_cast<std::uint8_t>(std::clamp(std::lround(value), 0L, 255L));
 }
 
-/// Bilinear sample of channel values at texture coordinates (u, v), clamped at the borders.
-Vec3d sample(const TextureImage& image, const Vec2d& uv)
-{
-    const double x = std::clamp(uv.x() * image.width - 0.5, 0.0, image.width - 1.0);
-    const double y = std::clamp(uv.y() * image.height - 0.5, 0.0, image.height - 1.0);
-    const int x0 = static_cast<int>(x);
-    const int y0 = static_cast<int>(y);
-    const int x1 = std::min(x0 + 1, image.width - 1);
-    const int y1 = std::min(y0 + 1, image.height - 1);
-    const double fx = x - x0;
-    const double fy = y - y0;
-    Vec3d out = Vec3d::Zero();
-    for (int c = 0; c < 3; ++c)
-    {
-        const int channel = std::min(c, image.channels - 1);
-        const auto at = [&](int px, int py) {
-            return static_cast<double>(image.pixels[texel_index(image, px, py) + channel]);
-        };
-        out[c] = (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) +
-                 fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
-    }
-    return out;
-}
-
 /// Area-weighted unit vertex normals of one level (serial sums: thread-count independent).
 std::vector<Vec3d> level_normals(const MultiresMesh& mesh, std::size_t level)
 {
@@ -209,7 +185,7 @@ TextureImage atlas_image(const Atlas& atlas, const TextureImage& image)
                             {
                                 const Vec2d uv((x + 0.5) / atlas.size,
                                                (static_cast<double>(y) + 0.5) / atlas.size);
-                                const Vec3d c = sample(image, uv);
+                                const Vec3d c = sample_texture(image, uv);
                                 const std::size_t i = texel_index(out, x, static_cast<int>(y));
                                 for (int k = 0; k < 3; ++k)
                                     out.pixels[i + static_cast<std::size_t>(k)] = to_byte(c[k]);
@@ -289,7 +265,7 @@ TextureImage bake_colors(const MultiresMesh& mesh, const Parameterization& param
             {
                 const PointId v = near.nearest(samples.positions[s]);
                 const BaseCoordinates& bc = parameterization.coordinates()[v.value];
-                const Vec3d baked = sample(image, atlas.uv(bc.face, bc.barycentric));
+                const Vec3d baked = sample_texture(image, atlas.uv(bc.face, bc.barycentric));
                 const Color& c = samples.colors[s];
                 squared[s] = (baked - Vec3d(c.r, c.g, c.b)).squaredNorm() / 3.0;
             }
@@ -361,6 +337,63 @@ TextureImage bake_normal_map(const MultiresMesh& mesh, const Parameterization& p
     });
     (void)dilate(image, mask, atlas.gutter + 1);
     return image;
+}
+
+} // namespace pointform
+
+namespace pointform {
+
+TextureOutcome texture_hierarchy(const MultiresMesh& mesh, const TextureRequest& request,
+                                 const PointCloudView* samples)
+{
+    if (mesh.level_count() == 0)
+        throw InvalidInput("texture: the hierarchy is empty");
+    TextureOutcome out;
+    out.level = request.level.value_or(mesh.finest_level());
+    check_level(mesh, out.level, "texture");
+    if (request.normal_map_level && *request.normal_map_level >= out.level)
+        throw InvalidInput("texture: the normal map's level " +
+                           std::to_string(*request.normal_map_level) +
+                           " must be coarser than the textured level " + std::to_string(out.level));
+    if (request.source == TextureRequest::Source::BakeColors &&
+        (samples == nullptr || !samples->has_colors()))
+        throw InvalidInput(
+            "texture: baking colours needs a scan with colours (red, green, "
+            "blue)");
+    if (request.source == TextureRequest::Source::Image && request.image.empty())
+        throw InvalidInput("texture: the image is empty");
+
+    const Parameterization parameterization(mesh);
+    out.atlas = make_atlas(mesh, out.level, request.atlas);
+    std::vector<std::size_t> levels;
+    if (request.normal_map_level)
+        levels.push_back(*request.normal_map_level);
+    else
+        for (std::size_t l = 0; l <= out.level; ++l)
+            levels.push_back(l);
+    out.mesh = textured_levels(mesh, parameterization, out.atlas, levels);
+    out.distortion = atlas_distortion(mesh, parameterization, out.atlas, levels);
+    switch (request.source)
+    {
+        case TextureRequest::Source::Checker:
+            out.mesh.base_color = checker_texture(out.atlas);
+            break;
+        case TextureRequest::Source::Image:
+            out.mesh.base_color = atlas_image(out.atlas, request.image);
+            break;
+        case TextureRequest::Source::BakeColors:
+        {
+            BakeReport report;
+            out.mesh.base_color = bake_colors(mesh, parameterization, out.atlas, out.level,
+                                              *samples, request.bake, &report);
+            out.bake = report;
+            break;
+        }
+    }
+    if (request.normal_map_level)
+        out.mesh.normal_map =
+            bake_normal_map(mesh, parameterization, out.atlas, out.mesh, out.level);
+    return out;
 }
 
 } // namespace pointform

@@ -88,14 +88,18 @@ struct Camera
 
 /// Two-sided Lambert with ambient, key light and headlight. `normal` need not face the viewer;
 /// `front` selects the colour.
+[[nodiscard]] inline double shade_intensity(const Camera& camera, const RenderOptions& options,
+                                            const Vec3d& normal, const Vec3d& ray_direction)
+{
+    return options.ambient + options.key_light * std::abs(normal.dot(camera.key_light)) +
+           options.headlight * std::abs(normal.dot(ray_direction));
+}
+
 [[nodiscard]] inline Vec3d shade(const Camera& camera, const RenderOptions& options,
                                  const Vec3d& normal, const Vec3d& ray_direction, bool front)
 {
-    const double intensity = options.ambient +
-                             options.key_light * std::abs(normal.dot(camera.key_light)) +
-                             options.headlight * std::abs(normal.dot(ray_direction));
     const Color c = front ? options.front_color : options.back_color;
-    return Vec3d(c.r, c.g, c.b) * intensity;
+    return Vec3d(c.r, c.g, c.b) * shade_intensity(camera, options, normal, ray_direction);
 }
 
 [[nodiscard]] inline Vec3d to_vec(const Color& c)

@@ -1,44 +1,31 @@
 // SPDX-License-Identifier: MIT
 // Copyright (c) 2026 the pointform authors
 
+// render's PNG output goes through the io module's encoder (libpng): one PNG writer in pointform.
+
+#include "pointform/io/png.h"
+
 #include "pointform/core/error.h"
-#include "pointform/io/io.h"
 #include "pointform/render/render.h"
-
-#include <stb_image_write.h> // compiled in Debian's libstb
-
-#include <string>
 
 namespace pointform {
 namespace {
 
-void append_bytes(void* context, void* data, int size)
+TextureImage texture_of(const Image& image)
 {
-    auto* out = static_cast<std::vector<std::uint8_t>*>(context);
-    const auto* bytes = static_cast<const std::uint8_t*>(data);
-    out->insert(out->end(), bytes, bytes + size);
+    return {.width = image.width, .height = image.height, .channels = 3, .pixels = image.rgb};
 }
 
 } // namespace
 
 std::vector<std::uint8_t> encode_png(const Image& image)
 {
-    if (image.width <= 0 || image.height <= 0 ||
-        image.rgb.size() !=
-            static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3)
-        throw InvalidInput("encode_png: the image is " + std::to_string(image.width) + " by " +
-                           std::to_string(image.height) + " pixels but holds " +
-                           std::to_string(image.rgb.size()) + " bytes");
-    std::vector<std::uint8_t> png;
-    if (stbi_write_png_to_func(&append_bytes, &png, image.width, image.height, 3, image.rgb.data(),
-                               image.width * 3) == 0)
-        throw Error("encode_png: stb_image_write failed");
-    return png;
+    return encode_png(texture_of(image));
 }
 
 void write_png(const std::filesystem::path& path, const Image& image)
 {
-    write_file_atomically(path, encode_png(image));
+    write_png(path, texture_of(image));
 }
 
 } // namespace pointform

@@ -131,9 +131,59 @@ void check_mesh(const TriMesh& mesh)
         throw InvalidInput("render_mesh: the origin is not finite");
 }
 
+/// A texture on the faces: per-vertex texture coordinates, the colour image, and optionally a
+/// tangent-space normal map with the vertices' normals and tangent frames.
+struct Texturing
+{
+    std::span<const Vec2f> uvs;
+    const TextureImage* color = nullptr;
+    const TextureImage* normal_map = nullptr;
+    std::span<const Vec3f> normals;
+    std::span<const Eigen::Vector4f> tangents;
+};
+
+Image render_surface(const TriMesh& mesh, const RenderOptions& options, const Texturing* texturing);
+
 } // namespace
 
 Image render_mesh(const TriMesh& mesh, const RenderOptions& options)
+{
+    return render_surface(mesh, options, nullptr);
+}
+
+Image render_textured_mesh(const TexturedMesh& mesh, std::size_t lod, const RenderOptions& options)
+{
+    if (lod >= mesh.lods.size())
+        throw InvalidInput("render_textured_mesh: level of detail " + std::to_string(lod) +
+                           " does not exist (the mesh has " + std::to_string(mesh.lods.size()) +
+                           ")");
+    const std::size_t n = mesh.lod_vertex_counts.at(lod);
+    if (mesh.uvs.size() < n || mesh.positions.size() < n || mesh.base_color.empty())
+        throw InvalidInput(
+            "render_textured_mesh: the mesh needs positions, texture coordinates "
+            "and a colour texture");
+    const bool normal_mapped =
+        !mesh.normal_map.empty() && mesh.normals.size() >= n && mesh.tangents.size() >= n;
+    TriMesh triangles;
+    triangles.vertices.origin = mesh.origin;
+    triangles.vertices.positions.assign(mesh.positions.begin(),
+                                        mesh.positions.begin() + static_cast<std::ptrdiff_t>(n));
+    triangles.triangles = mesh.lods[lod];
+    Texturing texturing;
+    texturing.uvs = std::span(mesh.uvs).first(n);
+    texturing.color = &mesh.base_color;
+    if (normal_mapped)
+    {
+        texturing.normal_map = &mesh.normal_map;
+        texturing.normals = std::span(mesh.normals).first(n);
+        texturing.tangents = std::span(mesh.tangents).first(n);
+    }
+    return render_surface(triangles, options, &texturing);
+}
+
+namespace {
+
+Image render_surface(const TriMesh& mesh, const RenderOptions& options, const Texturing* texturing)
 {
     validate(options);
     check_mesh(mesh);
@@ -282,7 +332,56 @@ Image render_mesh(const TriMesh& mesh, const RenderOptions& options)
                                 if (interpolated.dot(face_normal) > 0.0)
                                     normal = interpolated.normalized();
                             }
-                            Vec3d color = detail::shade(camera, options, normal, direction, front);
+                            Vec3d color;
+                            if (texturing != nullptr && front)
+                            {
+                                const double u = hit.hit.u;
+                                const double v = hit.hit.v;
+                                const auto corner = [&](auto values, int k) {
+                                    return values[t[static_cast<std::size_t>(k)]]
+                                        .template cast<double>();
+                                };
+                                const Eigen::Vector2d uv =
+                                    (1.0 - u - v) * corner(texturing->uvs, 0) +
+                                    u * corner(texturing->uvs, 1) + v * corner(texturing->uvs, 2);
+                                if (texturing->normal_map != nullptr)
+                                {
+                                    // The glTF tangent frame: +x along the tangent, +y the
+                                    // bitangent cross(n, t) · w, +z the interpolated normal.
+                                    Vec3d n = ((1.0 - u - v) * corner(texturing->normals, 0) +
+                                               u * corner(texturing->normals, 1) +
+                                               v * corner(texturing->normals, 2))
+                                                  .normalized();
+                                    Vec3d tangent = Vec3d::Zero();
+                                    for (int k = 0; k < 3; ++k)
+                                        tangent +=
+                                            (k == 0   ? 1.0 - u - v
+                                             : k == 1 ? u
+                                                      : v) *
+                                            texturing->tangents[t[static_cast<std::size_t>(k)]]
+                                                .head<3>()
+                                                .cast<double>();
+                                    tangent -= tangent.dot(n) * n;
+                                    if (tangent.norm() > 0.0)
+                                    {
+                                        tangent.normalize();
+                                        const Vec3d bitangent =
+                                            n.cross(tangent) *
+                                            static_cast<double>(texturing->tangents[t[0]].w());
+                                        const Vec3d m =
+                                            sample_texture(*texturing->normal_map, uv) / 127.5 -
+                                            Vec3d::Ones();
+                                        const Vec3d mapped =
+                                            m.x() * tangent + m.y() * bitangent + m.z() * n;
+                                        if (mapped.norm() > 0.0)
+                                            normal = mapped.normalized();
+                                    }
+                                }
+                                color = sample_texture(*texturing->color, uv) *
+                                        detail::shade_intensity(camera, options, normal, direction);
+                            }
+                            else
+                                color = detail::shade(camera, options, normal, direction, front);
                             if (options.wireframe)
                             {
                                 const Eigen::Vector2d p(sx, sy);
@@ -306,4 +405,5 @@ Image render_mesh(const TriMesh& mesh, const RenderOptions& options)
     return image;
 }
 
+} // namespace
 } // namespace pointform

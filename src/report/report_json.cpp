@@ -363,4 +363,37 @@ nlohmann::json report_json(const DeformOutcome& outcome)
     return out;
 }
 
+nlohmann::json report_json(const TextureOutcome& outcome)
+{
+    nlohmann::json out;
+    out["level"] = outcome.level;
+    out["atlas"] = {{"size", outcome.atlas.size},
+                    {"gutter", outcome.atlas.gutter},
+                    {"charts", outcome.atlas.corners.size()},
+                    {"texel_usage", outcome.atlas.texel_usage},
+                    {"texels_per_unit", outcome.atlas.texels_per_unit}};
+    nlohmann::json levels = nlohmann::json::array();
+    for (std::size_t i = 0; i < outcome.distortion.size(); ++i)
+    {
+        const AtlasDistortion& d = outcome.distortion[i];
+        levels.push_back({{"level", d.level},
+                          {"faces", d.faces},
+                          {"vertices", outcome.mesh.lod_vertex_counts[i]},
+                          {"l2_stretch", d.l2_stretch},
+                          {"linf_stretch", d.linf_stretch},
+                          {"angle_distortion", d.angle_distortion},
+                          {"area_distortion", d.area_distortion},
+                          {"flipped", d.flipped}});
+    }
+    out["levels"] = levels;
+    out["vertices"] = outcome.mesh.positions.size();
+    out["normal_map"] = !outcome.mesh.normal_map.empty();
+    if (outcome.bake)
+        out["bake"] = {{"texels", outcome.bake->texels},
+                       {"dilated", outcome.bake->dilated},
+                       {"mean_distance", outcome.bake->mean_distance},
+                       {"rms_color_error", outcome.bake->rms_color_error}};
+    return out;
+}
+
 } // namespace pointform

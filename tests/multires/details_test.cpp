@@ -68,7 +68,9 @@ TEST_P(DetailsByPredictor, RigidMotionOfALevelMovesEveryFinerLevelAlike)
 
 INSTANTIATE_TEST_SUITE_P(Predictors, DetailsByPredictor,
                          ::testing::Values(Predictor::Midpoint, Predictor::Butterfly),
-                         [](const auto& info) { return std::string(to_string(info.param)); });
+                         [](const auto& param_info) {
+                             return std::string(to_string(param_info.param));
+                         });
 
 TEST(Details, ReliefOfASurfaceIsNormalOffsets)
 {

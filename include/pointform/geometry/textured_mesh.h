@@ -6,6 +6,7 @@
 #include "pointform/core/types.h"
 #include "pointform/geometry/tri_mesh.h"
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -28,6 +29,33 @@ struct TextureImage
 
     [[nodiscard]] bool empty() const { return pixels.empty(); }
 };
+
+/// \brief The first three channels of `image` at texture coordinates `uv` (u right, v down, in
+/// [0, 1]; clamped at the borders), bilinear between texel centres, 0 … 255 each (a grey image's
+/// channel is repeated). \pre a non-empty image
+[[nodiscard]] inline Vec3d sample_texture(const TextureImage& image, const Eigen::Vector2d& uv)
+{
+    const double x = std::clamp(uv.x() * image.width - 0.5, 0.0, image.width - 1.0);
+    const double y = std::clamp(uv.y() * image.height - 0.5, 0.0, image.height - 1.0);
+    const int x0 = static_cast<int>(x);
+    const int y0 = static_cast<int>(y);
+    const int x1 = std::min(x0 + 1, image.width - 1);
+    const int y1 = std::min(y0 + 1, image.height - 1);
+    const double fx = x - x0;
+    const double fy = y - y0;
+    const auto at = [&](int px, int py, int channel) {
+        return static_cast<double>(
+            image.pixels[(static_cast<std::size_t>(py) * static_cast<std::size_t>(image.width) +
+                          static_cast<std::size_t>(px)) *
+                             static_cast<std::size_t>(image.channels) +
+                         static_cast<std::size_t>(std::min(channel, image.channels - 1))]);
+    };
+    Vec3d out;
+    for (int c = 0; c < 3; ++c)
+        out[c] = (1 - fy) * ((1 - fx) * at(x0, y0, c) + fx * at(x1, y0, c)) +
+                 fy * ((1 - fx) * at(x0, y1, c) + fx * at(x1, y1, c));
+    return out;
+}
 
 /// \brief A textured triangle mesh with levels of detail that share one vertex buffer: the
 /// export form of a hierarchy (glTF binary, OBJ + MTL + PNG).

@@ -10,6 +10,8 @@
 #include "pointform/multires/parameterization.h"
 
 #include <cstddef>
+#include <optional>
+#include <vector>
 
 namespace pointform {
 
@@ -73,5 +75,47 @@ struct BakeReport
 /// \brief Fills empty texels (mask 0) from filled 4-neighbours (their mean), `rounds` times;
 /// returns how many were filled. \pre mask has one entry per texel
 std::size_t dilate(TextureImage& image, std::vector<std::uint8_t>& mask, int rounds);
+
+} // namespace pointform
+
+namespace pointform {
+
+/// \brief What `pointform texture` makes: the colour source, the levels, the atlas.
+struct TextureRequest
+{
+    enum class Source
+    {
+        Checker,    ///< checker_texture()
+        Image,      ///< atlas_image() of `image`
+        BakeColors, ///< bake_colors() of the samples given to texture_hierarchy()
+    };
+    Source source = Source::Checker;
+    TextureImage image;               ///< Source::Image
+    std::optional<std::size_t> level; ///< the finest level textured (J); default: the finest
+    /// A level j < J to export alone with a normal map baked from level J (a light level that
+    /// renders with the fine relief); unset: levels 0 … J as levels of detail, no normal map.
+    std::optional<std::size_t> normal_map_level;
+    AtlasOptions atlas;
+    BakeOptions bake;
+};
+
+/// \brief The textured mesh and the figures every front end reports.
+struct TextureOutcome
+{
+    TexturedMesh mesh;
+    Atlas atlas;
+    std::vector<AtlasDistortion> distortion; ///< per exported level
+    std::optional<BakeReport> bake;
+    std::size_t level = 0; ///< J
+};
+
+/// \brief The one call behind `pointform texture` and Python's Hierarchy.texture(): the
+/// parameterization, the atlas (sized for level J), the textured levels, the colour texture and,
+/// if asked, the normal map. `samples` must be given (with colours) for Source::BakeColors.
+/// \throw InvalidInput for a level that does not exist, j ≥ J, a bad atlas size, a missing or
+///        colourless scan, an empty image
+[[nodiscard]] TextureOutcome texture_hierarchy(const MultiresMesh& mesh,
+                                               const TextureRequest& request,
+                                               const PointCloudView* samples = nullptr);
 
 } // namespace pointform

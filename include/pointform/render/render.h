@@ -6,6 +6,7 @@
 #include "pointform/core/types.h"
 #include "pointform/geometry/aabb.h"
 #include "pointform/geometry/point_cloud.h"
+#include "pointform/geometry/textured_mesh.h"
 #include "pointform/geometry/tri_mesh.h"
 
 #include <cstdint>
@@ -119,6 +120,15 @@ void validate(const RenderOptions& options);
 /// \throw Error with Embree's message if Embree fails
 [[nodiscard]] Image render_mesh(const TriMesh& mesh, const RenderOptions& options = {});
 
+/// \brief Ray-casts level of detail `lod` of a textured mesh as render_mesh() does, its front
+/// faces coloured by the colour texture (bilinear) and, when the mesh has a normal map, normals
+/// and tangents, shaded with the normal map's normals (glTF's tangent frame): a coarse level
+/// with a normal map shows the fine relief. Back faces keep `back_color`.
+/// \throw InvalidInput if the level of detail does not exist or the mesh has no texture
+///        coordinates or colour texture, or as render_mesh()
+[[nodiscard]] Image render_textured_mesh(const TexturedMesh& mesh, std::size_t lod,
+                                         const RenderOptions& options = {});
+
 /// \brief Draws a point cloud as depth-tested discs (surface splats), shaded by normal; headless,
 /// on the CPU, in parallel over bands of image rows. See RenderOptions for the disc radius and
 /// for clouds without normals. The output is the same whatever the thread count.
@@ -129,8 +139,9 @@ void validate(const RenderOptions& options);
 ///        samples (its depth buffer is 8 bytes a sample)
 [[nodiscard]] Image render_points(const PointCloudView& cloud, const RenderOptions& options = {});
 
-/// \brief Encodes an image as PNG (stb_image_write). \throw InvalidInput for an inconsistent
-/// image (size does not match width × height × 3, or a side ≤ 0).
+/// \brief Encodes an image as PNG: encode_png(const TextureImage&) of pointform/io/png.h
+/// (libpng), the one PNG writer. \throw InvalidInput for an inconsistent image (size does not
+/// match width × height × 3, or a side ≤ 0).
 [[nodiscard]] std::vector<std::uint8_t> encode_png(const Image& image);
 
 /// \brief Writes an image as PNG, to a temporary file beside `path` renamed into place when

@@ -12,6 +12,7 @@
 #include "pointform/multires/deformation.h"
 #include "pointform/multires/details.h"
 #include "pointform/multires/edit_file.h"
+#include "pointform/multires/texture.h"
 #include "pointform/polygonize/base_mesh.h"
 #include "pointform/polygonize/reconstruct.h"
 #include "pointform/polygonize/refine.h"
@@ -89,5 +90,11 @@ inline constexpr const char* hausdorff_definition =
 /// \brief deform_hierarchy()'s outcome: mode, predictor, diagonal, deformation (as above) and
 /// details (the input's, as above).
 [[nodiscard]] nlohmann::json report_json(const DeformOutcome& outcome);
+
+/// \brief texture_hierarchy()'s outcome: level, the atlas (size, gutter, charts, texel_usage,
+/// texels_per_unit), per exported level its faces, vertices and distortion (l2_stretch,
+/// linf_stretch, angle_distortion, area_distortion, flipped), the exported vertex count (seams
+/// included), and the bake's figures when colours were baked.
+[[nodiscard]] nlohmann::json report_json(const TextureOutcome& outcome);
 
 } // namespace pointform
