@@ -96,3 +96,57 @@ def test_bad_edits(small, tmp_path):
         h.deform(edit=ball_edit(h), plain=True)
     with pytest.raises(pointform.IoError):
         h.deform(edit=tmp_path / "missing.json")
+
+
+def test_texture_and_export_are_the_clis(small, tmp_path):
+    h, path = small
+    cli_glb = tmp_path / "cli.glb"
+    cli = run_cli("texture", path, "-o", cli_glb, "--size", 256, "--json", json_output=True)
+    textured = h.texture(size=256)
+    assert textured.report["levels"] == cli["levels"]
+    assert textured.report["atlas"] == cli["atlas"]
+    mine = tmp_path / "py.glb"
+    textured.save(mine)
+    assert mine.read_bytes() == cli_glb.read_bytes()
+    assert textured.base_color.shape == (256, 256, 3)
+    assert textured.uvs.min() >= 0.0 and textured.uvs.max() <= 1.0
+    assert textured.lod_vertex_counts[-1] == len(textured.positions)
+    assert [len(f) for f in textured.lods] == [h.face_count(i) for i in range(h.level_count)]
+    assert textured.normal_map is None
+
+    textured.save(tmp_path / "py.obj")
+    for name in ("py.obj", "py.mtl", "py_color.png"):
+        assert (tmp_path / name).exists()
+
+    cli_levels = tmp_path / "cli_levels.glb"
+    run_cli("export", path, "-o", cli_levels, "-q")
+    chain = h.export_levels()
+    chain.save(tmp_path / "py_levels.glb")
+    assert (tmp_path / "py_levels.glb").read_bytes() == cli_levels.read_bytes()
+    assert chain.uvs is None
+
+
+def test_texture_sources_and_bad_input(small, tmp_path):
+    h, _ = small
+    image = np.zeros((8, 8, 3), dtype=np.uint8)
+    image[:, 4:] = 255
+    painted = h.texture(image=image, size=64)
+    assert painted.base_color[:, :16].mean() < painted.base_color[:, -16:].mean()
+    light = h.texture(normal_map_level=1, size=128)
+    assert light.normal_map.shape == (128, 128, 3) and light.report["normal_map"]
+    assert len(light.lods) == 1
+    scan = pointform.read_points(BUNNY_SMALL)
+    with pytest.raises(pointform.InvalidInput, match="colours"):
+        h.texture(bake_colors=scan)
+    colored = pointform.PointCloud(scan.positions, colors=np.full((len(scan.positions), 3), 200, np.uint8),
+                                   origin=scan.origin)
+    baked = h.texture(bake_colors=colored, size=128)
+    assert baked.report["bake"]["rms_color_error"] < 1.0
+    with pytest.raises(pointform.InvalidInput, match="does not exist"):
+        h.texture(level=7)
+    with pytest.raises(pointform.InvalidInput):
+        h.texture(size=8)
+    with pytest.raises(pointform.IoError):
+        h.texture(image=tmp_path / "missing.png")
+    with pytest.raises(pointform.InvalidInput):
+        h.export_levels([2, 1])
