@@ -45,4 +45,13 @@ inline std::string quoted(const std::filesystem::path& path)
     return "'" + path.string() + "'";
 }
 
+/// \brief How many entries `dir` holds (no output written, no temporary left behind).
+inline std::size_t file_count(const std::filesystem::path& dir)
+{
+    std::size_t n = 0;
+    for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir))
+        ++n;
+    return n;
+}
+
 } // namespace pointform::test

@@ -25,16 +25,9 @@
 namespace pointform {
 namespace {
 
+using test::file_count;
 using test::quoted;
 using test::run;
-
-std::size_t file_count(const std::filesystem::path& dir)
-{
-    std::size_t n = 0;
-    for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir))
-        ++n;
-    return n;
-}
 
 /// The JSON chunk of a .glb file.
 nlohmann::json glb_json(const std::string& bytes)

@@ -21,6 +21,7 @@
 namespace pointform {
 namespace {
 
+using test::file_count;
 using test::quoted;
 using test::run;
 
@@ -38,14 +39,6 @@ MultiresMesh sphere_hierarchy(const Vec3d& centre)
             p = radius * p.normalized();
     }
     return mesh;
-}
-
-std::size_t file_count(const std::filesystem::path& dir)
-{
-    std::size_t n = 0;
-    for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir))
-        ++n;
-    return n;
 }
 
 TEST(LodCli, EveryLevelIsAClosedManifoldWithTheSplitCounts)

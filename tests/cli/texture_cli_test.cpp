@@ -23,16 +23,9 @@
 namespace pointform {
 namespace {
 
+using test::file_count;
 using test::quoted;
 using test::run;
-
-std::size_t file_count(const std::filesystem::path& dir)
-{
-    std::size_t n = 0;
-    for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir))
-        ++n;
-    return n;
-}
 
 class TextureCli : public ::testing::Test
 {
