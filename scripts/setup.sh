@@ -4,6 +4,9 @@
 # Then installs the Khronos glTF validator (npm gltf-validator, pinned by
 # tests/gltf/package-lock.json) into tests/gltf/node_modules with `npm ci`, for the test
 # gltf_validator; Node.js and npm come from Debian (nodejs, npm) unless node and npm are there.
+# Likewise three.js and playwright-core (pinned by viewer/package-lock.json) into
+# viewer/node_modules, for the page `pointform view` serves and the test viewer_e2e, which drives
+# Debian's chromium.
 #   bash scripts/setup.sh          build and test dependencies
 #   bash scripts/setup.sh --peers  also the peers of the side-by-side benchmarks (Open3D, CGAL)
 #   bash scripts/setup.sh --fuzz   also Clang and libFuzzer for scripts/fuzz.sh
@@ -12,9 +15,9 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libnanoflann-dev libcli11-dev nlohmann-json3-dev
-  libembree-dev libpng-dev libopenmesh-dev
+  libembree-dev libpng-dev libopenmesh-dev libcpp-httplib-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  clang-format
+  clang-format chromium
   python3 python3-dev python3-numpy python3-pybind11 python3-pytest
 )
 case "${1:-}" in
@@ -58,4 +61,20 @@ if [[ ! -f "$gltf_dir/node_modules/gltf-validator/package.json" ||
   fi
 else
   echo "setup: glTF validator already installed (tests/gltf/node_modules)"
+fi
+
+# three.js (the viewer page) and playwright-core (its browser test), as viewer/package-lock.json
+# pins them; again only when the lock file changed since the last install. Without them
+# `pointform view` warns that the page cannot work and the test viewer_e2e reports "skipped".
+viewer_dir="$(dirname "$0")/../viewer"
+installed_lock="$viewer_dir/node_modules/.package-lock.json"
+if [[ ! -f "$viewer_dir/node_modules/three/package.json" ||
+      ! -f "$viewer_dir/node_modules/playwright-core/package.json" ||
+      "$viewer_dir/package-lock.json" -nt "$installed_lock" ]]; then
+  echo "setup: installing three.js and playwright-core (npm ci in viewer)"
+  if ! (cd "$viewer_dir" && npm ci --no-audit --no-fund --loglevel=error); then
+    echo "setup: warning: npm ci failed in viewer; the page of pointform view will not work and the test viewer_e2e will be skipped" >&2
+  fi
+else
+  echo "setup: three.js and playwright-core already installed (viewer/node_modules)"
 fi

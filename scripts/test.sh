@@ -4,7 +4,9 @@
 #   bash scripts/test.sh         release build (build/release)
 #   bash scripts/test.sh asan    AddressSanitizer + UndefinedBehaviorSanitizer build (build/asan)
 # ctest includes gltf_validator (the Khronos glTF validator, which setup.sh installs with npm ci;
-# "skipped" without node or the validator). The release build also runs the Python package's
+# "skipped" without node or the validator) and viewer_e2e (the page of `pointform view` in
+# Debian's chromium through playwright-core, from viewer/node_modules; "skipped" without them).
+# The release build also runs the Python package's
 # pytest suite (python/tests) with Debian's /usr/bin/python3; the asan build has no Python module
 # (an instrumented extension cannot load into an uninstrumented interpreter).
 set -euo pipefail

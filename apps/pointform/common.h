@@ -110,5 +110,6 @@ void register_texture(CLI::App& app, const GlobalOptions& global);
 void register_deform(CLI::App& app, const GlobalOptions& global);
 void register_reconstruct(CLI::App& app, const GlobalOptions& global);
 void register_remesh(CLI::App& app, const GlobalOptions& global);
+void register_view(CLI::App& app, const GlobalOptions& global);
 
 } // namespace pointform::cli

@@ -82,6 +82,7 @@ int run(int argc, char** argv)
     pointform::cli::register_deform(app, global);
     pointform::cli::register_reconstruct(app, global);
     pointform::cli::register_remesh(app, global);
+    pointform::cli::register_view(app, global);
 
     try
     {
