@@ -89,29 +89,12 @@ TextureImage image_from(const py::object& value)
     return image;
 }
 
-/// Writes a textured mesh: .glb whole, or .obj (the finest level of detail) with its .mtl and
-/// PNGs beside it.
+/// Writes a textured mesh as `pointform texture` does: .glb whole, or .obj (the finest level of
+/// detail) with its .mtl and PNGs beside it.
 void save_textured(const TexturedMesh& mesh, const std::filesystem::path& path)
 {
-    const std::string ext = path.extension().string();
-    if (ext == ".glb")
-        return write_gltf(path, mesh);
-    if (ext != ".obj")
-        throw InvalidInput("save: " + path.string() + ": expected a .glb or .obj path");
-    const ObjFileNames names = obj_file_names(path);
-    const auto text_bytes = [](const std::string& text) {
-        return std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size());
-    };
-    const std::filesystem::path dir = path.parent_path();
-    if (obj_has_material(mesh))
-    {
-        write_file_atomically(dir / names.mtl, text_bytes(mtl_text(mesh, names)));
-        if (!mesh.base_color.empty())
-            write_png(dir / names.base_color, mesh.base_color);
-        if (!mesh.normal_map.empty())
-            write_png(dir / names.normal_map, mesh.normal_map);
-    }
-    write_file_atomically(path, text_bytes(obj_text(mesh, mesh.lods.size() - 1, names)));
+    for (const TexturedFile& file : textured_files(path, mesh, mesh.lods.size() - 1))
+        write_file_atomically(file.path, file.bytes);
 }
 
 } // namespace

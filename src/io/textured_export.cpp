@@ -6,7 +6,10 @@
 #include "pointform/io/textured_export.h"
 
 #include "pointform/core/error.h"
+#include "pointform/io/png.h"
 
+#include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <string_view>
@@ -247,6 +250,41 @@ std::string mtl_text(const TexturedMesh& mesh, const ObjFileNames& names)
         out += "map_Bump " + names.normal_map + "\n";
     }
     return out;
+}
+
+bool is_gltf_path(const std::filesystem::path& path)
+{
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (ext == ".glb")
+        return true;
+    if (ext == ".obj")
+        return false;
+    throw InvalidInput(path.string() +
+                       ": unknown output format; expected .glb (glTF binary, every level) or .obj "
+                       "(OBJ, one level)");
+}
+
+std::vector<TexturedFile> textured_files(const std::filesystem::path& output,
+                                         const TexturedMesh& mesh, std::size_t obj_lod)
+{
+    if (is_gltf_path(output))
+        return {{output, encode_gltf(mesh)}};
+    const auto text_bytes = [](const std::string& text) {
+        return std::vector<std::uint8_t>(text.begin(), text.end());
+    };
+    const ObjFileNames names = obj_file_names(output);
+    std::vector<TexturedFile> files = {{output, text_bytes(obj_text(mesh, obj_lod, names))}};
+    if (!obj_has_material(mesh))
+        return files;
+    const std::filesystem::path folder = output.parent_path();
+    files.push_back({folder / names.mtl, text_bytes(mtl_text(mesh, names))});
+    if (!mesh.base_color.empty())
+        files.push_back({folder / names.base_color, encode_png(mesh.base_color)});
+    if (!mesh.normal_map.empty())
+        files.push_back({folder / names.normal_map, encode_png(mesh.normal_map)});
+    return files;
 }
 
 } // namespace pointform

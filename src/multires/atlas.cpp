@@ -6,6 +6,7 @@
 #include "pointform/core/error.h"
 #include "pointform/core/memory.h"
 #include "pointform/core/parallel.h"
+#include "pointform/multires/level_of_detail.h"
 
 #include <algorithm>
 #include <bit>
@@ -63,21 +64,6 @@ std::size_t next_power_of_two(double value)
     return std::bit_ceil(static_cast<std::size_t>(std::ceil(std::max(value, 1.0))));
 }
 
-void check_levels(const MultiresMesh& mesh, std::span<const std::size_t> levels, const char* what)
-{
-    if (levels.empty())
-        throw InvalidInput(std::string(what) + ": no levels");
-    for (std::size_t i = 0; i < levels.size(); ++i)
-    {
-        if (levels[i] >= mesh.level_count())
-            throw InvalidInput(std::string(what) + ": level " + std::to_string(levels[i]) +
-                               " does not exist (the hierarchy has levels 0 to " +
-                               std::to_string(mesh.finest_level()) + ")");
-        if (i > 0 && levels[i] <= levels[i - 1])
-            throw InvalidInput(std::string(what) + ": the levels must increase");
-    }
-}
-
 /// (u, v) with v pointing up: the orientation in which charts are counter-clockwise.
 Vec2d upright(const Vec2d& uv)
 {
@@ -95,10 +81,7 @@ Atlas make_atlas(const MultiresMesh& mesh, std::size_t level, const AtlasOptions
 {
     if (mesh.level_count() == 0)
         throw InvalidInput("atlas: the hierarchy is empty");
-    if (level >= mesh.level_count())
-        throw InvalidInput("atlas: level " + std::to_string(level) +
-                           " does not exist (the hierarchy has levels 0 to " +
-                           std::to_string(mesh.finest_level()) + ")");
+    check_level(mesh, level);
     if (options.size != 0 && (options.size < min_atlas_size || options.size > max_atlas_size))
         throw InvalidInput("atlas: texture size " + std::to_string(options.size) + " is outside " +
                            std::to_string(min_atlas_size) + " to " +
@@ -203,7 +186,7 @@ Atlas make_atlas(const MultiresMesh& mesh, std::size_t level, const AtlasOptions
 TexturedMesh textured_levels(const MultiresMesh& mesh, const Parameterization& parameterization,
                              const Atlas& atlas, std::span<const std::size_t> levels)
 {
-    check_levels(mesh, levels, "textured_levels");
+    check_levels(mesh, levels);
     const std::size_t finest = levels.back();
     const std::vector<Triangle> faces = mesh.faces(finest);
     const unsigned shift = static_cast<unsigned>(2 * finest);
@@ -259,11 +242,10 @@ TexturedMesh textured_levels(const MultiresMesh& mesh, const Parameterization& p
         out.lod_levels.push_back(level);
     }
 
-    // Normals: area-weighted over the finest level's faces, per hierarchy vertex (serial sums:
-    // the same whatever the thread count). Tangents: per (vertex, chart), the area-weighted
-    // surface direction of +u, and the sign of image-up (−v).
+    // Normals: area-weighted over the finest level's faces, per hierarchy vertex. Tangents: per
+    // (vertex, chart), the area-weighted surface direction of +u, and the sign of image-up (−v).
     const std::span<const Vec3d> x = mesh.positions();
-    std::vector<Vec3d> vertex_normal(mesh.vertex_count(finest), Vec3d::Zero());
+    const std::vector<Vec3d> vertex_normal = vertex_normals(x, faces, mesh.vertex_count(finest));
     std::vector<Vec3d> tangent(n, Vec3d::Zero());
     std::vector<Vec3d> bitangent(n, Vec3d::Zero());
     const std::vector<Triangle>& finest_triangles = out.lods.back();
@@ -273,8 +255,6 @@ TexturedMesh textured_levels(const MultiresMesh& mesh, const Parameterization& p
         const Vec3d e1 = x[t[1]] - x[t[0]];
         const Vec3d e2 = x[t[2]] - x[t[0]];
         const Vec3d area_normal = e1.cross(e2);
-        for (const std::uint32_t v : t)
-            vertex_normal[v] += area_normal;
         const Triangle& c = finest_triangles[f];
         const Vec2d d1 = (out.uvs[c[1]] - out.uvs[c[0]]).cast<double>();
         const Vec2d d2 = (out.uvs[c[2]] - out.uvs[c[0]]).cast<double>();
@@ -296,8 +276,7 @@ TexturedMesh textured_levels(const MultiresMesh& mesh, const Parameterization& p
         for (std::size_t i = begin; i < end; ++i)
         {
             const auto v = static_cast<std::uint32_t>(keys[i] >> 32);
-            Vec3d normal = vertex_normal[v];
-            normal = normal.norm() > 0.0 ? Vec3d(normal.normalized()) : Vec3d::UnitZ();
+            const Vec3d& normal = vertex_normal[v];
             Vec3d t = tangent[i] - tangent[i].dot(normal) * normal;
             if (!(t.norm() > 0.0))
                 t = normal.unitOrthogonal();
@@ -316,7 +295,7 @@ std::vector<AtlasDistortion> atlas_distortion(const MultiresMesh& mesh,
                                               const Atlas& atlas,
                                               std::span<const std::size_t> levels)
 {
-    check_levels(mesh, levels, "atlas_distortion");
+    check_levels(mesh, levels);
     std::vector<AtlasDistortion> out;
     const std::span<const Vec3d> x = mesh.positions();
     for (const std::size_t level : levels)

@@ -6,6 +6,7 @@
 #include "pointform/core/disjoint_sets.h"
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
+#include "pointform/multires/level_of_detail.h"
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -170,10 +171,7 @@ MultiresDeformer::MultiresDeformer(const MultiresMesh& rest, const MultiresEdit&
 {
     if (rest.level_count() == 0)
         throw InvalidInput("deform: the hierarchy is empty");
-    if (edit.level >= rest.level_count())
-        throw InvalidInput("deform: level " + std::to_string(edit.level) +
-                           " does not exist (the hierarchy has levels 0 to " +
-                           std::to_string(rest.finest_level()) + ")");
+    check_level(rest, edit.level);
     const std::size_t j = edit.level;
     const std::size_t n = rest.vertex_count(j);
     const std::vector<std::uint8_t> in_region = region_members(rest, n, edit.region);

@@ -4,6 +4,7 @@
 #include "pointform/multires/edit_file.h"
 
 #include "pointform/core/error.h"
+#include "pointform/geometry/aabb.h"
 
 #include <nlohmann/json.hpp>
 
@@ -320,17 +321,10 @@ DeformOutcome deform_hierarchy(MultiresMesh& mesh, const DeformRequest& request)
         throw InvalidInput("deform: give exactly one of an edit and a lattice");
     DeformOutcome out;
     out.predictor = mesh.predictor();
-    if (mesh.vertex_count() > 0)
-    {
-        Vec3d lo = mesh.positions()[0];
-        Vec3d hi = lo;
-        for (const Vec3d& p : mesh.positions())
-        {
-            lo = lo.cwiseMin(p);
-            hi = hi.cwiseMax(p);
-        }
-        out.diagonal = (hi - lo).norm();
-    }
+    Aabb box;
+    for (const Vec3d& p : mesh.positions())
+        box.extend(p);
+    out.diagonal = box.diagonal();
     if (mesh.level_count() > 0)
         out.details = detail_statistics(analyze_details(mesh), out.normal_tolerance);
     if (request.edit)

@@ -11,49 +11,6 @@
 #include <string>
 
 namespace pointform {
-namespace {
-
-void check_levels(const MultiresMesh& mesh, std::span<const std::size_t> levels)
-{
-    if (levels.empty())
-        throw InvalidInput("no levels chosen: at least one is needed");
-    for (std::size_t k = 0; k < levels.size(); ++k)
-    {
-        check_level(mesh, levels[k]);
-        if (k > 0 && levels[k] <= levels[k - 1])
-            throw InvalidInput("levels must be strictly increasing, but level " +
-                               std::to_string(levels[k]) + " follows level " +
-                               std::to_string(levels[k - 1]));
-    }
-}
-
-/// Area-weighted unit vertex normals of `faces` over `vertex_count` vertices.
-std::vector<Vec3f> vertex_normals(std::span<const Vec3d> positions,
-                                  const std::vector<Triangle>& faces, std::size_t vertex_count)
-{
-    std::vector<Vec3d> sums(vertex_count, Vec3d::Zero());
-    Vec3d total = Vec3d::Zero();
-    for (const Triangle& t : faces)
-    {
-        // |cross| is twice the area: summing crosses weights each face normal by its area.
-        const Vec3d cross =
-            (positions[t[1]] - positions[t[0]]).cross(positions[t[2]] - positions[t[0]]);
-        for (const std::uint32_t v : t)
-            sums[v] += cross;
-        total += cross;
-    }
-    const Vec3d fallback = total.norm() > 0.0 ? total.normalized() : Vec3d::UnitZ();
-    std::vector<Vec3f> normals;
-    normals.reserve(vertex_count);
-    for (const Vec3d& sum : sums)
-    {
-        const double length = sum.norm();
-        normals.push_back((length > 0.0 ? Vec3d(sum / length) : fallback).cast<float>());
-    }
-    return normals;
-}
-
-} // namespace
 
 TexturedMesh level_chain(const MultiresMesh& mesh, std::span<const std::size_t> levels)
 {
@@ -73,7 +30,8 @@ TexturedMesh level_chain(const MultiresMesh& mesh, std::span<const std::size_t> 
         out.lod_vertex_counts.push_back(mesh.vertex_count(level));
         out.lod_levels.push_back(level);
     }
-    out.normals = vertex_normals(positions, out.lods.back(), vertex_count);
+    for (const Vec3d& n : vertex_normals(positions, out.lods.back(), vertex_count))
+        out.normals.push_back(n.cast<float>());
     return out;
 }
 

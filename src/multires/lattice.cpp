@@ -6,6 +6,7 @@
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 #include "pointform/multires/details.h"
+#include "pointform/multires/level_of_detail.h"
 
 #include <algorithm>
 #include <cmath>
@@ -124,10 +125,7 @@ DeformReport apply_lattice(MultiresMesh& mesh, const Lattice& lattice, std::size
     validate_lattice(lattice);
     if (mesh.level_count() == 0)
         throw InvalidInput("lattice: the hierarchy is empty");
-    if (level >= mesh.level_count())
-        throw InvalidInput("lattice: level " + std::to_string(level) +
-                           " does not exist (the hierarchy has levels 0 to " +
-                           std::to_string(mesh.finest_level()) + ")");
+    check_level(mesh, level);
     const MultiresMesh before = mesh;
     const std::size_t j = mode == LatticeMode::Plain ? mesh.finest_level() : level;
     const std::size_t n = mesh.vertex_count(j);

@@ -5,6 +5,7 @@
 
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
+#include "pointform/multires/level_of_detail.h"
 #include "pointform/spatial/kd_tree.h"
 
 #include <algorithm>
@@ -76,31 +77,6 @@ std::size_t texel_index(const TextureImage& image, int x, int y)
 std::uint8_t to_byte(double value)
 {
     return static_cast<std::uint8_t>(std::clamp(std::lround(value), 0L, 255L));
-}
-
-/// Area-weighted unit vertex normals of one level (serial sums: thread-count independent).
-std::vector<Vec3d> level_normals(const MultiresMesh& mesh, std::size_t level)
-{
-    const std::vector<Triangle> faces = mesh.faces(level);
-    const std::span<const Vec3d> x = mesh.positions();
-    std::vector<Vec3d> normals(mesh.vertex_count(level), Vec3d::Zero());
-    for (const Triangle& t : faces)
-    {
-        const Vec3d n = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
-        for (const std::uint32_t v : t)
-            normals[v] += n;
-    }
-    for (Vec3d& n : normals)
-        n = n.norm() > 0.0 ? Vec3d(n.normalized()) : Vec3d::UnitZ();
-    return normals;
-}
-
-void check_level(const MultiresMesh& mesh, std::size_t level, const char* what)
-{
-    if (level >= mesh.level_count())
-        throw InvalidInput(std::string(what) + ": level " + std::to_string(level) +
-                           " does not exist (the hierarchy has levels 0 to " +
-                           std::to_string(mesh.level_count() == 0 ? 0 : mesh.finest_level()) + ")");
 }
 
 } // namespace
@@ -198,7 +174,7 @@ TextureImage bake_colors(const MultiresMesh& mesh, const Parameterization& param
                          const Atlas& atlas, std::size_t level, const PointCloudView& samples,
                          const BakeOptions& options, BakeReport* report)
 {
-    check_level(mesh, level, "bake_colors");
+    check_level(mesh, level);
     if (samples.size() == 0)
         throw InvalidInput("bake_colors: the samples are empty");
     if (!samples.has_colors())
@@ -288,13 +264,14 @@ TextureImage bake_normal_map(const MultiresMesh& mesh, const Parameterization& p
             "bake_normal_map: the coarse mesh must be one textured level with "
             "normals and tangents");
     const std::size_t level = coarse.lod_levels[0];
-    check_level(mesh, fine, "bake_normal_map");
+    check_level(mesh, fine);
     if (fine <= level)
         throw InvalidInput("bake_normal_map: the fine level " + std::to_string(fine) +
                            " must be finer than the textured level " + std::to_string(level));
     (void)parameterization;
     const std::vector<Triangle> fine_faces = mesh.faces(fine);
-    const std::vector<Vec3d> fine_normals = level_normals(mesh, fine);
+    const std::vector<Vec3d> fine_normals =
+        vertex_normals(mesh.positions(), fine_faces, mesh.vertex_count(fine));
     const std::vector<Triangle>& coarse_faces = coarse.lods[0];
 
     // Texels outside every chart (beyond the dilated gutters) hold the unperturbed normal.
@@ -350,7 +327,7 @@ TextureOutcome texture_hierarchy(const MultiresMesh& mesh, const TextureRequest&
         throw InvalidInput("texture: the hierarchy is empty");
     TextureOutcome out;
     out.level = request.level.value_or(mesh.finest_level());
-    check_level(mesh, out.level, "texture");
+    check_level(mesh, out.level);
     if (request.normal_map_level && *request.normal_map_level >= out.level)
         throw InvalidInput("texture: the normal map's level " +
                            std::to_string(*request.normal_map_level) +

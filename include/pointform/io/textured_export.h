@@ -85,4 +85,24 @@ struct ObjFileNames
 /// \throw InvalidInput as check_textured_mesh()
 [[nodiscard]] std::string mtl_text(const TexturedMesh& mesh, const ObjFileNames& names);
 
+/// \brief One file of a textured export: where it goes and its bytes.
+struct TexturedFile
+{
+    std::filesystem::path path;
+    std::vector<std::uint8_t> bytes;
+};
+
+/// \brief Whether `path` names a glTF binary (.glb, every level) or an OBJ (.obj, one level),
+/// the formats of a TexturedMesh, whatever the extension's case.
+/// \throw InvalidInput for any other extension
+[[nodiscard]] bool is_gltf_path(const std::filesystem::path& path);
+
+/// \brief Every file of `mesh`'s export to `output`, encoded (nothing written): OUT.glb with
+/// every level; or OUT.obj with level of detail `obj_lod` and, when the mesh has a material,
+/// OUT.mtl and its PNG textures beside it (names from obj_file_names()), the main file first.
+/// \throw InvalidInput for another extension or a bad mesh
+[[nodiscard]] std::vector<TexturedFile> textured_files(const std::filesystem::path& output,
+                                                       const TexturedMesh& mesh,
+                                                       std::size_t obj_lod);
+
 } // namespace pointform

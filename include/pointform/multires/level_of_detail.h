@@ -14,7 +14,9 @@
 #include "pointform/geometry/tri_mesh.h"
 
 #include <cstddef>
+#include <span>
 #include <string>
+#include <vector>
 
 namespace pointform {
 
@@ -29,6 +31,17 @@ struct LevelOfDetail
 /// \brief Throws unless `level` is a level of `mesh`, with a message that lists the levels.
 /// \throw InvalidInput "level L does not exist: the hierarchy has N levels (0 to J)"
 void check_level(const MultiresMesh& mesh, std::size_t level);
+
+/// \brief Throws unless `levels` names at least one level, every one a level of `mesh`, in
+/// strictly increasing order. \throw InvalidInput saying which rule a level breaks
+void check_levels(const MultiresMesh& mesh, std::span<const std::size_t> levels);
+
+/// \brief Area-weighted unit vertex normals of vertices 0 … vertex_count − 1 over `faces`,
+/// summed in face order (the same whatever the thread count); a vertex whose faces' normals
+/// cancel gets the faces' overall normal (+z if that cancels too).
+[[nodiscard]] std::vector<Vec3d> vertex_normals(std::span<const Vec3d> positions,
+                                                std::span<const Triangle> faces,
+                                                std::size_t vertex_count);
 
 /// \brief Level `level` of `mesh` and its topology. \throw InvalidInput as check_level()
 [[nodiscard]] LevelOfDetail extract_level(const MultiresMesh& mesh, std::size_t level);
