@@ -49,32 +49,33 @@ else
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-# The glTF validator, exactly as tests/gltf/package-lock.json pins it; again only when the lock
-# file changed since the last install. Without it the test gltf_validator reports "skipped".
-gltf_dir="$(dirname "$0")/../tests/gltf"
-installed_lock="$gltf_dir/node_modules/.package-lock.json"
-if [[ ! -f "$gltf_dir/node_modules/gltf-validator/package.json" ||
-      "$gltf_dir/package-lock.json" -nt "$installed_lock" ]]; then
-  echo "setup: installing the glTF validator (npm ci in tests/gltf)"
-  if ! (cd "$gltf_dir" && npm ci --no-audit --no-fund --loglevel=error); then
-    echo "setup: warning: npm ci failed in tests/gltf; the test gltf_validator will be skipped" >&2
+# npm_install DIR WHAT CONSEQUENCE PACKAGE...: `npm ci` in DIR, exactly as its package-lock.json
+# pins them, unless every PACKAGE is installed and the lock file has not changed since the last
+# install. A failure only warns, saying CONSEQUENCE.
+npm_install() {
+  local dir="$1" what="$2" consequence="$3"
+  shift 3
+  local needed=0 package
+  for package in "$@"; do
+    [[ -f "$dir/node_modules/$package/package.json" ]] || needed=1
+  done
+  [[ "$dir/package-lock.json" -nt "$dir/node_modules/.package-lock.json" ]] && needed=1
+  if ((needed == 0)); then
+    echo "setup: $what already installed ($dir/node_modules)"
+    return
   fi
-else
-  echo "setup: glTF validator already installed (tests/gltf/node_modules)"
-fi
+  echo "setup: installing $what (npm ci in $dir)"
+  if ! (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error); then
+    echo "setup: warning: npm ci failed in $dir; $consequence" >&2
+  fi
+}
 
-# three.js (the viewer page) and playwright-core (its browser test), as viewer/package-lock.json
-# pins them; again only when the lock file changed since the last install. Without them
-# `pointform view` warns that the page cannot work and the test viewer_e2e reports "skipped".
-viewer_dir="$(dirname "$0")/../viewer"
-installed_lock="$viewer_dir/node_modules/.package-lock.json"
-if [[ ! -f "$viewer_dir/node_modules/three/package.json" ||
-      ! -f "$viewer_dir/node_modules/playwright-core/package.json" ||
-      "$viewer_dir/package-lock.json" -nt "$installed_lock" ]]; then
-  echo "setup: installing three.js and playwright-core (npm ci in viewer)"
-  if ! (cd "$viewer_dir" && npm ci --no-audit --no-fund --loglevel=error); then
-    echo "setup: warning: npm ci failed in viewer; the page of pointform view will not work and the test viewer_e2e will be skipped" >&2
-  fi
-else
-  echo "setup: three.js and playwright-core already installed (viewer/node_modules)"
-fi
+here="$(dirname "$0")/.."
+# The glTF validator, for the test gltf_validator (skipped without it).
+npm_install "$here/tests/gltf" "the glTF validator" "the test gltf_validator will be skipped" \
+  gltf-validator
+# three.js (the viewer page) and playwright-core (its browser test): without them `pointform
+# view` warns that the page cannot work and the test viewer_e2e reports "skipped".
+npm_install "$here/viewer" "three.js and playwright-core" \
+  "the page of pointform view will not work and the test viewer_e2e will be skipped" \
+  three playwright-core
