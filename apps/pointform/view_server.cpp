@@ -4,8 +4,11 @@
 #include "view_server.h"
 
 #include "pointform/core/error.h"
+#include "pointform/hermite/surfels.h"
 #include "pointform/io/hierarchy.h"
 #include "pointform/io/io.h"
+#include "pointform/metrics/hausdorff.h"
+#include "pointform/polygonize/reconstruct.h"
 
 #include <nlohmann/json.hpp>
 
@@ -18,11 +21,15 @@
 #include <atomic>
 #include <bit>
 #include <cerrno>
+#include <chrono>
 #include <csignal>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -43,6 +50,13 @@ void append_u32(std::string& out, std::uint32_t value)
 void append_f32(std::string& out, float value)
 {
     append_u32(out, std::bit_cast<std::uint32_t>(value));
+}
+
+void append_f64(std::string& out, double value)
+{
+    const auto bits = std::bit_cast<std::uint64_t>(value);
+    append_u32(out, static_cast<std::uint32_t>(bits & 0xFFFFFFFFU));
+    append_u32(out, static_cast<std::uint32_t>(bits >> 32));
 }
 
 std::uint32_t to_u32(std::size_t n)
@@ -96,8 +110,8 @@ extern "C" void on_stop_signal(int /*signal*/)
 
 /// Headers larger than this in all (names, values and separators) get 431.
 constexpr std::size_t max_header_bytes = 16 * 1024;
-/// GET requests have no body; anything larger than this is refused with 413.
-constexpr std::size_t max_payload_bytes = 1024;
+/// POST /api/reconstruct: max_picked_triangles triangles of three indices of up to 10 digits.
+constexpr std::size_t max_reconstruct_body_bytes = 4 * 1024 * 1024;
 
 void set_error(httplib::Response& res, int status, const std::string& message)
 {
@@ -160,7 +174,13 @@ ViewData read_view_data(const std::filesystem::path& path)
     return data;
 }
 
-std::string encode_info(const ViewData& data)
+TriMesh ViewData::level_mesh(std::size_t level) const
+{
+    PF_ASSERT(level < level_count());
+    return kind == Kind::Mesh ? mesh : hierarchy->level_mesh(level);
+}
+
+nlohmann::json encode_info(const ViewData& data)
 {
     nlohmann::json out;
     out["kind"] = kind_name(data.kind);
@@ -201,7 +221,7 @@ std::string encode_info(const ViewData& data)
     }
     out["levels"] = levels;
     out["origin"] = {origin.x(), origin.y(), origin.z()};
-    return out.dump();
+    return out;
 }
 
 std::string encode_level(const ViewData& data, std::size_t level)
@@ -275,6 +295,101 @@ std::string encode_points(const ViewData& data)
     return out;
 }
 
+std::string encode_distances(const ViewData& data, std::size_t level, const PointCloud& samples)
+{
+    PF_ASSERT(level < data.level_count() && !samples.empty());
+    const TriMesh mesh = data.level_mesh(level);
+    // Vertices to samples (what the colours show) and samples to the level (the one-sided
+    // Hausdorff distance of the refinement's report), both with the library's metrics.
+    const std::vector<double> to_samples = distances_to_points(mesh.vertices, samples);
+    const DistanceStats from_samples = summarize_distances(distances_to_mesh(samples, mesh));
+    const double largest =
+        to_samples.empty() ? 0.0 : *std::max_element(to_samples.begin(), to_samples.end());
+    std::string out;
+    out.reserve(40 + 4 * to_samples.size());
+    out.append("PFDS", 4);
+    append_u32(out, binary_version);
+    append_u32(out, to_u32(level));
+    append_u32(out, to_u32(to_samples.size()));
+    append_f64(out, from_samples.max);
+    append_f64(out, from_samples.mean);
+    append_f64(out, largest);
+    for (const double d : to_samples)
+        append_f32(out, static_cast<float>(d));
+    return out;
+}
+
+PickedRequest parse_picked_request(const std::string& body, std::size_t sample_count)
+{
+    // Bracket depth first: the request is two levels deep, and a hostile body of a million '['
+    // must not reach a recursive parser or destructor.
+    int depth = 0;
+    bool in_string = false;
+    for (std::size_t i = 0; i < body.size(); ++i)
+    {
+        const char c = body[i];
+        if (in_string)
+        {
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                in_string = false;
+            continue;
+        }
+        if (c == '"')
+            in_string = true;
+        else if (c == '[' || c == '{')
+        {
+            if (++depth > 4)
+                throw InvalidInput(
+                    "the request is nested deeper than {\"triangles\": [[i, j, k]]}");
+        }
+        else if (c == ']' || c == '}')
+            --depth;
+    }
+    nlohmann::json request;
+    try
+    {
+        request = nlohmann::json::parse(body);
+    }
+    catch (const nlohmann::json::parse_error& e)
+    {
+        throw InvalidInput(std::string("the request is not JSON: ") + e.what());
+    }
+    if (!request.is_object() || !request.contains("triangles") || !request["triangles"].is_array())
+        throw InvalidInput("expected {\"triangles\": [[i, j, k], ...]} over sample indices");
+    const nlohmann::json& triangles = request["triangles"];
+    if (triangles.empty())
+        throw InvalidInput("no triangles: join three picked samples first");
+    if (triangles.size() > max_picked_triangles)
+        throw InvalidInput(std::to_string(triangles.size()) + " triangles: at most " +
+                           std::to_string(max_picked_triangles) + " may be picked");
+    PickedRequest out;
+    std::map<std::uint32_t, std::uint32_t> vertex_of_sample;
+    for (std::size_t f = 0; f < triangles.size(); ++f)
+    {
+        const nlohmann::json& t = triangles[f];
+        const std::string which = "triangle " + std::to_string(f + 1);
+        if (!t.is_array() || t.size() != 3)
+            throw InvalidInput(which + " is not three sample indices");
+        Triangle triangle{};
+        for (std::size_t k = 0; k < 3; ++k)
+        {
+            if (!t[k].is_number_unsigned() || t[k].get<std::uint64_t>() >= sample_count)
+                throw InvalidInput(which + ": " + t[k].dump() + " is not a sample index (0 to " +
+                                   std::to_string(sample_count - 1) + ")");
+            const auto sample = static_cast<std::uint32_t>(t[k].get<std::uint64_t>());
+            const auto [it, inserted] =
+                vertex_of_sample.emplace(sample, static_cast<std::uint32_t>(out.samples.size()));
+            if (inserted)
+                out.samples.push_back(sample);
+            triangle[k] = it->second;
+        }
+        out.triangles.push_back(triangle);
+    }
+    return out;
+}
+
 StaticFiles read_static_files(const std::filesystem::path& viewer_dir)
 {
     // The fixed list of names the server answers besides /api: URL path, file, content type.
@@ -284,9 +399,10 @@ StaticFiles read_static_files(const std::filesystem::path& viewer_dir)
         const char* file;
         const char* type;
     };
-    static constexpr std::array<Entry, 6> entries = {{
+    static constexpr std::array<Entry, 7> entries = {{
         {"/", "web/index.html", "text/html; charset=utf-8"},
         {"/viewer.js", "web/viewer.js", "text/javascript; charset=utf-8"},
+        {"/base_mesh.js", "web/base_mesh.js", "text/javascript; charset=utf-8"},
         {"/style.css", "web/style.css", "text/css; charset=utf-8"},
         {"/vendor/three.module.js", "node_modules/three/build/three.module.js",
          "text/javascript; charset=utf-8"},
@@ -308,16 +424,195 @@ StaticFiles read_static_files(const std::filesystem::path& viewer_dir)
     return files;
 }
 
-void serve_view(const ViewData& data, const StaticFiles& files, const std::string& host, int port,
-                const std::function<void(int)>& on_listening)
+namespace {
+
+/// A layer as served: its data and its answers, encoded once; distances on first request.
+struct Layer
+{
+    ViewData data;
+    nlohmann::json info;
+    std::vector<std::string> levels;
+    std::string points;
+
+    std::mutex distance_mutex;
+    std::vector<std::string> distances; ///< per level, empty until asked for
+};
+
+std::shared_ptr<Layer> make_layer(ViewData data, std::size_t id, nlohmann::json extra = {})
+{
+    auto layer = std::make_shared<Layer>();
+    layer->info = encode_info(data);
+    layer->info["id"] = id;
+    for (auto& [key, value] : extra.items())
+        layer->info[key] = value;
+    layer->levels.resize(data.level_count());
+    for (std::size_t l = 0; l < layer->levels.size(); ++l)
+        layer->levels[l] = encode_level(data, l);
+    if (data.kind == ViewData::Kind::Points)
+        layer->points = encode_points(data);
+    layer->distances.resize(data.level_count());
+    layer->data = std::move(data);
+    return layer;
+}
+
+/// The reconstruction the page asked for: one at a time, on its own thread.
+class ReconstructionJob
+{
+public:
+    enum class State
+    {
+        Idle,
+        Running,
+        Done,
+        Failed
+    };
+
+    /// Starts a job unless one is running; `work` gets the job's number (1, 2, ...).
+    /// \return false if one is running
+    bool start(std::function<void(ReconstructionJob&, long long)> work)
+    {
+        const std::lock_guard lock(mutex_);
+        if (state_ == State::Running)
+            return false;
+        if (thread_.joinable())
+            thread_.join();
+        ++id_;
+        state_ = State::Running;
+        stage_ = "starting";
+        fraction_ = 0.0;
+        message_.clear();
+        layer_ = -1;
+        started_ = std::chrono::steady_clock::now();
+        thread_ = std::thread([this, work = std::move(work), id = id_] { work(*this, id); });
+        return true;
+    }
+
+    /// The progress callback of the library calls: records the stage, says stop on shutdown.
+    bool progress(std::string_view stage, double fraction)
+    {
+        const std::lock_guard lock(mutex_);
+        stage_ = std::string(stage);
+        fraction_ = fraction;
+        return !cancel_.load();
+    }
+
+    void finish(std::size_t layer, nlohmann::json report)
+    {
+        const std::lock_guard lock(mutex_);
+        state_ = State::Done;
+        layer_ = static_cast<long long>(layer);
+        report_ = std::move(report);
+        seconds_ = elapsed();
+    }
+
+    void fail(const std::string& message)
+    {
+        const std::lock_guard lock(mutex_);
+        state_ = State::Failed;
+        message_ = message;
+        seconds_ = elapsed();
+    }
+
+    [[nodiscard]] nlohmann::json status()
+    {
+        const std::lock_guard lock(mutex_);
+        static constexpr std::array<const char*, 4> names = {"idle", "running", "done", "failed"};
+        nlohmann::json out = {{"state", names[static_cast<int>(state_)]}, {"job", id_}};
+        if (state_ == State::Running)
+        {
+            out["stage"] = stage_;
+            out["fraction"] = fraction_;
+            out["seconds"] = elapsed();
+        }
+        if (state_ == State::Done)
+        {
+            out["layer"] = layer_;
+            out["report"] = report_;
+        }
+        if (state_ == State::Failed)
+            out["message"] = message_;
+        if (state_ == State::Done || state_ == State::Failed)
+            out["seconds"] = seconds_;
+        return out;
+    }
+
+    /// Asks a running job to stop and waits for it.
+    void stop()
+    {
+        cancel_ = true;
+        std::thread thread;
+        {
+            const std::lock_guard lock(mutex_);
+            thread = std::move(thread_);
+        }
+        if (thread.joinable())
+            thread.join();
+    }
+
+    ~ReconstructionJob() { stop(); }
+
+private:
+    [[nodiscard]] double elapsed() const
+    {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+    }
+
+    std::mutex mutex_;
+    std::thread thread_;
+    std::atomic<bool> cancel_{false};
+    State state_ = State::Idle;
+    long long id_ = 0;
+    std::string stage_;
+    double fraction_ = 0.0;
+    std::string message_;
+    long long layer_ = -1;
+    nlohmann::json report_;
+    double seconds_ = 0.0;
+    std::chrono::steady_clock::time_point started_;
+};
+
+/// The refinement report's per-level figures, level 0 (the base mesh) included.
+nlohmann::json level_report(const SemiRegularReport& report)
+{
+    const RefineReport& r = report.refinement;
+    nlohmann::json levels = nlohmann::json::array();
+    levels.push_back({{"level", 0},
+                      {"hausdorff", r.initial_hausdorff},
+                      {"mean_distance", r.initial_mean_distance}});
+    for (const RefineLevelStats& s : r.levels)
+    {
+        nlohmann::json entry = {{"level", s.level}, {"unprojected", s.unprojected}};
+        if (s.hausdorff)
+            entry["hausdorff"] = *s.hausdorff;
+        if (s.mean_distance)
+            entry["mean_distance"] = *s.mean_distance;
+        levels.push_back(entry);
+    }
+    return levels;
+}
+
+} // namespace
+
+void serve_view(std::vector<ViewData> inputs, const StaticFiles& files, const std::string& host,
+                int port, const std::function<void(int)>& on_listening)
 {
     // Everything served is encoded here, before the socket is bound: requests only copy bytes.
-    const std::string info = encode_info(data);
-    std::vector<std::string> levels(data.level_count());
-    for (std::size_t l = 0; l < levels.size(); ++l)
-        levels[l] = encode_level(data, l);
-    const std::string points =
-        data.kind == ViewData::Kind::Points ? encode_points(data) : std::string();
+    std::mutex layers_mutex;
+    std::vector<std::shared_ptr<Layer>> layers;
+    std::optional<std::size_t> samples_layer;
+    for (ViewData& data : inputs)
+    {
+        if (data.kind == ViewData::Kind::Points && !samples_layer)
+            samples_layer = layers.size();
+        layers.push_back(make_layer(std::move(data), layers.size(), {{"source", "file"}}));
+    }
+    const auto layer_at = [&](std::size_t k) -> std::shared_ptr<Layer> {
+        const std::lock_guard lock(layers_mutex);
+        return k < layers.size() ? layers[k] : nullptr;
+    };
+    // The samples stay in their layer, which is never removed or changed.
+    const PointCloud* samples = samples_layer ? &layers[*samples_layer]->data.points : nullptr;
+    ReconstructionJob job;
 
     httplib::Server server;
     // SO_REUSEADDR (a restart may bind while old connections linger in TIME_WAIT) but not
@@ -326,13 +621,14 @@ void serve_view(const ViewData& data, const StaticFiles& files, const std::strin
         int yes = 1;
         ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
     });
-    server.set_payload_max_length(max_payload_bytes);
+    server.set_payload_max_length(max_reconstruct_body_bytes);
     server.set_read_timeout(5, 0);
     server.set_write_timeout(30, 0);
     server.set_keep_alive_max_count(100);
 
-    // Before routing: refuse oversized headers (cpp-httplib's own limit is per line) and
-    // bodies (the GET endpoints take none).
+    // Before routing (and before a body is read): refuse oversized headers (cpp-httplib's own
+    // limit is per line). Bodies beyond max_reconstruct_body_bytes get 413 from cpp-httplib; only
+    // POST /api/reconstruct reads one.
     server.set_pre_routing_handler([](const httplib::Request& req, httplib::Response& res) {
         std::size_t header_bytes = req.target.size();
         for (const auto& [name, value] : req.headers)
@@ -342,40 +638,170 @@ void serve_view(const ViewData& data, const StaticFiles& files, const std::strin
             set_error(res, 431, "request headers too large");
             return httplib::Server::HandlerResponse::Handled;
         }
-        if (req.body.size() > max_payload_bytes)
-        {
-            set_error(res, 413, "request body too large");
-            return httplib::Server::HandlerResponse::Handled;
-        }
         return httplib::Server::HandlerResponse::Unhandled;
     });
 
-    server.Get("/api/info", [&info](const httplib::Request&, httplib::Response& res) {
-        res.set_content(info, "application/json");
+    server.Get("/api/info", [&](const httplib::Request&, httplib::Response& res) {
+        nlohmann::json info;
+        info["layers"] = nlohmann::json::array();
+        {
+            const std::lock_guard lock(layers_mutex);
+            for (const auto& layer : layers)
+                info["layers"].push_back(layer->info);
+        }
+        info["samples"] = samples_layer ? nlohmann::json(*samples_layer) : nlohmann::json(nullptr);
+        info["max_picked_triangles"] = max_picked_triangles;
+        res.set_content(info.dump(), "application/json");
     });
-    server.Get(R"(/api/level/([0-9]{1,9}))", [&levels](const httplib::Request& req,
-                                                       httplib::Response& res) {
-        const std::size_t level = std::stoul(req.matches[1].str());
-        if (level >= levels.size())
+
+    // /api/layer/<k>/<what>[/<i>]
+    const auto layer_of = [&](const httplib::Request& req,
+                              httplib::Response& res) -> std::shared_ptr<Layer> {
+        const std::size_t k = std::stoul(req.matches[1].str());
+        std::shared_ptr<Layer> layer = layer_at(k);
+        if (!layer)
+            set_error(res, 404, "layer " + std::to_string(k) + " does not exist");
+        return layer;
+    };
+    const auto level_of = [](const Layer& layer, const httplib::Request& req,
+                             httplib::Response& res) -> std::optional<std::size_t> {
+        const std::size_t level = std::stoul(req.matches[2].str());
+        if (level >= layer.levels.size())
         {
             set_error(res, 404,
-                      "level " + std::to_string(level) +
-                          " does not exist: " + std::to_string(levels.size()) + " levels");
-            return;
+                      "level " + std::to_string(level) + " does not exist: the layer has " +
+                          std::to_string(layer.levels.size()) + " levels");
+            return std::nullopt;
         }
-        res.set_content(levels[level], "application/octet-stream");
-    });
-    server.Get(R"(/api/level/(.*))", [](const httplib::Request& req, httplib::Response& res) {
-        set_error(res, 400, "bad level \"" + req.matches[1].str() + "\": expected 0, 1, 2, ...");
-    });
-    server.Get("/api/points", [&points, &data](const httplib::Request&, httplib::Response& res) {
-        if (points.empty())
+        return level;
+    };
+    server.Get(R"(/api/layer/([0-9]{1,9})/level/([0-9]{1,9}))",
+               [&](const httplib::Request& req, httplib::Response& res) {
+                   const auto layer = layer_of(req, res);
+                   if (!layer)
+                       return;
+                   if (const auto level = level_of(*layer, req, res))
+                       res.set_content(layer->levels[*level], "application/octet-stream");
+               });
+    server.Get(R"(/api/layer/([0-9]{1,9})/distance/([0-9]{1,9}))", [&](const httplib::Request& req,
+                                                                       httplib::Response& res) {
+        const auto layer = layer_of(req, res);
+        if (!layer)
+            return;
+        if (!samples)
         {
-            set_error(res, 404, std::string("no points: the file is a ") + kind_name(data.kind));
+            set_error(res, 404, "no samples: name a point cloud on the command line too");
             return;
         }
-        res.set_content(points, "application/octet-stream");
+        const auto level = level_of(*layer, req, res);
+        if (!level)
+            return;
+        const std::lock_guard lock(layer->distance_mutex);
+        std::string& answer = layer->distances[*level];
+        if (answer.empty())
+            answer = encode_distances(layer->data, *level, *samples);
+        res.set_content(answer, "application/octet-stream");
     });
+    server.Get(R"(/api/layer/([0-9]{1,9})/points)", [&](const httplib::Request& req,
+                                                        httplib::Response& res) {
+        const auto layer = layer_of(req, res);
+        if (!layer)
+            return;
+        if (layer->points.empty())
+        {
+            set_error(res, 404,
+                      std::string("no points: the layer is a ") + kind_name(layer->data.kind));
+            return;
+        }
+        res.set_content(layer->points, "application/octet-stream");
+    });
+    server.Get(R"(/api/layer/(.*))", [](const httplib::Request& req, httplib::Response& res) {
+        set_error(res, 400,
+                  "bad layer request \"" + req.matches[1].str() +
+                      "\": expected <k>/level/<i>, <k>/distance/<i> or <k>/points");
+    });
+
+    server.Get("/api/reconstruct", [&](const httplib::Request&, httplib::Response& res) {
+        res.set_content(job.status().dump(), "application/json");
+    });
+    server.Post("/api/reconstruct", [&](const httplib::Request& req, httplib::Response& res) {
+        if (!samples)
+        {
+            set_error(res, 404,
+                      "no samples to reconstruct from: name a point cloud on the command line");
+            return;
+        }
+        PickedRequest picked;
+        try
+        {
+            picked = parse_picked_request(req.body, samples->size());
+        }
+        catch (const InvalidInput& e)
+        {
+            set_error(res, 400, e.what());
+            return;
+        }
+        PickedVertices vertices{.triangles = std::move(picked.triangles),
+                                .source = "the picked base mesh"};
+        vertices.vertices.reserve(picked.samples.size());
+        for (const std::uint32_t s : picked.samples)
+            vertices.vertices.push_back(samples->world(s));
+        const bool started = job.start([&, vertices = std::move(vertices)](
+                                           ReconstructionJob& self, long long number) mutable {
+            try
+            {
+                const ProgressCallback progress = [&self](std::string_view stage, double f) {
+                    return self.progress(stage, f);
+                };
+                // What `pointform reconstruct SCAN --base-mesh PICKED.obj` runs, at its defaults.
+                SurfelsFromSamples surfels = surfels_from_samples(*samples, {.progress = progress});
+                ReconstructOptions options;
+                options.picked_vertices = std::move(vertices);
+                options.progress = progress;
+                ReconstructReport report = reconstruct(std::move(surfels.surfels), options);
+                nlohmann::json summary = {
+                    {"levels", level_report(report.semi_regular)},
+                    {"stop", std::string(to_string(report.semi_regular.refinement.stop))},
+                    {"base_faces", report.picked->mesh.face_count()},
+                    {"reoriented_faces", report.picked->reoriented_faces},
+                    {"euler_characteristic", report.picked->topology.euler_characteristic},
+                    {"boundary_loops", report.picked->topology.boundary_loops}};
+                ViewData data;
+                data.kind = ViewData::Kind::Hierarchy;
+                data.name = "reconstruction " + std::to_string(number);
+                data.hierarchy = std::move(report.semi_regular.hierarchy);
+                std::size_t id = 0;
+                {
+                    const std::lock_guard lock(layers_mutex);
+                    id = layers.size();
+                    auto layer = make_layer(std::move(data), id,
+                                            {{"source", "reconstruction"}, {"report", summary}});
+                    layers.push_back(std::move(layer));
+                }
+                self.finish(id, std::move(summary));
+            }
+            catch (const Cancelled&)
+            {
+                self.fail("cancelled");
+            }
+            catch (const std::bad_alloc&)
+            {
+                self.fail("out of memory");
+            }
+            catch (const std::exception& e)
+            {
+                self.fail(e.what());
+            }
+        });
+        if (!started)
+        {
+            set_error(res, 409, "a reconstruction is already running");
+            return;
+        }
+        res.status = 202;
+        res.set_content(job.status().dump(), "application/json");
+    });
+
     server.Get(R"(/.*)", [&files](const httplib::Request& req, httplib::Response& res) {
         const auto it = files.by_path.find(req.path);
         if (it == files.by_path.end())
@@ -386,9 +812,12 @@ void serve_view(const ViewData& data, const StaticFiles& files, const std::strin
         res.set_content(it->second.body, it->second.content_type.c_str());
         res.set_header("Cache-Control", "no-cache");
     });
-    const auto not_allowed = [](const httplib::Request&, httplib::Response& res) {
-        res.set_header("Allow", "GET, HEAD");
-        set_error(res, 405, "only GET is served");
+    const auto not_allowed = [](const httplib::Request& req, httplib::Response& res) {
+        const bool reconstruct = req.path == "/api/reconstruct";
+        res.set_header("Allow", reconstruct ? "GET, HEAD, POST" : "GET, HEAD");
+        set_error(res, 405,
+                  reconstruct ? "GET or POST /api/reconstruct"
+                              : "only GET is served here (POST only to /api/reconstruct)");
     };
     server.Post(R"(/.*)", not_allowed);
     server.Put(R"(/.*)", not_allowed);
@@ -428,6 +857,7 @@ void serve_view(const ViewData& data, const StaticFiles& files, const std::strin
     // listen_after_bind() also returns when the socket fails; make the stopper finish either way.
     on_stop_signal(0);
     stopper.join();
+    job.stop(); // a running reconstruction is cancelled at its next progress report
     ::sigaction(SIGINT, &old_int, nullptr);
     ::sigaction(SIGTERM, &old_term, nullptr);
     ::close(stop_pipe[0]);

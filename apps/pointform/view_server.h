@@ -4,33 +4,37 @@
 #pragma once
 
 /// \file
-/// \brief What `pointform view` serves: the data of the one file named on its command line,
-/// encoded once at start-up for the data endpoints (docs/viewer.md), and the HTTP server
-/// (cpp-httplib) that answers GET requests for a fixed list of names. No path from a request
-/// ever reaches the file system: the page's files are read into memory before serving.
+/// \brief What `pointform view` serves: the layers (the files named on its command line, then
+/// the reconstructions made from the page), each encoded once for the data endpoints
+/// (docs/viewer.md), and the HTTP server (cpp-httplib) that answers a fixed list of names. No
+/// path from a request ever reaches the file system: the page's files are read into memory
+/// before serving.
 
 #include "pointform/geometry/multires_mesh.h"
 #include "pointform/geometry/point_cloud.h"
 #include "pointform/geometry/tri_mesh.h"
+
+#include <nlohmann/json.hpp>
 
 #include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 namespace pointform::cli {
 
-/// \brief The file a viewer shows, read before the server starts.
+/// \brief One thing a viewer shows: a file read before the server starts, or a reconstruction.
 struct ViewData
 {
     enum class Kind
     {
-        Hierarchy, ///< a .pfh file: every level
+        Hierarchy, ///< a .pfh file or a reconstruction: every level
         Mesh,      ///< a triangle mesh: one level, drawn shaded
-        Points     ///< a point cloud (or surfels): drawn as points
+        Points     ///< a point cloud (or surfels): drawn as points, picked on
     };
     Kind kind = Kind::Points;
     std::string name;                      ///< the file's name (no directories)
@@ -38,8 +42,10 @@ struct ViewData
     TriMesh mesh;                          ///< Mesh: the mesh, served as the only level 0
     PointCloud points;                     ///< Points: the points
 
-    /// \brief Levels served by /api/level: the hierarchy's, 1 for a mesh, 0 for points.
+    /// \brief Levels served by /api/layer/<k>/level: the hierarchy's, 1 for a mesh, 0 for points.
     [[nodiscard]] std::size_t level_count() const;
+    /// \brief Level `level` as a mesh (a hierarchy's level or the mesh). \pre level < level_count()
+    [[nodiscard]] TriMesh level_mesh(std::size_t level) const;
 };
 
 /// \brief Reads `path`: a hierarchy (by its magic bytes), else a mesh if the file has faces,
@@ -49,16 +55,38 @@ struct ViewData
 /// \brief "hierarchy", "mesh" or "points".
 [[nodiscard]] const char* kind_name(ViewData::Kind kind);
 
-/// \brief GET /api/info: the JSON description of the data (docs/viewer.md).
-[[nodiscard]] std::string encode_info(const ViewData& data);
+/// \brief One layer's entry of GET /api/info (docs/viewer.md): kind, file, levels, bounding
+/// box, origin and what the points carry.
+[[nodiscard]] nlohmann::json encode_info(const ViewData& data);
 
-/// \brief GET /api/level/<i>: the 24-byte header, the float32 positions of the vertices new at
-/// level i and the uint32 faces of level i (docs/viewer.md). \pre i < level count
+/// \brief GET /api/layer/<k>/level/<i>: the 24-byte header, the float32 positions of the
+/// vertices new at level i and the uint32 faces of level i (docs/viewer.md).
+/// \pre i < level count
 [[nodiscard]] std::string encode_level(const ViewData& data, std::size_t level);
 
-/// \brief GET /api/points: the 16-byte header, float32 positions, float32 normals if any,
-/// uint8 RGB colours if any (docs/viewer.md). \pre data.kind == Points
+/// \brief GET /api/layer/<k>/points: the 16-byte header, float32 positions, float32 normals if
+/// any, uint8 RGB colours if any (docs/viewer.md). \pre data.kind == Points
 [[nodiscard]] std::string encode_points(const ViewData& data);
+
+/// \brief GET /api/layer/<k>/distance/<i>: the 40-byte header (the one-sided Hausdorff distance
+/// and the mean distance from the samples to level i, the largest vertex distance), then the
+/// float32 distance from every vertex of level i to its nearest sample (docs/viewer.md).
+/// \pre i < level count, samples not empty
+[[nodiscard]] std::string encode_distances(const ViewData& data, std::size_t level,
+                                           const PointCloud& samples);
+
+/// \brief The base mesh a page sends with POST /api/reconstruct: {"triangles": [[i, j, k],
+/// ...]} over the indices of the samples (the first point cloud's points), at most
+/// max_picked_triangles. \return the picked samples' indices in order of first use, and the
+/// triangles over positions in that list
+/// \throw InvalidInput saying what is wrong with the request (the server's 400)
+struct PickedRequest
+{
+    std::vector<std::uint32_t> samples;
+    std::vector<Triangle> triangles;
+};
+inline constexpr std::size_t max_picked_triangles = 100000;
+[[nodiscard]] PickedRequest parse_picked_request(const std::string& body, std::size_t sample_count);
 
 /// \brief One of the page's files, held in memory.
 struct StaticFile
@@ -68,8 +96,9 @@ struct StaticFile
 };
 
 /// \brief The page's files by URL path ("/", "/viewer.js", "/vendor/three.module.js", ...),
-/// read from `viewer_dir` (viewer/ of the source tree: web/ and node_modules/three). Files that
-/// are missing (three.js before `npm ci`) are left out and named in `missing`.
+/// read from `viewer_dir` (web/ and node_modules/three: viewer/ of the source tree, or the
+/// installed share/pointform/viewer). Files that are missing (three.js before `npm ci`) are left
+/// out and named in `missing`.
 struct StaticFiles
 {
     std::map<std::string, StaticFile> by_path;
@@ -77,11 +106,14 @@ struct StaticFiles
 };
 [[nodiscard]] StaticFiles read_static_files(const std::filesystem::path& viewer_dir);
 
-/// \brief Serves `data` and `files` on host:port (port 0: a free one) until stop_signal
-/// is raised (SIGINT or SIGTERM). `on_listening` receives the port once the socket is bound,
-/// before the first request is served.
+/// \brief Serves `layers` (the command line's files, in order) and `files` on host:port
+/// (port 0: a free one) until SIGINT or SIGTERM. Reconstructions asked for by the page run on
+/// the first point cloud among `layers` (surfels_from_samples() and reconstruct() with the
+/// picked base mesh, as `pointform reconstruct --base-mesh` runs them) and are served as new
+/// layers. `on_listening` receives the port once the socket is bound, before the first request
+/// is served.
 /// \throw std::runtime_error if the address cannot be bound
-void serve_view(const ViewData& data, const StaticFiles& files, const std::string& host, int port,
-                const std::function<void(int)>& on_listening);
+void serve_view(std::vector<ViewData> layers, const StaticFiles& files, const std::string& host,
+                int port, const std::function<void(int)>& on_listening);
 
 } // namespace pointform::cli

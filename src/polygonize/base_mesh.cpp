@@ -1221,27 +1221,58 @@ PickedBaseMesh read_picked_base_mesh(const std::filesystem::path& path, const Po
         return base_mesh_from_samples(triangles, samples, field, name, lines);
     }
 
-    // OBJ: snap every used vertex to its nearest sample.
-    const ReadResult obj = read_geometry(path, {});
+    // OBJ: every used vertex snaps to its nearest sample.
+    ReadResult obj = read_geometry(path, {});
     if (obj.triangles.empty())
     {
         throw InvalidInput(name + ": the OBJ file has no faces");
     }
+    PickedVertices picked{.triangles = std::move(obj.triangles), .source = name};
+    picked.vertices.resize(obj.points.size());
+    for (std::size_t v = 0; v < picked.vertices.size(); ++v)
+        picked.vertices[v] = obj.points.world(v);
+    return snap_picked_base_mesh(picked, samples, field);
+}
+
+PickedBaseMesh snap_picked_base_mesh(const PickedVertices& picked, const PointCloud& samples,
+                                     const Field& field)
+{
+    const std::string& name = picked.source;
+    if (samples.empty())
+    {
+        throw InvalidInput(name + ": no samples to pick from");
+    }
+    if (picked.triangles.empty())
+    {
+        throw InvalidInput(name + ": no triangles");
+    }
     const KdTree tree(samples.positions);
-    std::vector<std::uint32_t> sample_of(obj.points.size(), PointId::invalid_value);
+    std::vector<std::uint32_t> sample_of(picked.vertices.size(), PointId::invalid_value);
     std::map<std::uint32_t, std::size_t> vertex_of_sample;
     double max_snap = 0.0;
     std::vector<Triangle> triangles;
-    triangles.reserve(obj.triangles.size());
-    for (const Triangle& t : obj.triangles)
+    triangles.reserve(picked.triangles.size());
+    for (std::size_t f = 0; f < picked.triangles.size(); ++f)
     {
+        const Triangle& t = picked.triangles[f];
         Triangle s{};
         for (std::size_t k = 0; k < 3; ++k)
         {
             const std::uint32_t v = t[k];
+            if (v >= picked.vertices.size())
+            {
+                throw InvalidInput(name + ": triangle " + std::to_string(f + 1) + " names vertex " +
+                                   std::to_string(v + 1) + " of " +
+                                   std::to_string(picked.vertices.size()));
+            }
             if (sample_of[v] == PointId::invalid_value)
             {
-                const Vec3d world = obj.points.world(v);
+                const Vec3d& world = picked.vertices[v];
+                if (!world.allFinite())
+                {
+                    throw InvalidInput(name + ": vertex " + std::to_string(v + 1) +
+                                       " is not finite");
+                }
                 float squared = 0.0F;
                 const PointId nearest =
                     tree.nearest((world - samples.origin).cast<float>(), &squared);

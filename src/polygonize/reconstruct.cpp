@@ -223,6 +223,8 @@ VertexResidual field_residual_at_vertices(const TriMesh& mesh, const Field& fiel
 ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& options)
 {
     check_semi_regular_options(options.semi_regular);
+    if (!options.base_mesh.empty() && !options.picked_vertices.empty())
+        throw InvalidInput("give a base-mesh file or picked vertices, not both");
     ReconstructReport report;
     StageClock clock(report.stage_seconds);
     const Aabb bounds = surfels.bounds();
@@ -230,10 +232,12 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
     clock.lap("field");
     const PointCloud& samples = field.surfels();
 
-    if (!options.base_mesh.empty())
+    if (!options.base_mesh.empty() || !options.picked_vertices.empty())
     {
         // M0 picked over the samples (§5.1, Fig. 6).
-        report.picked = read_picked_base_mesh(options.base_mesh, samples, field);
+        report.picked = options.base_mesh.empty()
+                            ? snap_picked_base_mesh(options.picked_vertices, samples, field)
+                            : read_picked_base_mesh(options.base_mesh, samples, field);
         report.picked_angles = angle_quality(report.picked->mesh);
         const double base_seconds = clock.lap("base mesh (picked)");
         report.semi_regular = refine_semi_regular(report.picked->mesh, field, &samples,

@@ -241,7 +241,8 @@ nlohmann::json report_json(const ReconstructReport& report, const ReconstructOpt
     {
         const PickedBaseMesh& picked = *report.picked;
         nlohmann::json b;
-        b["source"] = options.base_mesh.string();
+        b["source"] =
+            options.base_mesh.empty() ? options.picked_vertices.source : options.base_mesh.string();
         b["faces"] = picked.mesh.face_count();
         b["vertices"] = picked.mesh.vertex_count();
         b["reoriented_faces"] = picked.reoriented_faces;

@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <sstream>
@@ -602,6 +603,63 @@ TEST(PickedBaseMesh, ObjVerticesSnapToTheNearestSamples)
         [&] { (void)read_picked_base_mesh(dir / "twice.obj", samples, *picks.field); });
     EXPECT_NE(message.find("twice.obj"), std::string::npos) << message;
     EXPECT_NE(message.find("same sample"), std::string::npos) << message;
+}
+
+TEST(PickedBaseMesh, PickedVerticesInMemoryGiveTheObjFilesMesh)
+{
+    const Picks picks = sphere_picks();
+    const PointCloud& samples = picks.field->surfels();
+    // The axis samples' own positions, as `pointform view` sends them, and the same as an OBJ.
+    PickedVertices picked{.source = "the viewer's picked triangles"};
+    std::ostringstream obj;
+    obj.precision(17);
+    for (const std::uint32_t s : picks.axis)
+    {
+        picked.vertices.push_back(samples.world(s));
+        obj << "v " << samples.world(s).x() << ' ' << samples.world(s).y() << ' '
+            << samples.world(s).z() << '\n';
+    }
+    for (const auto& t : octahedron)
+    {
+        picked.triangles.push_back({static_cast<std::uint32_t>(t[0]),
+                                    static_cast<std::uint32_t>(t[2]),
+                                    static_cast<std::uint32_t>(t[1])}); // inwards: reoriented
+        obj << "f " << t[0] + 1 << ' ' << t[2] + 1 << ' ' << t[1] + 1 << '\n';
+    }
+    const test::TempDir dir;
+    test::write_file(dir / "picked.obj", obj.str());
+    const PickedBaseMesh from_memory = snap_picked_base_mesh(picked, samples, *picks.field);
+    const PickedBaseMesh from_file =
+        read_picked_base_mesh(dir / "picked.obj", samples, *picks.field);
+    EXPECT_EQ(from_memory.mesh.triangles, from_file.mesh.triangles);
+    EXPECT_EQ(from_memory.samples, from_file.samples);
+    EXPECT_EQ(from_memory.reoriented_faces, 8U);
+    EXPECT_EQ(from_memory.topology.euler_characteristic, 2);
+    EXPECT_EQ(from_memory.max_snap_distance, 0.0);
+    for (const std::uint32_t s : picks.axis) // every pick is its own sample
+        EXPECT_NE(std::find_if(from_memory.samples.begin(), from_memory.samples.end(),
+                               [&](PointId id) { return id.value == s; }),
+                  from_memory.samples.end());
+
+    // Refusals name the source.
+    const auto refused = [&](PickedVertices bad, const std::string& expected) {
+        const std::string message =
+            invalid_input_message([&] { (void)snap_picked_base_mesh(bad, samples, *picks.field); });
+        EXPECT_NE(message.find("the viewer's picked triangles"), std::string::npos) << message;
+        EXPECT_NE(message.find(expected), std::string::npos) << message;
+    };
+    PickedVertices out_of_range = picked;
+    out_of_range.triangles.push_back({0, 1, 6});
+    refused(out_of_range, "names vertex 7 of 6");
+    PickedVertices not_finite = picked;
+    not_finite.vertices[2].x() = std::numeric_limits<double>::quiet_NaN();
+    refused(not_finite, "not finite");
+    PickedVertices none = picked;
+    none.triangles.clear();
+    refused(none, "no triangles");
+    PickedVertices fin = picked; // three triangles on one edge
+    fin.triangles.push_back({0, 2, 1});
+    refused(fin, "edge");
 }
 
 } // namespace

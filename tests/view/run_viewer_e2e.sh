@@ -1,7 +1,8 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
-# The CTest test viewer_e2e: reconstructs the shipped bunny scan into a hierarchy and opens it with
-# `pointform view` in Debian's chromium, driven by playwright-core (viewer_e2e.mjs). Exits 77
+# The CTest test viewer_e2e: makes the shipped bunny scan's samples (its points with oriented
+# normals), reconstructs them into a hierarchy and opens both with `pointform view` in Debian's
+# chromium, driven by playwright-core (viewer_e2e.mjs). Exits 77
 # (CTest's "skipped") when node, chromium, three.js or playwright-core is missing.
 #   run_viewer_e2e.sh NODE POINTFORM SCAN OUTPUT_FOLDER
 # PF_UPDATE_DOCS_SCREENSHOT=1 also copies the screenshot to docs/images/viewer_bunny.png.
@@ -31,10 +32,13 @@ done
 
 rm -rf "$out"
 mkdir -p "$out"
-"$cli" reconstruct "$scan" -o "$out/bunny.ply" --save-hierarchy "$out/bunny.pfh" -q
+"$cli" normals "$scan" -o "$out/samples.ply" -q
+"$cli" reconstruct "$out/samples.ply" -o "$out/bunny.ply" --save-hierarchy "$out/bunny.pfh" --json \
+  > "$out/bunny.json"
 docs=""
 if [ "${PF_UPDATE_DOCS_SCREENSHOT:-0}" = 1 ]; then
   docs="$here/../../docs/images/viewer_bunny.png"
 fi
 # shellcheck disable=SC2086
-exec "$node" "$here/viewer_e2e.mjs" "$cli" "$out/bunny.pfh" "$out" $docs
+exec "$node" "$here/viewer_e2e.mjs" "$cli" "$out/bunny.pfh" "$out/samples.ply" "$out/bunny.json" \
+  "$out" $docs

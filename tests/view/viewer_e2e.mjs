@@ -2,11 +2,15 @@
 // Copyright (c) 2026 the pointform authors
 //
 // The browser test of `pointform view` (CTest viewer_e2e, through run_viewer_e2e.sh): starts the
-// server on a hierarchy, drives Debian's chromium headless through playwright-core (installed in
-// viewer/node_modules by scripts/setup.sh; no browser download; WebGL through SwiftShader) and
-// checks that every level arrives, the canvas is not blank, each level has 4 times the faces of
-// the one below, the picture export gives a PNG, and nothing but the page and the data is served.
-//   node viewer_e2e.mjs POINTFORM HIERARCHY.pfh OUTPUT_FOLDER [DOCS_SCREENSHOT.png]
+// server on a hierarchy and its samples, drives Debian's chromium headless through playwright-core
+// (installed in viewer/node_modules by scripts/setup.sh; no browser download; WebGL through
+// SwiftShader) and checks that every level arrives, the canvas is not blank, each level has 4
+// times the faces of the one below, the distances to the samples agree with the reconstruction's
+// report, the picture export gives a PNG, a base mesh picked by mouse clicks is checked live,
+// refused when it is not a manifold, reconstructed on the server with the same result as
+// `pointform reconstruct --base-mesh` with the saved OBJ, and nothing but the page and the data
+// is served.
+//   node viewer_e2e.mjs POINTFORM HIERARCHY.pfh SAMPLES REPORT.json OUTPUT_FOLDER [DOCS_SCREENSHOT.png]
 // Exits 0 on success, 1 on a failed check, 77 (skipped) without chromium or playwright-core.
 
 import { spawn, execFileSync } from 'node:child_process';
@@ -20,9 +24,9 @@ const here = path.dirname(fileURLToPath(import.meta.url));
 const viewerDir = path.resolve(here, '../../viewer');
 const chromiumPath = process.env.PF_CHROMIUM ?? '/usr/bin/chromium';
 
-const [cli, hierarchy, outDir, docsScreenshot] = process.argv.slice(2);
-if (!cli || !hierarchy || !outDir) {
-  console.error('usage: node viewer_e2e.mjs POINTFORM HIERARCHY.pfh OUTPUT_FOLDER [DOCS_SCREENSHOT.png]');
+const [cli, hierarchy, samplesFile, reportFile, outDir, docsScreenshot] = process.argv.slice(2);
+if (!cli || !hierarchy || !samplesFile || !reportFile || !outDir) {
+  console.error('usage: node viewer_e2e.mjs POINTFORM HIERARCHY.pfh SAMPLES REPORT.json OUTPUT_FOLDER [DOCS_SCREENSHOT.png]');
   process.exit(2);
 }
 if (!existsSync(chromiumPath)) {
@@ -44,10 +48,10 @@ function check(condition, what) {
   if (!condition) failures += 1;
 }
 
-/** Starts `pointform view FILE --port 0` and resolves to { server, url } once it prints the URL. */
-function startServer(file) {
+/** Starts `pointform view FILES --port 0` and resolves to { server, url } once it prints the URL. */
+function startServer(files) {
   return new Promise((resolve, reject) => {
-    const server = spawn(cli, ['view', file, '--port', '0'], { stdio: ['ignore', 'pipe', 'pipe'] });
+    const server = spawn(cli, ['view', ...files, '--port', '0'], { stdio: ['ignore', 'pipe', 'pipe'] });
     let out = '';
     const timer = setTimeout(() => reject(new Error(`no URL printed within 20 s: ${out}`)), 20000);
     server.stdout.on('data', (chunk) => {
@@ -75,9 +79,12 @@ function rawGet(port, rawPath) {
   });
 }
 
-const expected = JSON.parse(execFileSync(cli, ['lod', hierarchy, '--json'], { encoding: 'utf8' })).levels;
+const lod = (file) => JSON.parse(execFileSync(cli, ['lod', file, '--json'], { encoding: 'utf8' })).levels;
+const expected = lod(hierarchy);
+const near = (a, b, tolerance) => Math.abs(a - b) <= tolerance * Math.max(Math.abs(a), Math.abs(b));
 mkdirSync(outDir, { recursive: true });
-const { server, url, port } = await startServer(hierarchy);
+const report = JSON.parse(readFileSync(reportFile, 'utf8'));
+const { server, url, port } = await startServer([hierarchy, samplesFile]);
 const serverExit = new Promise((resolve) => server.on('exit', (code, signal) => resolve({ code, signal })));
 const browser = await chromium.launch({
   executablePath: chromiumPath,
@@ -147,11 +154,17 @@ try {
 
   // Only the page and the data of the file named on the command line are served.
   const refused = await page.evaluate(async () => {
-    const paths = ['/bunny.pfh', '/data/bunny/bun_zipper.ply', '/CMakeLists.txt', '/web/index.html',
-      '/node_modules/three/package.json', '/api/level/99', '/api/points', '/etc/passwd'];
+    const paths = ['/bunny.pfh', '/samples.ply', '/data/bunny/bun_zipper.ply', '/CMakeLists.txt',
+      '/web/index.html', '/node_modules/three/package.json', '/api/layer/0/level/99',
+      '/api/layer/0/points', '/api/layer/7/points', '/api/layer/1/level/0', '/api/layer/x/points',
+      '/api/layer/0/distance/99', '/etc/passwd'];
     const statuses = {};
     for (const p of paths) statuses[p] = (await fetch(p)).status;
     statuses['POST /api/info'] = (await fetch('/api/info', { method: 'POST', body: 'x' })).status;
+    for (const body of ['x', '[[[[[[[[[[', '{"triangles": [[0, 1]]}', '{"triangles": [[0, 1, 99999999]]}',
+      '{"triangles": []}', '{"triangles": [[0, 1, -2]]}']) {
+      statuses[`POST /api/reconstruct ${body}`] = (await fetch('/api/reconstruct', { method: 'POST', body })).status;
+    }
     return statuses;
   });
   for (const rawPath of ['/../../etc/passwd', '/vendor/../../CMakeLists.txt', '/%2e%2e/%2e%2e/etc/passwd']) {
@@ -162,8 +175,23 @@ try {
   }
   check(await page.evaluate(async () => (await fetch('/api/info')).status) === 200,
     'the server still answers after the refused requests');
+  errors.length = 0; // the refused requests above were logged by the browser as failed loads
 
-  // The screenshot: the finest level with the base mesh over it.
+  // Colour by distance: the server's distances from the samples to each level are the
+  // reconstruction report's one-sided Hausdorff distances.
+  await page.evaluate(() => window.pointform.setColorByDistance(true));
+  for (let i = 0; i < expected.length; ++i) {
+    const measured = await page.evaluate((l) => window.pointform.hausdorff(l), i);
+    const reported = report.levels[i].hausdorff;
+    check(near(measured, reported, 1e-5),
+      `level ${i}: Hausdorff from the samples ${measured.toPrecision(6)} = the report's ${reported.toPrecision(6)}`);
+  }
+  check(await page.evaluate(() => document.getElementById('legend').textContent.startsWith('distance')),
+    'colour by distance shows its legend');
+  await page.evaluate(() => window.pointform.setColorByDistance(false));
+
+  // The picture export downloads a PNG (above); the screenshot: the finest level with the base
+  // mesh over it, before any picking.
   await page.evaluate((l) => { window.pointform.setLevel(l); window.pointform.setBaseOverlay(true); }, expected.length - 1);
   const shot = path.join(outDir, 'viewer_bunny.png');
   await page.screenshot({ path: shot });
@@ -172,6 +200,106 @@ try {
     copyFileSync(shot, docsScreenshot);
     console.log(`screenshot copied to ${docsScreenshot}`);
   }
+  await page.evaluate(() => window.pointform.setBaseOverlay(false));
+
+  // The interactive base mesh (Fig. 6), by mouse clicks: an octahedron over the samples
+  // farthest along the six axes, each picked in the view from its axis.
+  await page.check('#pick-mode');
+  const box = await page.locator('#view').boundingBox();
+  const axes = [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]];
+  const octahedron = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+  const vertexOf = new Map(); // axis -> picked sample
+  const click = async (x, y) => {
+    await page.mouse.click(box.x + x, box.y + y);
+  };
+  for (const face of octahedron) {
+    for (const a of face) {
+      // Each vertex is clicked in the view from its axis, where it is in front.
+      await page.evaluate((d) => window.pointform.setView(d), axes[a]);
+      if (vertexOf.has(a)) {
+        const [x, y] = await page.evaluate((s) => window.pointform.sampleScreenPosition(s), vertexOf.get(a));
+        await click(x, y);
+        continue;
+      }
+      // The centre of the view, or the nearest point around it where a sample is drawn.
+      const target = await page.evaluate(([w, h]) => {
+        for (let r = 0; r < 200; r += 4) {
+          for (let k = 0; k < Math.max(1, 2 * r); ++k) {
+            const x = w / 2 + r * Math.cos(k * Math.PI / Math.max(1, r));
+            const y = h / 2 + r * Math.sin(k * Math.PI / Math.max(1, r));
+            if (window.pointform.pickSample(x, y) !== null) return [x, y];
+          }
+        }
+        return null;
+      }, [box.width, box.height]);
+      check(target !== null, `a sample is drawn near the centre of the view from ${axes[a]}`);
+      const before = (await page.evaluate(() => window.pointform.baseMesh())).vertices.length;
+      await click(...target);
+      const after = await page.evaluate(() => window.pointform.baseMesh());
+      vertexOf.set(a, after.vertices[after.vertices.length - 1]);
+      check(after.vertices.length === before + 1, `a click from ${axes[a]} picks sample ${vertexOf.get(a)}`);
+    }
+  }
+  let picked = await page.evaluate(() => window.pointform.baseMesh());
+  check(picked.triangles.length === 8 && picked.check.closed && picked.check.manifold && picked.check.orientable &&
+    picked.check.euler === 2 && picked.check.ok,
+    `8 triangles by clicks: closed, manifold, oriented, Euler characteristic ${picked.check.euler} (${picked.shownChecks.join('; ')})`);
+  // Undo takes the last triangle back (an open mesh, one boundary loop of 3 edges) ...
+  await page.click('#undo');
+  picked = await page.evaluate(() => window.pointform.baseMesh());
+  check(picked.triangles.length === 7 && picked.check.boundaryEdges === 3 && picked.check.ok,
+    `undo: 7 triangles, 3 boundary edges (${picked.check.boundaryEdges} shown)`);
+  const last = octahedron[7].map((a) => vertexOf.get(a));
+  await page.evaluate((t) => window.pointform.joinTriangle(...t), last);
+  // ... and a fin on an edge is not a manifold: shown on the page, refused by the server.
+  const fin = await page.evaluate(() => {
+    const p = window.pointform;
+    const extra = [0, 1, 2, 3, 4, 5].map((k) => 100 + 997 * k).find((s) => !p.baseMesh().vertices.includes(s));
+    p.addVertex(extra);
+    const [a, b] = p.baseMesh().triangles[0];
+    p.joinTriangle(a, b, extra);
+    return { extra, state: p.baseMesh(), disabled: document.getElementById('reconstruct').disabled };
+  });
+  check(!fin.state.check.manifold && fin.disabled &&
+    fin.state.shownChecks.some((t) => t.startsWith('not a manifold: the edge between samples')),
+    `a third triangle on an edge: "${fin.state.shownChecks.find((t) => t.startsWith('not a manifold')) ?? ''}", reconstruct disabled`);
+  const refusal = await page.evaluate(() => window.pointform.reconstruct(true));
+  const shownRefusal = await page.evaluate(() => window.pointform.jobText());
+  check(refusal.state === 'failed' && /more than two triangles/.test(refusal.message) && shownRefusal.startsWith('refused:'),
+    `the server refuses it with the reason on the page: "${shownRefusal}"`);
+  await page.evaluate(() => { window.pointform.undo(); window.pointform.undo(); });
+  picked = await page.evaluate(() => window.pointform.baseMesh());
+  check(picked.check.ok && picked.triangles.length === 8 && picked.vertices.length === 6,
+    'undo twice: the octahedron again');
+
+  // Save it in the format --base-mesh reads.
+  const [saved] = await Promise.all([page.waitForEvent('download'), page.click('#save-base')]);
+  const savedObj = path.join(outDir, saved.suggestedFilename());
+  await saved.saveAs(savedObj);
+  check(savedObj.endsWith('.obj') && /^v /m.test(readFileSync(savedObj, 'utf8')), `save base mesh -> ${savedObj}`);
+
+  // Reconstruct on the server: the new levels arrive as a layer, 4x the faces per level.
+  await page.click('#reconstruct');
+  await page.waitForFunction(() => window.pointform.layers().some((l) => l.source === 'reconstruction') &&
+    window.pointform.loadedLevels() === window.pointform.levelCount(), null, { timeout: 120000 });
+  const rebuilt = await page.evaluate(() => {
+    const p = window.pointform;
+    const faces = [];
+    for (let i = 0; i < p.levelCount(); ++i) { p.setLevel(i); faces.push(p.faceCount()); }
+    return { faces, report: p.report(), text: p.jobText() };
+  });
+  check(rebuilt.faces.length > 1 && rebuilt.faces.every((f, i) => f === 8 * 4 ** i),
+    `Reconstruct returned ${rebuilt.faces.length} levels of ${rebuilt.faces.join(', ')} faces (${rebuilt.text})`);
+
+  // The same library call as the command line with the saved base mesh: same levels and figures.
+  const cliReport = JSON.parse(execFileSync(cli, ['reconstruct', samplesFile, '--base-mesh', savedObj,
+    '-o', path.join(outDir, 'picked.ply'), '--save-hierarchy', path.join(outDir, 'picked.pfh'), '--json'],
+  { encoding: 'utf8' }));
+  const same = cliReport.levels.length === rebuilt.report.levels.length &&
+    cliReport.levels.every((l, i) => near(l.hausdorff, rebuilt.report.levels[i].hausdorff, 1e-12));
+  check(same, `pointform reconstruct --base-mesh ${path.basename(savedObj)}: ${cliReport.levels.length} levels, ` +
+    `the same Hausdorff distances as the page's reconstruction (finest ${cliReport.levels.at(-1).hausdorff.toPrecision(6)})`);
+  check(errors.length === 0, `no errors on the page after picking ${errors.length ? JSON.stringify(errors) : ''}`);
 } finally {
   await browser.close();
   server.kill('SIGINT');

@@ -195,6 +195,28 @@ struct PickedBaseMesh
                                                     const std::string& source = "picked triangles",
                                                     std::span<const std::size_t> lines = {});
 
+/// \brief A base mesh picked as points: vertex positions (world coordinates) and triangles over
+/// them, each used vertex to be snapped to its nearest sample (snap_picked_base_mesh()). What an
+/// OBJ given to read_picked_base_mesh() holds, and what `pointform view` sends when a user picks
+/// samples on its page.
+struct PickedVertices
+{
+    std::vector<Vec3d> vertices;
+    std::vector<Triangle> triangles;
+    /// How messages name the input (a file name, "the viewer's picked triangles").
+    std::string source = "picked triangles";
+
+    [[nodiscard]] bool empty() const noexcept { return triangles.empty(); }
+};
+
+/// \brief Snaps every vertex used by picked.triangles to its nearest sample, then
+/// base_mesh_from_samples(); PickedBaseMesh::max_snap_distance is the farthest snap.
+/// \throw InvalidInput naming picked.source: no samples or no triangles, a vertex index out of
+///        range, a vertex that is not finite, two vertices that snap to the same sample, and
+///        every condition of base_mesh_from_samples()
+[[nodiscard]] PickedBaseMesh snap_picked_base_mesh(const PickedVertices& picked,
+                                                   const PointCloud& samples, const Field& field);
+
 /// \brief Reads a picked base mesh: an OBJ (".obj") whose vertices are snapped to their nearest
 /// samples, or any other file as text, one triangle a line as three sample indices "i j k"
 /// (0-based; '#' starts a comment; blank lines are skipped). Then base_mesh_from_samples().

@@ -155,6 +155,10 @@ struct ReconstructOptions
     /// A picked base mesh (§5.1, Fig. 6; read_picked_base_mesh()) instead of the automatic one;
     /// empty = automatic (then marching cubes and the debris removal run).
     std::filesystem::path base_mesh;
+    /// A picked base mesh given as points that snap to the nearest samples
+    /// (snap_picked_base_mesh(); what `pointform view` sends), instead of a file; at most one of
+    /// `base_mesh` and `picked_vertices`.
+    PickedVertices picked_vertices;
     SemiRegularOptions semi_regular;
     ProgressCallback progress;
 };
@@ -178,7 +182,8 @@ struct ReconstructReport
     std::size_t degenerate_triangles = 0;
     std::size_t degenerate_kept = 0;
     ComponentFilterReport debris;
-    /// The picked base mesh, when ReconstructOptions::base_mesh was given, and its angles.
+    /// The picked base mesh, when ReconstructOptions::base_mesh or picked_vertices was given, and
+    /// its angles.
     std::optional<PickedBaseMesh> picked;
     AngleQuality picked_angles;
     /// Wall-clock seconds by stage, in order: "field", then "marching cubes", "debris",
@@ -190,7 +195,8 @@ struct ReconstructReport
 /// cubes, debris removal and the automatic base mesh (or the picked one), then
 /// refine_semi_regular() measured from the surfels.
 /// \param surfels  oriented surfels with radii (surfels_from_samples())
-/// \throw InvalidInput for bad surfels or options, or work that would not fit in memory;
+/// \throw InvalidInput for bad surfels or options (both a base-mesh file and picked vertices),
+///        or work that would not fit in memory;
 ///        IoError for an unreadable picked base mesh; Error when marching cubes makes no
 ///        triangle; Cancelled if the progress callback asks to stop
 [[nodiscard]] ReconstructReport reconstruct(PointCloud surfels,
