@@ -28,3 +28,11 @@ run(${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/consumer" -B "${WORK_DIR}/build" -G
     -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF)
 run(${CMAKE_COMMAND} --build "${WORK_DIR}/build")
 run("${WORK_DIR}/build/consumer" "${WORK_DIR}/consumer_sphere.ply")
+
+# The page `pointform view` serves is installed beside the executable (share/pointform/viewer),
+# where an installed pointform reads it.
+foreach(file web/index.html web/viewer.js web/base_mesh.js web/style.css)
+  if(NOT EXISTS "${WORK_DIR}/prefix/share/pointform/viewer/${file}")
+    message(FATAL_ERROR "the viewer's ${file} is not installed under share/pointform/viewer")
+  endif()
+endforeach()

@@ -192,7 +192,11 @@ try {
 
   // The picture export downloads a PNG (above); the screenshot: the finest level with the base
   // mesh over it, before any picking.
-  await page.evaluate((l) => { window.pointform.setLevel(l); window.pointform.setBaseOverlay(true); }, expected.length - 1);
+  await page.evaluate((l) => {
+    window.pointform.setLayerVisible(1, false); // the samples
+    window.pointform.setLevel(l);
+    window.pointform.setBaseOverlay(true);
+  }, expected.length - 1);
   const shot = path.join(outDir, 'viewer_bunny.png');
   await page.screenshot({ path: shot });
   console.log(`screenshot: ${shot}`);
@@ -200,7 +204,7 @@ try {
     copyFileSync(shot, docsScreenshot);
     console.log(`screenshot copied to ${docsScreenshot}`);
   }
-  await page.evaluate(() => window.pointform.setBaseOverlay(false));
+  await page.evaluate(() => { window.pointform.setBaseOverlay(false); window.pointform.setLayerVisible(1, true); });
 
   // The interactive base mesh (Fig. 6), by mouse clicks: an octahedron over the samples
   // farthest along the six axes, each picked in the view from its axis.
@@ -222,16 +226,17 @@ try {
         continue;
       }
       // The centre of the view, or the nearest point around it where a sample is drawn.
-      const target = await page.evaluate(([w, h]) => {
+      const target = await page.evaluate(() => {
+        const [cx, cy] = window.pointform.sceneCentreOnScreen();
         for (let r = 0; r < 200; r += 4) {
           for (let k = 0; k < Math.max(1, 2 * r); ++k) {
-            const x = w / 2 + r * Math.cos(k * Math.PI / Math.max(1, r));
-            const y = h / 2 + r * Math.sin(k * Math.PI / Math.max(1, r));
+            const x = cx + r * Math.cos(k * Math.PI / Math.max(1, r));
+            const y = cy + r * Math.sin(k * Math.PI / Math.max(1, r));
             if (window.pointform.pickSample(x, y) !== null) return [x, y];
           }
         }
         return null;
-      }, [box.width, box.height]);
+      });
       check(target !== null, `a sample is drawn near the centre of the view from ${axes[a]}`);
       const before = (await page.evaluate(() => window.pointform.baseMesh())).vertices.length;
       await click(...target);
@@ -290,6 +295,23 @@ try {
   });
   check(rebuilt.faces.length > 1 && rebuilt.faces.every((f, i) => f === 8 * 4 ** i),
     `Reconstruct returned ${rebuilt.faces.length} levels of ${rebuilt.faces.join(', ')} faces (${rebuilt.text})`);
+
+  // The second picture: the picked octahedron over the samples and the level 2 it gave.
+  await page.evaluate(() => {
+    const p = window.pointform;
+    p.setLayerVisible(1, false); // the samples: the picked octahedron stays drawn
+    p.setLevel(3);
+    p.setView([0.6, 0.35, 1]);
+  });
+  const pickedShot = path.join(outDir, 'viewer_picked.png');
+  await page.screenshot({ path: pickedShot });
+  console.log(`screenshot: ${pickedShot}`);
+  if (docsScreenshot) {
+    const docsPicked = path.join(path.dirname(docsScreenshot), 'viewer_picked.png');
+    copyFileSync(pickedShot, docsPicked);
+    console.log(`screenshot copied to ${docsPicked}`);
+  }
+  await page.evaluate(() => window.pointform.setLayerVisible(1, true));
 
   // The same library call as the command line with the saved base mesh: same levels and figures.
   const cliReport = JSON.parse(execFileSync(cli, ['reconstruct', samplesFile, '--base-mesh', savedObj,

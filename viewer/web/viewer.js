@@ -70,6 +70,11 @@ function resize() {
     renderer.setSize(w, h, false);
   }
   camera.aspect = w / Math.max(h, 1);
+  // The picture's centre moved right by half the panel's width, when there is room, so that
+  // the framed scene is not under the panel.
+  const panelWidth = $('panel').offsetWidth + 8;
+  if (w > 2.5 * panelWidth) camera.setViewOffset(w, h, -panelWidth / 2, 0, w, h);
+  else camera.clearViewOffset();
   camera.updateProjectionMatrix();
   render();
 }
@@ -480,7 +485,9 @@ function drawPicked() {
     group.add(new THREE.LineSegments(eg, new THREE.LineBasicMaterial({ vertexColors: true, depthTest: false })));
   }
   group.renderOrder = 10;
-  samples.group.add(group);
+  // Beside the samples, not in their group: it stays visible when the samples are hidden.
+  group.position.copy(samples.group.position);
+  scene.add(group);
   pickOverlay = group;
 }
 
@@ -635,8 +642,9 @@ async function reconstruct(force = false) {
     info.layers = fresh.layers;
     followStream = true;
     const layerInfo = fresh.layers[job.layer];
+    // The new surface replaces the others on screen (their boxes in the list bring them back).
+    for (const l of layers) if (l.info.kind !== 'points') l.group.visible = false;
     await addLayer(layerInfo);
-    if (samples) samples.group.visible = true;
     updateLayerList();
   }
   return job;
@@ -674,6 +682,8 @@ window.pointform = {
    *  loading failed. */
   ready: () => readyPromise,
   isReady: () => allArrived,
+  /** Shows or hides layer `id`. */
+  setLayerVisible: (id, on) => { layers[id].group.visible = on; updateLayerList(); render(); },
   /** The layers: file, kind, levels, source ("file" or "reconstruction"). */
   layers: () => layers.map((l) => ({ id: l.info.id, file: l.info.file, kind: l.info.kind,
     levels: l.info.levels.length, source: l.info.source })),
@@ -691,6 +701,11 @@ window.pointform = {
   setView: (direction) => frame(direction),
   /** The sample drawn under (x, y) (CSS pixels from the canvas's top-left), or null. */
   pickSample,
+  /** Where the centre of the scene's box is drawn now: [x, y] in CSS pixels. */
+  sceneCentreOnScreen: () => {
+    const v = sceneBounds().getCenter(new THREE.Vector3()).project(camera);
+    return [(v.x + 1) / 2 * canvas.clientWidth, (1 - v.y) / 2 * canvas.clientHeight];
+  },
   /** Where sample s is drawn now: [x, y] in CSS pixels from the canvas's top-left. */
   sampleScreenPosition: (s) => { const [x, y] = screenOf(s); return [x * canvas.clientWidth, y * canvas.clientHeight]; },
   /** A click in picking mode at (x, y): the picked sample or null. */
