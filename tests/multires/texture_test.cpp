@@ -17,7 +17,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <random>
 
 namespace pointform {
@@ -125,27 +128,63 @@ TEST(Atlas, ChartsNeitherFlipNorOverlapAndAFlatHierarchyIsIsometric)
         const Atlas atlas = make_atlas(refined, refined.finest_level(), {.size = 512, .gutter = 3});
         EXPECT_EQ(atlas.size, 512);
         EXPECT_GT(atlas.texel_usage, 0.2);
-        // Charts' boxes inside the texture and at least a gutter apart.
+        // Charts inside the texture and at least a gutter apart (triangles may interleave, so
+        // the distance between the triangles themselves).
         const std::size_t charts = atlas.corners.size();
-        std::vector<std::pair<Vec2d, Vec2d>> boxes;
-        for (const auto& c : atlas.corners)
-        {
-            const Vec2d lo = c[0].cwiseMin(c[1]).cwiseMin(c[2]) * atlas.size;
-            const Vec2d hi = c[0].cwiseMax(c[1]).cwiseMax(c[2]) * atlas.size;
-            EXPECT_GE(lo.minCoeff(), 0.0);
-            EXPECT_LE(hi.maxCoeff(), atlas.size);
-            boxes.emplace_back(lo, hi);
-        }
+        std::vector<std::array<Vec2d, 3>> texel(charts);
+        for (std::size_t i = 0; i < charts; ++i)
+            for (std::size_t k = 0; k < 3; ++k)
+            {
+                texel[i][k] = atlas.corners[i][k] * atlas.size;
+                EXPECT_GE(texel[i][k].minCoeff(), 0.5 * atlas.gutter - 1e-9);
+                EXPECT_LE(texel[i][k].maxCoeff(), atlas.size - 0.5 * atlas.gutter + 1e-9);
+            }
+        const auto segment_distance = [](const Vec2d& p, const Vec2d& a, const Vec2d& b) {
+            const Vec2d ab = b - a;
+            const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+            return (a + t * ab - p).norm();
+        };
+        const auto inside = [](const Vec2d& p, const std::array<Vec2d, 3>& t) {
+            const auto side = [](const Vec2d& a, const Vec2d& b, const Vec2d& q) {
+                return (b - a).x() * (q - a).y() - (b - a).y() * (q - a).x();
+            };
+            const double s0 = side(t[0], t[1], p);
+            const double s1 = side(t[1], t[2], p);
+            const double s2 = side(t[2], t[0], p);
+            return (s0 >= 0 && s1 >= 0 && s2 >= 0) || (s0 <= 0 && s1 <= 0 && s2 <= 0);
+        };
+        const auto distance = [&](const std::array<Vec2d, 3>& a, const std::array<Vec2d, 3>& b) {
+            double d = std::numeric_limits<double>::infinity();
+            const auto cross = [](const Vec2d& p, const Vec2d& q, const Vec2d& r) {
+                return (q - p).x() * (r - p).y() - (q - p).y() * (r - p).x();
+            };
+            for (std::size_t k = 0; k < 3; ++k)
+            {
+                if (inside(a[k], b) || inside(b[k], a))
+                    return 0.0;
+                for (std::size_t e = 0; e < 3; ++e) // edges that cross
+                {
+                    const Vec2d& p = a[k];
+                    const Vec2d& q = a[(k + 1) % 3];
+                    const Vec2d& r = b[e];
+                    const Vec2d& t = b[(e + 1) % 3];
+                    if (cross(p, q, r) * cross(p, q, t) < 0 && cross(r, t, p) * cross(r, t, q) < 0)
+                        return 0.0;
+                }
+                for (std::size_t e = 0; e < 3; ++e)
+                {
+                    d = std::min(d, segment_distance(a[k], b[e], b[(e + 1) % 3]));
+                    d = std::min(d, segment_distance(b[k], a[e], a[(e + 1) % 3]));
+                }
+            }
+            return d; // segments of two triangles that do not contain each other's corners
+        };
+        std::size_t too_close = 0;
         for (std::size_t i = 0; i < charts; ++i)
             for (std::size_t j = i + 1; j < charts; ++j)
-            {
-                const bool apart =
-                    boxes[i].second.x() + atlas.gutter - 1e-9 <= boxes[j].first.x() ||
-                    boxes[j].second.x() + atlas.gutter - 1e-9 <= boxes[i].first.x() ||
-                    boxes[i].second.y() + atlas.gutter - 1e-9 <= boxes[j].first.y() ||
-                    boxes[j].second.y() + atlas.gutter - 1e-9 <= boxes[i].first.y();
-                EXPECT_TRUE(apart) << "charts " << i << " and " << j;
-            }
+                if (distance(texel[i], texel[j]) < atlas.gutter - 1e-6)
+                    ++too_close;
+        EXPECT_EQ(too_close, 0U);
         const std::vector<std::size_t> levels = {0, refined.finest_level()};
         for (const AtlasDistortion& d : atlas_distortion(refined, p, atlas, levels))
         {
