@@ -73,11 +73,14 @@ void run_lod(const LodOptions& options, const GlobalOptions& global)
         timings.lap("write");
     }
 
+    // The version the file was written in (read_hierarchy() has read it, so it is one it knows).
+    const std::uint32_t version =
+        hierarchy_file_version(options.input).value_or(hierarchy_format_version);
     if (options.json)
     {
         nlohmann::json out;
         out["input"] = options.input;
-        out["format_version"] = hierarchy_format_version;
+        out["format_version"] = version;
         out["origin"] = {mesh.origin().x(), mesh.origin().y(), mesh.origin().z()};
         nlohmann::json levels = nlohmann::json::array();
         for (std::size_t l = 0; l < mesh.level_count(); ++l)
@@ -102,7 +105,7 @@ void run_lod(const LodOptions& options, const GlobalOptions& global)
     if (global.quiet)
         return;
     std::printf("%s: semi-regular hierarchy, format version %u, %zu level%s\n",
-                options.input.c_str(), hierarchy_format_version, mesh.level_count(),
+                options.input.c_str(), version, mesh.level_count(),
                 mesh.level_count() == 1 ? "" : "s");
     std::printf("  %5s %12s %12s\n", "level", "vertices", "faces");
     for (std::size_t l = 0; l < mesh.level_count(); ++l)

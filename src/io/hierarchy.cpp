@@ -7,6 +7,7 @@
 
 #include "detail_readers.h"
 
+#include <array>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -239,6 +240,30 @@ bool is_hierarchy_file(const std::filesystem::path& path) noexcept
     catch (...)
     {
         return false;
+    }
+}
+
+std::optional<std::uint32_t> hierarchy_file_version(const std::filesystem::path& path) noexcept
+{
+    try
+    {
+        const FilePtr file(std::fopen(path.c_str(), "rb"));
+        if (!file)
+            return std::nullopt;
+        std::array<unsigned char, hierarchy_magic.size() + 4> head{};
+        if (std::fread(head.data(), 1, head.size(), file.get()) != head.size() ||
+            std::string_view(reinterpret_cast<const char*>(head.data()), hierarchy_magic.size()) !=
+                magic_bytes())
+            return std::nullopt;
+        const std::size_t at = hierarchy_magic.size();
+        return static_cast<std::uint32_t>(head[at]) |
+               (static_cast<std::uint32_t>(head[at + 1]) << 8) |
+               (static_cast<std::uint32_t>(head[at + 2]) << 16) |
+               (static_cast<std::uint32_t>(head[at + 3]) << 24);
+    }
+    catch (...)
+    {
+        return std::nullopt;
     }
 }
 

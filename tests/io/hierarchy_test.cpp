@@ -432,6 +432,11 @@ TEST(Hierarchy, RecordsThePredictorAndReadsVersionOneAsMidpoint)
     const auto v1 = dir / "v1.pfh";
     test::write_file(v1, bytes);
     const MultiresMesh old = read_hierarchy(v1);
+    EXPECT_EQ(hierarchy_file_version(v1), 1U);
+    EXPECT_EQ(hierarchy_file_version(path), hierarchy_format_version);
+    EXPECT_EQ(hierarchy_file_version(dir / "missing.pfh"), std::nullopt);
+    test::write_file(dir / "short.pfh", bytes.substr(0, 10));
+    EXPECT_EQ(hierarchy_file_version(dir / "short.pfh"), std::nullopt);
     EXPECT_EQ(old.predictor(), Predictor::Midpoint);
     EXPECT_EQ(old.vertex_count(), mesh.vertex_count());
     put_le(bytes, 12, 1U);

@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 
 namespace pointform {
 
@@ -79,5 +80,10 @@ void write_hierarchy(const std::filesystem::path& path, const MultiresMesh& mesh
 /// \brief Whether `path` is a readable file that starts with the hierarchy magic bytes (it may
 /// still be of another version, truncated or corrupt). Never throws.
 [[nodiscard]] bool is_hierarchy_file(const std::filesystem::path& path) noexcept;
+
+/// \brief The format version word of a file that starts with the hierarchy magic bytes (what
+/// read_hierarchy() then reads, or refuses); nothing for any other file. Never throws.
+[[nodiscard]] std::optional<std::uint32_t> hierarchy_file_version(
+    const std::filesystem::path& path) noexcept;
 
 } // namespace pointform
