@@ -80,6 +80,50 @@ float edge_cost(std::span<const Vec3f> positions, std::span<const Vec3f> normals
 /// plate thinner than the guide's reach scores 0, so it is never guided across its walls.
 constexpr float noisy_flatness = 0.02F;
 
+/// A point lies off a sample's sheet when its height along the sample's guide is more than this
+/// many robust standard deviations of the noise from the median height of the sample's
+/// neighbours (mark_sheets()): under Gaussian noise 3 keeps 99.7% of a sheet's own samples,
+/// while a sample of the opposite face of a thin plate, which noise can bring into a
+/// neighbourhood, lies about the gap away. Faces less than about 8 deviations apart share outliers
+/// that no test of positions can tell apart.
+constexpr float off_sheet_deviations = 3.0F;
+
+/// The smallest robust deviation of the heights in a row, relative to the distance to the
+/// farthest neighbour: on a clean, flat part of a noisy cloud the deviations are about zero, and
+/// rounding would decide.
+constexpr float min_height_limit = 0.05F;
+
+/// Guide normals (guide_normals()) and, for each sample, the band of heights along its guide that
+/// its own sheet fills (mark_sheets()).
+struct Guide
+{
+    /// One a sample; empty for a clean cloud.
+    std::vector<Vec3f> normals;
+    /// The median height of each sample's neighbours along its guide, relative to the sample.
+    std::vector<float> centre;
+    /// How far from `centre` a point may lie and still be on the sample's sheet.
+    std::vector<float> reach;
+
+    /// Whether the edge a–b of the neighbour table jumps between sheets: b is one of a's
+    /// neighbours and lies off a's sheet, or the other way round. Such edges would pass the
+    /// orientation of one face of a thin plate to the opposite face unchanged, since their guides
+    /// are parallel.
+    [[nodiscard]] bool jumps(std::span<const Vec3f> positions, const KnnTable& table,
+                             std::uint32_t a, std::uint32_t b) const
+    {
+        if (reach.empty())
+            return false;
+        const auto off = [&](std::uint32_t from, std::uint32_t to) {
+            const float height = (positions[to] - positions[from]).dot(normals[from]);
+            if (!(std::abs(height - centre[from]) > reach[from]))
+                return false;
+            const auto row = table.neighbors(from); // rarely searched: only where off the band
+            return std::find(row.begin(), row.end(), to) != row.end();
+        };
+        return off(a, b) || off(b, a);
+    }
+};
+
 /// A neighbourhood's centroid and covariance (upper triangle: xx xy xz yy yz zz), in float: the
 /// guide needs a direction, not digits.
 struct Moments
@@ -150,6 +194,67 @@ Vec3f least_axis(const std::array<float, 6>& covariance)
     return v / length;
 }
 
+/// The band of each sample's sheet along its guide normal, which its neighbours must lie in (far
+/// steadier than its own normal under noise): centred on the median height of its neighbours,
+/// off_sheet_deviations robust deviations wide each way. The deviation is the median, over the
+/// sample's neighbours, of each one's own robust deviation (1.4826 times the median absolute
+/// deviation of the heights in its row): where noise brings the opposite face of a thin plate into
+/// a row, that row's own deviation is inflated by the other face, its neighbours' mostly are not.
+/// Samples without a guide get an unbounded band.
+void mark_sheets(std::span<const Vec3f> positions, const KnnTable& neighbors, Guide& guide)
+{
+    const std::size_t n = positions.size();
+    guide.centre.assign(n, 0.0F);
+    guide.reach.assign(n, std::numeric_limits<float>::infinity());
+    std::vector<float> deviation(n, 0.0F);
+    parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+        std::vector<float> height(neighbors.k);
+        std::vector<float> scratch(neighbors.k);
+        const auto median = [&](std::size_t count) {
+            const auto middle = scratch.begin() + static_cast<std::ptrdiff_t>(count / 2);
+            std::nth_element(scratch.begin(), middle,
+                             scratch.begin() + static_cast<std::ptrdiff_t>(count));
+            return *middle;
+        };
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            const Vec3f& axis = guide.normals[i];
+            if (!usable(axis))
+                continue;
+            const auto row = neighbors.neighbors(i);
+            const std::size_t count = row.size();
+            float extent2 = 0.0F;
+            for (std::size_t c = 0; c < count; ++c)
+            {
+                const Vec3f d = positions[row[c]] - positions[i];
+                height[c] = d.dot(axis);
+                scratch[c] = height[c];
+                extent2 = std::max(extent2, d.squaredNorm());
+            }
+            const float middle = median(count);
+            for (std::size_t c = 0; c < count; ++c)
+                scratch[c] = std::abs(height[c] - middle);
+            guide.centre[i] = middle;
+            deviation[i] = std::max(1.4826F * median(count), min_height_limit * std::sqrt(extent2));
+        }
+    });
+    parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+        std::vector<float> scratch(neighbors.k);
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            if (!usable(guide.normals[i]))
+                continue;
+            const auto row = neighbors.neighbors(i);
+            for (std::size_t c = 0; c < row.size(); ++c)
+                scratch[c] = deviation[row[c]];
+            const auto middle = scratch.begin() + static_cast<std::ptrdiff_t>(row.size() / 2);
+            std::nth_element(scratch.begin(), middle,
+                             scratch.begin() + static_cast<std::ptrdiff_t>(row.size()));
+            guide.reach[i] = off_sheet_deviations * *middle;
+        }
+    });
+}
+
 /// The normals that orientation follows: for each sample, the PCA normal of its neighbourhood
 /// grown ring by ring through the neighbour table (up to `rings` rings) at the scale where the
 /// points are flattest (least flatness()). Noise makes a small neighbourhood thick, and growing it
@@ -158,9 +263,10 @@ Vec3f least_axis(const std::array<float, 6>& covariance)
 /// clean, curved or thin-walled parts. The moments of the union (with multiplicity) of the
 /// neighbourhoods of i's neighbours follow from theirs: mean of the centroids, and mean
 /// covariance plus the covariance of the centroids; so each ring costs one pass over the table.
-/// Empty when the cloud is clean (noisy_flatness). Zero where `normals` is.
-std::vector<Vec3f> guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
-                                 const KnnTable& neighbors, std::size_t rings)
+/// Empty when the cloud is clean (noisy_flatness). Zero where `normals` is. With the guides, the
+/// band of each sample's sheet (mark_sheets()).
+Guide guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
+                    const KnnTable& neighbors, std::size_t rings)
 {
     const std::size_t n = positions.size();
     // Sums of d and d dᵀ about `shift`, turned into a centroid and covariance.
@@ -249,16 +355,18 @@ std::vector<Vec3f> guide_normals(std::span<const Vec3f> positions, std::span<con
     }
     std::vector<Moments>().swap(current);
     std::vector<Moments>().swap(next);
-    std::vector<Vec3f> guide(n, Vec3f::Zero());
+    Guide result;
+    result.normals.assign(n, Vec3f::Zero());
     parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
             if (usable(normals[i]))
             {
                 const Vec3f axis = least_axis(best[i]);
-                guide[i] = best_flatness[i] < 1.0F && usable(axis) ? axis : normals[i];
+                result.normals[i] = best_flatness[i] < 1.0F && usable(axis) ? axis : normals[i];
             }
     });
-    return guide;
+    mark_sheets(positions, neighbors, result);
+    return result;
 }
 
 std::size_t count_flipped(std::span<const Vec3f> before, std::span<const Vec3f> after)
@@ -272,10 +380,13 @@ std::size_t count_flipped(std::span<const Vec3f> before, std::span<const Vec3f> 
 
 } // namespace
 
-RiemannianForest riemannian_spanning_forest(std::span<const Vec3f> positions,
-                                            std::span<const Vec3f> normals,
-                                            const KnnTable& neighbors,
-                                            const OrientationOptions& options)
+namespace {
+
+/// riemannian_spanning_forest(), with the edges that jump between sheets (Guide::jumps()) at the
+/// worst cost.
+RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
+                                 const Guide& guide, const KnnTable& neighbors,
+                                 const OrientationOptions& options)
 {
     const std::size_t n = positions.size();
     if (normals.size() != n || neighbors.rows() != n)
@@ -314,7 +425,9 @@ RiemannianForest riemannian_spanning_forest(std::span<const Vec3f> positions,
                     b == a || (b < a && row_contains(neighbors, b, columns, a))
                         ? not_an_edge
                         : std::bit_cast<std::uint32_t>(
-                              edge_cost(positions, normals, options.rule, a, b));
+                              guide.jumps(positions, neighbors, a, b)
+                                  ? 2.0F
+                                  : edge_cost(positions, normals, options.rule, a, b));
             }
         }
     });
@@ -491,6 +604,16 @@ RiemannianForest riemannian_spanning_forest(std::span<const Vec3f> positions,
     return forest;
 }
 
+} // namespace
+
+RiemannianForest riemannian_spanning_forest(std::span<const Vec3f> positions,
+                                            std::span<const Vec3f> normals,
+                                            const KnnTable& neighbors,
+                                            const OrientationOptions& options)
+{
+    return spanning_forest(positions, normals, Guide{}, neighbors, options);
+}
+
 OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
                                    std::span<const Vec3f> fine_normals, const KnnTable& neighbors,
                                    const OrientationOptions& options)
@@ -502,13 +625,14 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
     check_knn_table(neighbors, positions.size(), positions.size(), "orientation");
     // 0. On noisy clouds, orientation follows normals at a coarser scale and hands their signs to
     //    the samples' own normals at the end (step 3).
-    std::vector<Vec3f> guide;
+    //    Edges that jump between sheets (Guide::jumps()) pass no orientation.
+    Guide guide;
     if (options.rule == OrientationRule::Hoppe && options.guide_rings > 0 && !positions.empty())
         guide = guide_normals(positions, fine_normals, neighbors, options.guide_rings);
-    const bool guided = !guide.empty();
-    const std::span<const Vec3f> normals = guided ? std::span<const Vec3f>(guide) : fine_normals;
-    const RiemannianForest forest =
-        riemannian_spanning_forest(positions, normals, neighbors, options);
+    const bool guided = !guide.normals.empty();
+    const std::span<const Vec3f> normals =
+        guided ? std::span<const Vec3f>(guide.normals) : fine_normals;
+    const RiemannianForest forest = spanning_forest(positions, normals, guide, neighbors, options);
     const std::size_t n = positions.size();
     OrientedNormals result;
     result.normals.assign(normals.begin(), normals.end());
@@ -522,6 +646,7 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
     {
         const std::uint32_t parent = forest.parent[v];
         const bool joins = parent != v && usable(normals[v]) && usable(normals[parent]) &&
+                           !guide.jumps(positions, neighbors, parent, v) &&
                            edge_cost(positions, normals, options.rule, parent, v) <=
                                static_cast<float>(options.patch_cost);
         if (!joins)
@@ -553,7 +678,8 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
         for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
         {
             const auto pj = patch[j];
-            if (pj == RiemannianForest::none || pj == pi)
+            if (pj == RiemannianForest::none || pj == pi ||
+                guide.jumps(positions, neighbors, static_cast<std::uint32_t>(i), j))
                 continue;
             const float w = agreement(positions, result.normals, options.rule,
                                       static_cast<std::uint32_t>(i), j);
@@ -623,6 +749,25 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
     for (std::size_t i = 0; i < n; ++i)
         if (patch[i] != RiemannianForest::none && patch_flip[patch[i]] == 1)
             result.normals[i] = -result.normals[i];
+    //    A patch that no vote reached (each of its edges jumps between sheets: an outlier of the
+    //    noise in the gap of a thin plate) takes the sign of its neighbours in reached patches.
+    if (guided)
+    {
+        const auto reached = [&](std::size_t i) {
+            return patch[i] != RiemannianForest::none && patch_flip[patch[i]] != unvisited;
+        };
+        std::vector<double> pull(patch_count, 0.0);
+        for (std::size_t i = 0; i < n; ++i)
+            if (patch[i] != RiemannianForest::none && !reached(i))
+                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                    if (reached(j))
+                        pull[patch[i]] +=
+                            static_cast<double>(agreement(positions, result.normals, options.rule,
+                                                          static_cast<std::uint32_t>(i), j));
+        for (std::size_t i = 0; i < n; ++i)
+            if (patch[i] != RiemannianForest::none && !reached(i) && pull[patch[i]] < 0.0)
+                result.normals[i] = -result.normals[i];
+    }
 
     // 3. Each sample re-decides its sign by its neighbours: flip if n_i disagrees with
     //    m_i = Σ_j w_ij n_j over its k neighbours, w_ij = 1 − |n_i·ê_ij| (the edge's share in

@@ -130,7 +130,13 @@ struct OrientedNormals
 /// into patches, which are flipped against each other by the summed agreement of every graph
 /// edge between them. Then `options.smoothing_sweeps` times, every sample takes the sign of its
 /// neighbours' weighted mean normal. On noisy clouds (Hoppe rule) all this runs on coarser-scale
-/// guide normals (`options.guide_rings`), which are then the output normals. Finally, so that
+/// guide normals (`options.guide_rings`), which are then the output normals; there an edge whose
+/// end lies off the other end's sheet (its height along that end's guide more than 3 robust
+/// deviations of the local noise from the median of that end's neighbours) neither passes
+/// orientation nor votes, so the two faces of a noisy thin plate, whose outliers meet in the gap
+/// with parallel guides, are not oriented alike (faces at least about 8 noise deviations apart:
+/// closer ones share outliers that no test of positions tells apart), and a patch left without
+/// votes takes the sign of its neighbours. Finally, so that
 /// closed surfaces come out with outward normals whatever their shape, the component's normals are
 /// flipped if the area-weighted flux Σ a_i n_i·(p_i − c) (3 × the enclosed volume for a closed
 /// surface, by the divergence theorem) is clearly negative; for open, flat components the flux says
