@@ -449,6 +449,91 @@ std::size_t improve_by_flips(OmMesh& mesh, double max_dihedral)
     return flips;
 }
 
+/// Edge flips across creases: where an edge's two triangles turn by more than `max_dihedral`
+/// (radians) from each other, the quad they form is split along the diagonal whose midpoint is
+/// nearer the surface, |f| at most half the other's. Decimation and the projection leave edges
+/// that cross a crease from one side to the other, with two triangles that straddle it; the
+/// crease then runs through the middle of the quad, and the refinement must put the vertex of
+/// that edge on the crease's corner, along a direction (the mean of two normals far apart) that
+/// has little to do with the surface. The other diagonal joins the vertices nearest the crease
+/// and follows it. A flip is made only if both new triangles face the way the field's gradient
+/// does at their centroids (no fold) and each end keeps its lowest valence. Flatter pairs are
+/// left to improve_by_flips, so the two never undo each other.
+std::size_t align_to_creases(OmMesh& mesh, const Field& field, double max_dihedral)
+{
+    const double flat_cos = std::cos(max_dihedral);
+    constexpr int max_passes = 10;
+    const auto value = [&field](const Vec3d& p) -> std::optional<double> {
+        const FieldSample s = field.evaluate(p);
+        if (!s.defined || !std::isfinite(s.value))
+        {
+            return std::nullopt;
+        }
+        return std::abs(s.value);
+    };
+    const auto agrees = [&field](const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+        const Vec3d n = (b - a).cross(c - a);
+        const FieldSample s = field.evaluate((a + b + c) / 3.0);
+        return n.squaredNorm() > 0.0 && s.defined && s.gradient.allFinite() &&
+               n.dot(s.gradient) > 0.0;
+    };
+    std::size_t flips = 0;
+    for (int pass = 0; pass < max_passes; ++pass)
+    {
+        std::size_t flips_this_pass = 0;
+        for (const auto e : mesh.edges())
+        {
+            if (mesh.is_boundary(e) || !mesh.is_flip_ok(e))
+            {
+                continue;
+            }
+            const auto h = mesh.halfedge_handle(e, 0);
+            const auto o = mesh.opposite_halfedge_handle(h);
+            const auto a = mesh.from_vertex_handle(h);
+            const auto b = mesh.to_vertex_handle(h);
+            const auto c = mesh.to_vertex_handle(mesh.next_halfedge_handle(h));
+            const auto d = mesh.to_vertex_handle(mesh.next_halfedge_handle(o));
+            const auto lowest = [&mesh](OmMesh::VertexHandle v) {
+                return mesh.is_boundary(v) ? 2U : 3U;
+            };
+            if (mesh.valence(a) <= lowest(a) || mesh.valence(b) <= lowest(b))
+            {
+                continue;
+            }
+            const Vec3d pa = to_eigen(mesh.point(a));
+            const Vec3d pb = to_eigen(mesh.point(b));
+            const Vec3d pc = to_eigen(mesh.point(c));
+            const Vec3d pd = to_eigen(mesh.point(d));
+            const Vec3d n1 = (pb - pa).cross(pc - pa);
+            const Vec3d n2 = (pa - pb).cross(pd - pb);
+            const double l1 = n1.norm();
+            const double l2 = n2.norm();
+            if (l1 > 0.0 && l2 > 0.0 && n1.dot(n2) >= flat_cos * l1 * l2)
+            {
+                continue; // flat enough: improve_by_flips decides
+            }
+            const std::optional<double> before = value(0.5 * (pa + pb));
+            const std::optional<double> after = value(0.5 * (pc + pd));
+            if (!before || !after || !(*after < 0.5 * *before))
+            {
+                continue;
+            }
+            if (!agrees(pa, pd, pc) || !agrees(pd, pb, pc))
+            {
+                continue;
+            }
+            mesh.flip(e);
+            ++flips_this_pass;
+        }
+        flips += flips_this_pass;
+        if (flips_this_pass == 0)
+        {
+            break;
+        }
+    }
+    return flips;
+}
+
 /// Per-vertex state of the shape-improvement and projection stage.
 struct VertexState
 {
@@ -798,6 +883,11 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
                     break; // no longer improving
                 }
                 previous = bad;
+                if (options.project)
+                {
+                    stats.flips +=
+                        align_to_creases(mesh, field, options.max_flip_dihedral_degrees * degrees);
+                }
                 stats.flips += improve_by_flips(mesh, options.max_flip_dihedral_degrees * degrees);
                 ++stats.smoothing_rounds;
             }

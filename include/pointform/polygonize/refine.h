@@ -93,7 +93,8 @@ struct RefineOptions
     int relax_iterations = 1;
     Relaxation relaxation = Relaxation::AcrossEdge;
     /// A child face is folded when the cosine between its normal and its parent face's normal is
-    /// at most this (0: the child faces away from its parent, or is degenerate).
+    /// at most this (0: the child faces away from its parent, or is degenerate), and so is the
+    /// cosine with the field's gradient at the child's centroid (where the field is defined).
     double fold_cosine = 0.0;
     /// refine(): the finest level J to reach at most (the level cap, `--levels J`).
     std::size_t max_level = 6;
@@ -222,9 +223,13 @@ struct RefineReport
 ///    nearest zero crossing where AW_FEN·∇f > 0 (project_to_zero), the search bounded by
 ///    search_scale × |e|.
 /// 3. Folds: a child face whose normal is against its parent face's normal (cosine ≤
-///    fold_cosine) marks its new vertices; they are projected again from the prediction along
-///    VEN(e), the normalised sum of the area-weighted vertex normals of e's ends (§5.2.2). A
-///    vertex still in a folded face goes back to the prediction (then to the midpoint).
+///    fold_cosine) and against the field's gradient at its centroid as well (or degenerate, or
+///    the field undefined there) marks its new vertices; a parent that straddles a crease has
+///    children turned by up to the crease's angle from it, which agree with the field. The
+///    marked vertices are projected again from the prediction along VEN(e), the normalised sum
+///    of the area-weighted vertex normals of e's ends (§5.2.2). A vertex still in a folded face
+///    goes to the nearest point of f = 0 (Newton steps), else back to the prediction (then to
+///    the midpoint).
 /// 4. Relax (§5.2.3): relax_iterations rounds of the tangential umbrella move of every projected
 ///    new vertex towards the average of its 1-ring in M^(J+1) (on the boundary: of its two
 ///    boundary neighbours; tangent plane: the vertex's area-weighted normal; by default only
