@@ -319,7 +319,7 @@ std::string encode_distances(const ViewData& data, std::size_t level, const Poin
     return out;
 }
 
-PickedRequest parse_picked_request(const std::string& body, std::size_t sample_count)
+std::vector<Triangle> parse_picked_request(const std::string& body, std::size_t sample_count)
 {
     // Bracket depth first: the request is two levels deep, and a hostile body of a million '['
     // must not reach a recursive parser or destructor.
@@ -364,8 +364,8 @@ PickedRequest parse_picked_request(const std::string& body, std::size_t sample_c
     if (triangles.size() > max_picked_triangles)
         throw InvalidInput(std::to_string(triangles.size()) + " triangles: at most " +
                            std::to_string(max_picked_triangles) + " may be picked");
-    PickedRequest out;
-    std::map<std::uint32_t, std::uint32_t> vertex_of_sample;
+    std::vector<Triangle> out;
+    out.reserve(triangles.size());
     for (std::size_t f = 0; f < triangles.size(); ++f)
     {
         const nlohmann::json& t = triangles[f];
@@ -378,14 +378,9 @@ PickedRequest parse_picked_request(const std::string& body, std::size_t sample_c
             if (!t[k].is_number_unsigned() || t[k].get<std::uint64_t>() >= sample_count)
                 throw InvalidInput(which + ": " + t[k].dump() + " is not a sample index (0 to " +
                                    std::to_string(sample_count - 1) + ")");
-            const auto sample = static_cast<std::uint32_t>(t[k].get<std::uint64_t>());
-            const auto [it, inserted] =
-                vertex_of_sample.emplace(sample, static_cast<std::uint32_t>(out.samples.size()));
-            if (inserted)
-                out.samples.push_back(sample);
-            triangle[k] = it->second;
+            triangle[k] = static_cast<std::uint32_t>(t[k].get<std::uint64_t>());
         }
-        out.triangles.push_back(triangle);
+        out.push_back(triangle);
     }
     return out;
 }
@@ -731,7 +726,7 @@ void serve_view(std::vector<ViewData> inputs, const StaticFiles& files, const st
                       "no samples to reconstruct from: name a point cloud on the command line");
             return;
         }
-        PickedRequest picked;
+        std::vector<Triangle> picked;
         try
         {
             picked = parse_picked_request(req.body, samples->size());
@@ -741,11 +736,8 @@ void serve_view(std::vector<ViewData> inputs, const StaticFiles& files, const st
             set_error(res, 400, e.what());
             return;
         }
-        PickedVertices vertices{.triangles = std::move(picked.triangles),
-                                .source = "the picked base mesh"};
-        vertices.vertices.reserve(picked.samples.size());
-        for (const std::uint32_t s : picked.samples)
-            vertices.vertices.push_back(samples->world(s));
+        PickedVertices vertices =
+            picked_vertices_from_samples(picked, *samples, "the picked base mesh");
         const bool started = job.start([&, vertices = std::move(vertices)](
                                            ReconstructionJob& self, long long number) mutable {
             try

@@ -77,16 +77,11 @@ struct ViewData
 
 /// \brief The base mesh a page sends with POST /api/reconstruct: {"triangles": [[i, j, k],
 /// ...]} over the indices of the samples (the first point cloud's points), at most
-/// max_picked_triangles. \return the picked samples' indices in order of first use, and the
-/// triangles over positions in that list
+/// max_picked_triangles. \return the triangles over sample indices
 /// \throw InvalidInput saying what is wrong with the request (the server's 400)
-struct PickedRequest
-{
-    std::vector<std::uint32_t> samples;
-    std::vector<Triangle> triangles;
-};
 inline constexpr std::size_t max_picked_triangles = 100000;
-[[nodiscard]] PickedRequest parse_picked_request(const std::string& body, std::size_t sample_count);
+[[nodiscard]] std::vector<Triangle> parse_picked_request(const std::string& body,
+                                                         std::size_t sample_count);
 
 /// \brief One of the page's files, held in memory.
 struct StaticFile

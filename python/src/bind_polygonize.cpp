@@ -249,8 +249,9 @@ void bind_polygonize(py::module_& m)
            const std::optional<long long>& base_faces, const std::string& stop_rule,
            const std::string& fit, int resolution, double cell,
            const std::optional<long long>& min_component_samples,
-           const std::optional<std::filesystem::path>& base_mesh, long long k, double radius_scale,
-           const std::string& predictor, int relax_iterations, const std::string& relaxation) {
+           const std::optional<std::filesystem::path>& base_mesh, const py::object& base_triangles,
+           long long k, double radius_scale, const std::string& predictor, int relax_iterations,
+           const std::string& relaxation) {
             ReconstructOptions options;
             options.semi_regular = semi_regular_options(levels, base_faces, stop_rule, predictor,
                                                         relax_iterations, relaxation);
@@ -271,6 +272,15 @@ void bind_polygonize(py::module_& m)
                 if (base_faces)
                     throw InvalidInput("give base_mesh or base_faces, not both");
                 options.base_mesh = *base_mesh;
+            }
+            if (!base_triangles.is_none())
+            {
+                if (base_faces || base_mesh)
+                    throw InvalidInput("give base_triangles, base_mesh or base_faces, not two");
+                // Over the cloud's own indices, as `pointform view` sends them.
+                options.picked_vertices =
+                    picked_vertices_from_samples(triangles_from(base_triangles, cloud->view.size()),
+                                                 cloud->view, "base_triangles");
             }
             const SurfelsFromSamplesOptions surfel_options{.k = non_negative(k, "k"),
                                                            .radius_scale = radius_scale};
@@ -293,19 +303,23 @@ void bind_polygonize(py::module_& m)
         py::arg("base_faces") = py::none(), py::arg("stop_rule") = default_stop_rule,
         py::arg("fit") = "quadric", py::arg("resolution") = 0, py::arg("cell") = 0.0,
         py::arg("min_component_samples") = py::none(), py::arg("base_mesh") = py::none(),
-        py::arg("k") = default_neighbors, py::arg("radius_scale") = default_field_radius_scale,
+        py::arg("base_triangles") = py::none(), py::arg("k") = default_neighbors,
+        py::arg("radius_scale") = default_field_radius_scale,
         py::arg("predictor") = default_predictor,
         py::arg("relax_iterations") = default_semi_regular.relax_iterations,
         py::arg("relaxation") = default_relaxation,
         "reconstruct(cloud, *, levels=None, base_faces=None, stop_rule='auto', fit='quadric', "
-        "resolution=0, cell=0.0, min_component_samples=None, base_mesh=None, k=16, "
+        "resolution=0, cell=0.0, min_component_samples=None, base_mesh=None, base_triangles=None, "
+        "k=16, "
         "radius_scale=1.5, predictor=..., relax_iterations=..., relaxation=...) -> Hierarchy\n\n"
         "Points to a semi-regular multiresolution mesh (paper §5), as `pointform reconstruct` "
         "does, with the same defaults and the same result: surfels (pointform.surfels() with "
         "k and radius_scale; raw points get normals, points with normals keep them), their "
         "field (fit), marching cubes (resolution cells along the longest side, or cell size, "
         "or automatic), debris removal, the automatic base mesh (base_faces faces) or a picked "
-        "one (base_mesh: a file), then 1-to-4 refinement projected onto the field: exactly to "
+        "one (base_mesh: a file as `reconstruct --base-mesh` reads; base_triangles: an M by 3 "
+        "integer array of the cloud's sample indices, as picked in `pointform view`), then "
+        "1-to-4 refinement projected onto the field: exactly to "
         "`levels` (0-8), or until stop_rule says so ('auto' or 'paper'). Raises InvalidInput "
         "for bad points or options, or work that would not fit in memory.");
 

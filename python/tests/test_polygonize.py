@@ -201,3 +201,42 @@ def test_ctrl_c_stops_a_long_call():
     timer.join()
     assert time.perf_counter() - start < 3.0
     assert pointform.reconstruct(cloud, levels=0).level_count == 1  # still usable
+
+
+def test_picked_base_triangles_are_the_clis_base_mesh(bunny_points, tmp_path):
+    """base_triangles (sample indices, as picked in `pointform view`) give the hierarchy that
+    `pointform reconstruct --base-mesh` gives with the same triangles as an OBJ."""
+    positions = bunny_points.world()
+    centre = 0.5 * (positions.min(axis=0) + positions.max(axis=0))
+    picks = []
+    for axis in range(3):
+        for sign in (1.0, -1.0):
+            along = sign * (positions[:, axis] - centre[axis])
+            near_axis = np.linalg.norm(np.delete(positions - centre, axis, axis=1), axis=1) < 0.01
+            candidates = np.flatnonzero(near_axis)
+            picks.append(int(candidates[np.argmax(along[candidates])]))
+    octahedron = [(0, 2, 4), (2, 1, 4), (1, 3, 4), (3, 0, 4), (2, 0, 5), (1, 2, 5), (3, 1, 5), (0, 3, 5)]
+    triangles = np.array([[picks[a], picks[b], picks[c]] for a, b, c in octahedron])
+    ours = pointform.reconstruct(bunny_points, base_triangles=triangles)
+    assert ours.level_count >= 3
+    assert ours.report["base_mesh"]["faces"] == 8
+    assert ours.report["base_mesh"]["euler_characteristic"] == 2
+
+    obj = tmp_path / "picked.obj"
+    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in positions[picks].tolist()]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in octahedron]
+    obj.write_text("\n".join(lines) + "\n")
+    cli_pfh = tmp_path / "cli.pfh"
+    run_cli("reconstruct", BUNNY_SCAN, "--base-mesh", obj, "-o", tmp_path / "cli.ply",
+            "--save-hierarchy", cli_pfh)
+    saved = tmp_path / "ours.pfh"
+    ours.save(saved)
+    assert saved.read_bytes() == cli_pfh.read_bytes()
+
+    with pytest.raises(pointform.InvalidInput, match="not two"):
+        pointform.reconstruct(bunny_points, base_triangles=triangles, base_faces=8)
+    with pytest.raises(ValueError, match="faces"):
+        pointform.reconstruct(bunny_points, base_triangles=np.array([[0, 1, 10**9]]))
+    fin = np.vstack([triangles, [[picks[0], picks[2], picks[1]]]])
+    with pytest.raises(pointform.InvalidInput, match="more than two triangles"):
+        pointform.reconstruct(bunny_points, base_triangles=fin)

@@ -1324,6 +1324,34 @@ PickedBaseMesh read_picked_base_mesh(const std::filesystem::path& path, const Po
     return snap_picked_base_mesh(picked, samples, field);
 }
 
+PickedVertices picked_vertices_from_samples(std::span<const Triangle> triangles,
+                                            const PointCloudView& samples,
+                                            const std::string& source)
+{
+    PickedVertices out{.source = source};
+    std::map<std::uint32_t, std::uint32_t> vertex_of_sample;
+    out.triangles.reserve(triangles.size());
+    for (std::size_t f = 0; f < triangles.size(); ++f)
+    {
+        Triangle t{};
+        for (std::size_t k = 0; k < 3; ++k)
+        {
+            const std::uint32_t s = triangles[f][k];
+            if (s >= samples.size())
+                throw InvalidInput(source + ": triangle " + std::to_string(f + 1) +
+                                   " names sample " + std::to_string(s) + " of " +
+                                   std::to_string(samples.size()));
+            const auto [it, inserted] =
+                vertex_of_sample.emplace(s, static_cast<std::uint32_t>(out.vertices.size()));
+            if (inserted)
+                out.vertices.push_back(samples.origin + samples.positions[s].cast<double>());
+            t[k] = it->second;
+        }
+        out.triangles.push_back(t);
+    }
+    return out;
+}
+
 PickedBaseMesh snap_picked_base_mesh(const PickedVertices& picked, const PointCloud& samples,
                                      const Field& field)
 {

@@ -209,6 +209,15 @@ struct PickedVertices
     [[nodiscard]] bool empty() const noexcept { return triangles.empty(); }
 };
 
+/// \brief Triangles over indices of `samples` (what a user picks on a point cloud, before any
+/// surfels exist) as PickedVertices: the picked samples' world positions in order of first use
+/// and the triangles over them, so that they snap back to those samples in
+/// snap_picked_base_mesh() even if samples are dropped or reordered on the way to the surfels.
+/// \throw InvalidInput naming `source`: an index out of range
+[[nodiscard]] PickedVertices picked_vertices_from_samples(std::span<const Triangle> triangles,
+                                                          const PointCloudView& samples,
+                                                          const std::string& source);
+
 /// \brief Snaps every vertex used by picked.triangles to its nearest sample, then
 /// base_mesh_from_samples(); PickedBaseMesh::max_snap_distance is the farthest snap.
 /// \throw InvalidInput naming picked.source: no samples or no triangles, a vertex index out of
