@@ -4,6 +4,7 @@
 #include "view_server.h"
 
 #include "pointform/core/error.h"
+#include "pointform/core/json_depth.h"
 #include "pointform/hermite/surfels.h"
 #include "pointform/io/hierarchy.h"
 #include "pointform/io/io.h"
@@ -321,32 +322,10 @@ std::string encode_distances(const ViewData& data, std::size_t level, const Poin
 
 std::vector<Triangle> parse_picked_request(const std::string& body, std::size_t sample_count)
 {
-    // Bracket depth first: the request is two levels deep, and a hostile body of a million '['
+    // Depth first: the request is three levels deep, and a hostile body of a million '['
     // must not reach a recursive parser or destructor.
-    int depth = 0;
-    bool in_string = false;
-    for (std::size_t i = 0; i < body.size(); ++i)
-    {
-        const char c = body[i];
-        if (in_string)
-        {
-            if (c == '\\')
-                ++i;
-            else if (c == '"')
-                in_string = false;
-            continue;
-        }
-        if (c == '"')
-            in_string = true;
-        else if (c == '[' || c == '{')
-        {
-            if (++depth > 4)
-                throw InvalidInput(
-                    "the request is nested deeper than {\"triangles\": [[i, j, k]]}");
-        }
-        else if (c == ']' || c == '}')
-            --depth;
-    }
+    if (json_nests_deeper_than(body, 4))
+        throw InvalidInput("the request is nested deeper than {\"triangles\": [[i, j, k]]}");
     nlohmann::json request;
     try
     {

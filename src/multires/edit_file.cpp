@@ -4,6 +4,7 @@
 #include "pointform/multires/edit_file.h"
 
 #include "pointform/core/error.h"
+#include "pointform/core/json_depth.h"
 #include "pointform/geometry/aabb.h"
 
 #include <nlohmann/json.hpp>
@@ -34,29 +35,8 @@ constexpr std::size_t max_depth = 16;
 /// parser or the destructor of a deep value recurse far).
 void check_depth(std::string_view text, const std::string& source)
 {
-    std::size_t depth = 0;
-    bool in_string = false;
-    for (std::size_t i = 0; i < text.size(); ++i)
-    {
-        const char c = text[i];
-        if (in_string)
-        {
-            if (c == '\\')
-                ++i;
-            else if (c == '"')
-                in_string = false;
-            continue;
-        }
-        if (c == '"')
-            in_string = true;
-        else if (c == '[' || c == '{')
-        {
-            if (++depth > max_depth)
-                fail(source, "nesting deeper than " + std::to_string(max_depth) + " levels");
-        }
-        else if ((c == ']' || c == '}') && depth > 0)
-            --depth;
-    }
+    if (json_nests_deeper_than(text, max_depth))
+        fail(source, "nesting deeper than " + std::to_string(max_depth) + " levels");
 }
 
 json parse_json(std::string_view text, const std::string& source)

@@ -2,6 +2,7 @@
 // Copyright (c) 2026 the pointform authors
 
 #include "pointform/core/error.h"
+#include "pointform/core/json_depth.h"
 #include "pointform/core/parallel.h"
 #include "pointform/core/progress.h"
 #include "pointform/core/types.h"
@@ -14,6 +15,7 @@
 #include <numeric>
 #include <random>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -213,6 +215,21 @@ TEST(Ids, CompareAndValidity)
     EXPECT_TRUE(PointId(3).is_valid());
     EXPECT_LT(PointId(2), PointId(3));
     EXPECT_EQ(FaceId(7), FaceId(7));
+}
+
+TEST(JsonDepth, CountsBracketsOutsideStrings)
+{
+    EXPECT_FALSE(json_nests_deeper_than("", 0));
+    EXPECT_FALSE(json_nests_deeper_than("3", 0));
+    EXPECT_TRUE(json_nests_deeper_than("[]", 0));
+    EXPECT_FALSE(json_nests_deeper_than(R"({"t": [[1, 2, 3], [4, 5, 6]]})", 3));
+    EXPECT_TRUE(json_nests_deeper_than(R"({"t": [[[1]]]})", 3));
+    // Brackets in strings, escaped quotes included, do not count; closing ones do.
+    EXPECT_FALSE(json_nests_deeper_than(R"(["[[[[\"[[", {"a": "{{{{"}])", 2));
+    EXPECT_FALSE(json_nests_deeper_than("[][][][][][]", 1));
+    EXPECT_FALSE(json_nests_deeper_than("]]]][", 1)); // stray closers do not go below zero
+    // A hostile million brackets: answered at the limit, without recursion.
+    EXPECT_TRUE(json_nests_deeper_than(std::string(1000000, '['), 16));
 }
 
 } // namespace
