@@ -197,6 +197,8 @@ void check_options(const RefineOptions& options)
         throw InvalidInput("refine: detail_factor must lie in (0, 1]");
     if (!(options.noise_decay > 0.0 && options.noise_decay < 1.0))
         throw InvalidInput("refine: noise_decay must lie in (0, 1)");
+    if (!(options.tail_factor >= 1.0) || !std::isfinite(options.tail_factor))
+        throw InvalidInput("refine: tail_factor must be finite and at least 1");
 }
 
 /// Share of the distances, the smallest first, that the robust distance averages.
@@ -757,10 +759,18 @@ std::size_t next_level_vertices(const MultiresMesh& mesh, long long chi)
     return static_cast<std::size_t>(v + (v + f - chi));
 }
 
-/// The expected detail of the next level: the robust statistic of |f| at the midpoints of the
-/// finest level's edges. Where f is undefined (beyond every influence radius) the detail is
-/// unknown and counts as infinite: more than 5% of such midpoints make the next level needed.
-double next_detail(const MultiresMesh& mesh, const Field& field)
+/// The expected detail of the next level (see NextDetail).
+struct NextDetail
+{
+    /// The robust statistic of |f| at the midpoints of the finest level's edges. Where f is
+    /// undefined (beyond every influence radius) the detail is unknown and counts as infinite:
+    /// more than 5% of such midpoints make the next level needed.
+    double robust = 0.0;
+    /// The largest details: the 99th percentile of |f| over the midpoints where f is defined.
+    double tail = 0.0;
+};
+
+NextDetail next_detail(const MultiresMesh& mesh, const Field& field)
 {
     const std::vector<std::uint64_t> edges = unique_edges(mesh.faces(mesh.finest_level()));
     std::vector<Vec3d> midpoints(edges.size());
@@ -770,10 +780,27 @@ double next_detail(const MultiresMesh& mesh, const Field& field)
     std::vector<FieldSample> values(midpoints.size());
     field.evaluate(midpoints, values);
     std::vector<double> detail(values.size());
+    std::vector<double> defined;
+    defined.reserve(values.size());
     for (std::size_t e = 0; e < values.size(); ++e)
+    {
         detail[e] =
             values[e].defined ? std::abs(values[e].value) : std::numeric_limits<double>::infinity();
-    return robust_stats(detail).robust;
+        if (values[e].defined && std::isfinite(values[e].value))
+            defined.push_back(detail[e]);
+    }
+    NextDetail out;
+    out.robust = robust_stats(detail).robust;
+    if (!defined.empty())
+    {
+        const auto at =
+            std::min(defined.size() - 1,
+                     static_cast<std::size_t>(0.99 * static_cast<double>(defined.size())));
+        std::nth_element(defined.begin(), defined.begin() + static_cast<std::ptrdiff_t>(at),
+                         defined.end());
+        out.tail = defined[at];
+    }
+    return out;
 }
 
 } // namespace
@@ -839,7 +866,8 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
                 report.stop = RefineStop::VertexBudget;
                 break;
             }
-            const double detail = next_detail(mesh, field);
+            const NextDetail next = next_detail(mesh, field);
+            const double detail = next.robust;
             const double previous = report.levels.empty() ? std::numeric_limits<double>::infinity()
                                     : report.levels.size() == 1
                                         ? report.initial_next_detail
@@ -853,7 +881,8 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
                 report.stop = RefineStop::SmallDetails;
                 break;
             }
-            if (detail < report.field_residual && detail > options.noise_decay * previous)
+            if (detail < report.field_residual && detail > options.noise_decay * previous &&
+                next.tail <= options.tail_factor * report.field_residual)
             {
                 report.stop = RefineStop::NoisyDetails;
                 break;

@@ -1,0 +1,83 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+// Issue 13: the automatic stop on a noisy thin plate. Its flat faces' details shrink by half per
+// level, as noise does, but the rims stay well off the coarse levels: the rule must go on where
+// a finer level is closer to the true plate.
+
+#include "pointform/geometry/shapes.h"
+#include "pointform/hermite/radius.h"
+#include "pointform/metrics/quality.h"
+#include "pointform/polygonize/reconstruct.h"
+#include "pointform/spatial/kd_tree.h"
+#include "pointform/spatial/triangle_bvh.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace pointform {
+namespace {
+
+constexpr double thickness = 0.05;
+
+/// Distance from p to the surface of the box [-1, 1]² × [-t/2, t/2].
+double plate_distance(const Vec3d& p)
+{
+    const Vec3d h(1.0, 1.0, 0.5 * thickness);
+    const Vec3d q = p.cwiseAbs() - h;
+    const double outside = q.cwiseMax(0.0).norm();
+    const double inside = std::min(q.maxCoeff(), 0.0);
+    return std::abs(outside + inside);
+}
+
+/// Chamfer distance between a level and the true plate, relative to the plate's diagonal: the
+/// mean distance to the plate over the level's vertices, edge midpoints and centroids, plus the
+/// mean distance from noiseless samples of the plate to the level.
+double level_error(const MultiresMesh& mesh, std::size_t level, const PointCloud& truth)
+{
+    double sum = 0.0;
+    std::size_t count = 0;
+    for (const Triangle& t : mesh.faces(level))
+    {
+        const Vec3d a = mesh.world(t[0]);
+        const Vec3d b = mesh.world(t[1]);
+        const Vec3d c = mesh.world(t[2]);
+        for (const Vec3d& p : {a, Vec3d(0.5 * (a + b)), Vec3d((a + b + c) / 3.0)})
+        {
+            sum += plate_distance(p);
+            ++count;
+        }
+    }
+    const std::vector<double> back = distances_to_mesh(TriangleBvh(mesh.level_mesh(level)), truth);
+    double back_sum = 0.0;
+    for (const double d : back)
+        back_sum += d;
+    const double diagonal = std::sqrt(8.0 + thickness * thickness);
+    return (sum / static_cast<double>(count) + back_sum / static_cast<double>(back.size())) /
+           diagonal;
+}
+
+TEST(NoisyPlateStop, RefinesWhileTheRimsAreFarFromTheMesh)
+{
+    PointCloud samples = sample_shape(
+        Shape::Plate, {.count = 60000, .seed = 5, .noise = 0.002, .thickness = thickness});
+    const KdTree tree(samples.positions);
+    samples.radii = influence_radii(knn_batch(tree, samples.positions, 17), 1.5);
+    const ReconstructReport report = reconstruct(std::move(samples), {});
+    const MultiresMesh& mesh = report.semi_regular.hierarchy;
+    const RefineReport& refinement = report.semi_regular.refinement;
+    ASSERT_GE(mesh.finest_level(), 2U) << to_string(refinement.stop);
+    // Level 1, where the mean detail alone (below the noise, halving per level) stopped, is
+    // farther from the true plate: its chords cut the rims.
+    const PointCloud truth =
+        sample_shape(Shape::Plate, {.count = 60000, .seed = 6, .thickness = thickness});
+    const double fine = level_error(mesh, mesh.finest_level(), truth);
+    const double coarse = level_error(mesh, 1, truth);
+    EXPECT_LT(fine, 0.95 * coarse)
+        << "level " << mesh.finest_level() << ": " << fine << " vs " << coarse;
+}
+
+} // namespace
+} // namespace pointform
