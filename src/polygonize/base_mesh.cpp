@@ -380,12 +380,13 @@ OmMesh to_openmesh(const TriMesh& mesh)
     return om;
 }
 
-/// Edge flips that raise the smaller minimum angle of an edge's two triangles, where the two
-/// triangles' normals differ by at most `max_dihedral` (radians; so a flip does not cut across a
-/// crease) and neither new triangle turns further than that from their mean normal.
-std::size_t improve_by_flips(OmMesh& mesh, double max_dihedral)
+/// Passes of edge flips until one flips nothing (at most 10): every interior edge that OpenMesh
+/// can flip and whose ends keep their lowest valence (an interior vertex three, a boundary one
+/// two) is offered to `flip` with its quad: the edge a-b, its triangles a-b-c and b-a-d (so a
+/// flip makes a-d-c and d-b-c). \return the flips made
+template <class Decide>
+std::size_t flip_passes(OmMesh& mesh, Decide&& flip)
 {
-    const double flat_cos = std::cos(max_dihedral);
     constexpr int max_passes = 10;
     std::size_t flips = 0;
     for (int pass = 0; pass < max_passes; ++pass)
@@ -403,7 +404,6 @@ std::size_t improve_by_flips(OmMesh& mesh, double max_dihedral)
             const auto b = mesh.to_vertex_handle(h);
             const auto c = mesh.to_vertex_handle(mesh.next_halfedge_handle(h));
             const auto d = mesh.to_vertex_handle(mesh.next_halfedge_handle(o));
-            // a and b each lose an edge: an interior vertex keeps three, a boundary one two.
             const auto lowest = [&mesh](OmMesh::VertexHandle v) {
                 return mesh.is_boundary(v) ? 2U : 3U;
             };
@@ -411,30 +411,8 @@ std::size_t improve_by_flips(OmMesh& mesh, double max_dihedral)
             {
                 continue;
             }
-            const Vec3d pa = to_eigen(mesh.point(a));
-            const Vec3d pb = to_eigen(mesh.point(b));
-            const Vec3d pc = to_eigen(mesh.point(c));
-            const Vec3d pd = to_eigen(mesh.point(d));
-            const Vec3d n1 = (pb - pa).cross(pc - pa);
-            const Vec3d n2 = (pa - pb).cross(pd - pb);
-            const Vec3d m1 = (pd - pa).cross(pc - pa);
-            const Vec3d m2 = (pb - pd).cross(pc - pd);
-            const double l1 = n1.norm();
-            const double l2 = n2.norm();
-            const double k1 = m1.norm();
-            const double k2 = m2.norm();
-            if (l1 == 0.0 || l2 == 0.0 || k1 == 0.0 || k2 == 0.0 || n1.dot(n2) < flat_cos * l1 * l2)
-            {
-                continue;
-            }
-            const Vec3d n = (n1 / l1 + n2 / l2).normalized();
-            if (m1.dot(n) < flat_cos * k1 || m2.dot(n) < flat_cos * k2)
-            {
-                continue;
-            }
-            const double before = std::min(min_angle(pa, pb, pc), min_angle(pb, pa, pd));
-            const double after = std::min(min_angle(pa, pd, pc), min_angle(pd, pb, pc));
-            if (after > before + 1e-9)
+            if (flip(to_eigen(mesh.point(a)), to_eigen(mesh.point(b)), to_eigen(mesh.point(c)),
+                     to_eigen(mesh.point(d))))
             {
                 mesh.flip(e);
                 ++flips_this_pass;
@@ -447,6 +425,37 @@ std::size_t improve_by_flips(OmMesh& mesh, double max_dihedral)
         }
     }
     return flips;
+}
+
+/// Edge flips that raise the smaller minimum angle of an edge's two triangles, where the two
+/// triangles' normals differ by at most `max_dihedral` (radians; so a flip does not cut across a
+/// crease) and neither new triangle turns further than that from their mean normal.
+std::size_t improve_by_flips(OmMesh& mesh, double max_dihedral)
+{
+    const double flat_cos = std::cos(max_dihedral);
+    return flip_passes(
+        mesh, [&](const Vec3d& pa, const Vec3d& pb, const Vec3d& pc, const Vec3d& pd) {
+            const Vec3d n1 = (pb - pa).cross(pc - pa);
+            const Vec3d n2 = (pa - pb).cross(pd - pb);
+            const Vec3d m1 = (pd - pa).cross(pc - pa);
+            const Vec3d m2 = (pb - pd).cross(pc - pd);
+            const double l1 = n1.norm();
+            const double l2 = n2.norm();
+            const double k1 = m1.norm();
+            const double k2 = m2.norm();
+            if (l1 == 0.0 || l2 == 0.0 || k1 == 0.0 || k2 == 0.0 || n1.dot(n2) < flat_cos * l1 * l2)
+            {
+                return false;
+            }
+            const Vec3d n = (n1 / l1 + n2 / l2).normalized();
+            if (m1.dot(n) < flat_cos * k1 || m2.dot(n) < flat_cos * k2)
+            {
+                return false;
+            }
+            const double before = std::min(min_angle(pa, pb, pc), min_angle(pb, pa, pd));
+            const double after = std::min(min_angle(pa, pd, pc), min_angle(pd, pb, pc));
+            return after > before + 1e-9;
+        });
 }
 
 /// Edge flips across creases: where an edge's two triangles turn by more than `max_dihedral`
@@ -462,7 +471,6 @@ std::size_t improve_by_flips(OmMesh& mesh, double max_dihedral)
 std::size_t align_to_creases(OmMesh& mesh, const Field& field, double max_dihedral)
 {
     const double flat_cos = std::cos(max_dihedral);
-    constexpr int max_passes = 10;
     const auto value = [&field](const Vec3d& p) -> std::optional<double> {
         const FieldSample s = field.evaluate(p);
         if (!s.defined || !std::isfinite(s.value))
@@ -477,61 +485,24 @@ std::size_t align_to_creases(OmMesh& mesh, const Field& field, double max_dihedr
         return n.squaredNorm() > 0.0 && s.defined && s.gradient.allFinite() &&
                n.dot(s.gradient) > 0.0;
     };
-    std::size_t flips = 0;
-    for (int pass = 0; pass < max_passes; ++pass)
-    {
-        std::size_t flips_this_pass = 0;
-        for (const auto e : mesh.edges())
-        {
-            if (mesh.is_boundary(e) || !mesh.is_flip_ok(e))
-            {
-                continue;
-            }
-            const auto h = mesh.halfedge_handle(e, 0);
-            const auto o = mesh.opposite_halfedge_handle(h);
-            const auto a = mesh.from_vertex_handle(h);
-            const auto b = mesh.to_vertex_handle(h);
-            const auto c = mesh.to_vertex_handle(mesh.next_halfedge_handle(h));
-            const auto d = mesh.to_vertex_handle(mesh.next_halfedge_handle(o));
-            const auto lowest = [&mesh](OmMesh::VertexHandle v) {
-                return mesh.is_boundary(v) ? 2U : 3U;
-            };
-            if (mesh.valence(a) <= lowest(a) || mesh.valence(b) <= lowest(b))
-            {
-                continue;
-            }
-            const Vec3d pa = to_eigen(mesh.point(a));
-            const Vec3d pb = to_eigen(mesh.point(b));
-            const Vec3d pc = to_eigen(mesh.point(c));
-            const Vec3d pd = to_eigen(mesh.point(d));
-            const Vec3d n1 = (pb - pa).cross(pc - pa);
-            const Vec3d n2 = (pa - pb).cross(pd - pb);
-            const double l1 = n1.norm();
-            const double l2 = n2.norm();
-            if (l1 > 0.0 && l2 > 0.0 && n1.dot(n2) >= flat_cos * l1 * l2)
-            {
-                continue; // flat enough: improve_by_flips decides
-            }
-            const std::optional<double> before = value(0.5 * (pa + pb));
-            const std::optional<double> after = value(0.5 * (pc + pd));
-            if (!before || !after || !(*after < 0.5 * *before))
-            {
-                continue;
-            }
-            if (!agrees(pa, pd, pc) || !agrees(pd, pb, pc))
-            {
-                continue;
-            }
-            mesh.flip(e);
-            ++flips_this_pass;
-        }
-        flips += flips_this_pass;
-        if (flips_this_pass == 0)
-        {
-            break;
-        }
-    }
-    return flips;
+    return flip_passes(mesh,
+                       [&](const Vec3d& pa, const Vec3d& pb, const Vec3d& pc, const Vec3d& pd) {
+                           const Vec3d n1 = (pb - pa).cross(pc - pa);
+                           const Vec3d n2 = (pa - pb).cross(pd - pb);
+                           const double l1 = n1.norm();
+                           const double l2 = n2.norm();
+                           if (l1 > 0.0 && l2 > 0.0 && n1.dot(n2) >= flat_cos * l1 * l2)
+                           {
+                               return false; // flat enough: improve_by_flips decides
+                           }
+                           const std::optional<double> before = value(0.5 * (pa + pb));
+                           const std::optional<double> after = value(0.5 * (pc + pd));
+                           if (!before || !after || !(*after < 0.5 * *before))
+                           {
+                               return false;
+                           }
+                           return agrees(pa, pd, pc) && agrees(pd, pb, pc);
+                       });
 }
 
 /// Per-vertex state of the shape-improvement and projection stage.
