@@ -194,6 +194,34 @@ Vec3f least_axis(const std::array<float, 6>& covariance)
     return v / length;
 }
 
+/// The value at position count / 2 of `values` in ascending order, as std::nth_element leaves it
+/// there (which it may do to `values`). Short rows, as neighbour rows are, take each value's rank
+/// counted without branches, several times faster than nth_element's partitioning on 17 values.
+float middle_value(std::span<float> values)
+{
+    constexpr std::size_t short_row = 32;
+    const std::size_t count = values.size();
+    const std::size_t middle = count / 2;
+    if (count <= short_row)
+        for (std::size_t i = 0; i < count; ++i)
+        {
+            const float v = values[i];
+            std::size_t less = 0;
+            std::size_t not_greater = 0;
+            for (std::size_t j = 0; j < count; ++j)
+            {
+                less += values[j] < v ? 1U : 0U;
+                not_greater += values[j] <= v ? 1U : 0U;
+            }
+            if (less <= middle && middle < not_greater)
+                return v;
+        }
+    // Long rows, and rows with a NaN (no value has a consistent rank).
+    const auto at = values.begin() + static_cast<std::ptrdiff_t>(middle);
+    std::nth_element(values.begin(), at, values.end());
+    return *at;
+}
+
 /// The band of each sample's sheet along its guide normal, which its neighbours must lie in (far
 /// steadier than its own normal under noise): centred on the median height of its neighbours,
 /// off_sheet_deviations robust deviations wide each way. The deviation is the median, over the
@@ -211,10 +239,7 @@ void mark_sheets(std::span<const Vec3f> positions, const KnnTable& neighbors, Gu
         std::vector<float> height(neighbors.k);
         std::vector<float> scratch(neighbors.k);
         const auto median = [&](std::size_t count) {
-            const auto middle = scratch.begin() + static_cast<std::ptrdiff_t>(count / 2);
-            std::nth_element(scratch.begin(), middle,
-                             scratch.begin() + static_cast<std::ptrdiff_t>(count));
-            return *middle;
+            return middle_value(std::span<float>(scratch).first(count));
         };
         for (std::size_t i = begin; i < end; ++i)
         {
@@ -247,10 +272,8 @@ void mark_sheets(std::span<const Vec3f> positions, const KnnTable& neighbors, Gu
             const auto row = neighbors.neighbors(i);
             for (std::size_t c = 0; c < row.size(); ++c)
                 scratch[c] = deviation[row[c]];
-            const auto middle = scratch.begin() + static_cast<std::ptrdiff_t>(row.size() / 2);
-            std::nth_element(scratch.begin(), middle,
-                             scratch.begin() + static_cast<std::ptrdiff_t>(row.size()));
-            guide.reach[i] = off_sheet_deviations * *middle;
+            guide.reach[i] =
+                off_sheet_deviations * middle_value(std::span<float>(scratch).first(row.size()));
         }
     });
 }
@@ -294,33 +317,45 @@ Guide guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> nor
         outer[4] += y * z;
         outer[5] += z * z;
     };
+    // The moments of sample i's own neighbourhood.
+    const auto own_moments = [&](std::size_t i) {
+        const Vec3f& p = positions[i];
+        std::array<float, 3> sum{};
+        std::array<float, 6> outer{};
+        const auto row = neighbors.neighbors(i);
+        for (const std::uint32_t j : row)
+        {
+            const Vec3f d = positions[j] - p;
+            add(sum, outer, d.x(), d.y(), d.z());
+        }
+        return finish({p.x(), p.y(), p.z()}, sum, outer, static_cast<float>(row.size()));
+    };
+    // Clean enough when the median flatness (the value at n / 2 in order) is below
+    // noisy_flatness, that is when more than n / 2 samples are flatter: counted, not sorted, and
+    // nothing kept for a clean cloud, whose samples' own normals are the best guide.
+    {
+        constexpr std::size_t block = 4096;
+        std::vector<std::size_t> flatter((n + block - 1) / block, 0);
+        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+            std::size_t count = 0;
+            for (std::size_t i = begin; i < end; ++i)
+                count += flatness(own_moments(i).covariance) < noisy_flatness ? 1U : 0U;
+            flatter[begin / block] = count;
+        });
+        if (std::accumulate(flatter.begin(), flatter.end(), std::size_t{0}) > n / 2)
+            return {};
+    }
     std::vector<Moments> current(n);
     std::vector<std::array<float, 6>> best(n);
     std::vector<float> best_flatness(n);
     parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
         {
-            const Vec3f& p = positions[i];
-            std::array<float, 3> sum{};
-            std::array<float, 6> outer{};
-            const auto row = neighbors.neighbors(i);
-            for (const std::uint32_t j : row)
-            {
-                const Vec3f d = positions[j] - p;
-                add(sum, outer, d.x(), d.y(), d.z());
-            }
-            current[i] = finish({p.x(), p.y(), p.z()}, sum, outer, static_cast<float>(row.size()));
+            current[i] = own_moments(i);
             best[i] = current[i].covariance;
             best_flatness[i] = flatness(best[i]);
         }
     });
-    {
-        std::vector<float> sorted = best_flatness;
-        const auto middle = sorted.begin() + static_cast<std::ptrdiff_t>(n / 2);
-        std::nth_element(sorted.begin(), middle, sorted.end());
-        if (*middle < noisy_flatness)
-            return {}; // clean enough: the samples' own normals are the best guide
-    }
     std::vector<Moments> next(rings > 0 ? n : 0);
     for (std::size_t ring = 0; ring < rings; ++ring)
     {
@@ -413,25 +448,6 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
         throw InvalidInput("orientation: too many points times graph neighbours (" +
                            std::to_string(n) + " x " + std::to_string(columns) + ")");
     std::vector<std::uint32_t> cost_bits(n * columns);
-    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i)
-        {
-            const auto a = static_cast<std::uint32_t>(i);
-            const auto row = neighbors.neighbors(i).first(columns);
-            for (std::size_t c = 0; c < columns; ++c)
-            {
-                const std::uint32_t b = row[c];
-                cost_bits[i * columns + c] =
-                    b == a || (b < a && row_contains(neighbors, b, columns, a))
-                        ? not_an_edge
-                        : std::bit_cast<std::uint32_t>(
-                              guide.jumps(positions, neighbors, a, b)
-                                  ? 2.0F
-                                  : edge_cost(positions, normals, options.rule, a, b));
-            }
-        }
-    });
-    progress.update(0.3, 1.0);
 
     // 2. Borůvka: each round, every component takes its cheapest edge to another component,
     //    found in parallel by atomic minima of 64-bit keys (cost, then edge index: the order of
@@ -460,9 +476,41 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
     std::vector<std::uint8_t> internal(n, 0);       // every edge of the row is inside one component
     std::vector<std::uint64_t> tree_keys;
     tree_keys.reserve(n);
-    for (bool merged = true; merged;)
+    //    The costs are stored as the first round's search goes: every sample its own component,
+    //    every edge leaves one.
+    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            const auto a = static_cast<std::uint32_t>(i);
+            const auto row = neighbors.neighbors(i).first(columns);
+            std::uint64_t own = no_key;
+            for (std::size_t c = 0; c < columns; ++c)
+            {
+                const std::uint32_t b = row[c];
+                const std::uint32_t bits =
+                    b == a || (b < a && row_contains(neighbors, b, columns, a))
+                        ? not_an_edge
+                        : std::bit_cast<std::uint32_t>(
+                              guide.jumps(positions, neighbors, a, b)
+                                  ? 2.0F
+                                  : edge_cost(positions, normals, options.rule, a, b));
+                cost_bits[i * columns + c] = bits;
+                if (bits == not_an_edge)
+                    continue;
+                const std::uint64_t key = key_of(bits, i * columns + c);
+                own = std::min(own, key);
+                lower(cheapest[b], key);
+            }
+            if (own != no_key)
+                lower(cheapest[a], own);
+            else
+                internal[i] = 1;
+        }
+    });
+    progress.update(0.3, 1.0);
+    for (bool merged = true, first = true; merged; first = false)
     {
-        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        parallel_blocks(first ? 0 : n, block, [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i)
             {
                 if (internal[i] != 0)

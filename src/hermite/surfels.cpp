@@ -4,6 +4,7 @@
 #include "pointform/hermite/surfels.h"
 
 #include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
 #include "pointform/hermite/normals.h"
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/spatial_sort.h"
@@ -21,6 +22,9 @@ namespace {
 /// Second-largest over largest eigenvalue of the whole cloud's covariance below which all points
 /// are taken to lie on one line. Relative, so unit-free; float storage noise is about 1e-14.
 constexpr double global_collinear_ratio = 1e-12;
+
+/// Samples a block when the cloud is put into Morton order and back.
+constexpr std::size_t gather_block = 1U << 16U;
 
 class StageTimer
 {
@@ -87,8 +91,10 @@ SurfelResult compute_surfels(const PointCloudView& cloud, const SurfelOptions& o
     // the end. The order depends only on the positions, so results do not depend on threads.
     const std::vector<std::uint32_t> order = spatial_order(cloud.positions);
     std::vector<Vec3f> sorted(n);
-    for (std::size_t j = 0; j < n; ++j)
-        sorted[j] = cloud.positions[order[j]];
+    parallel_blocks(n, gather_block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t j = begin; j < end; ++j)
+            sorted[j] = cloud.positions[order[j]];
+    });
     const std::span<const Vec3f> positions = sorted;
     timer.lap("spatial sort");
 
@@ -148,11 +154,13 @@ SurfelResult compute_surfels(const PointCloudView& cloud, const SurfelOptions& o
     result.surfels.colors.assign(cloud.colors.begin(), cloud.colors.end());
     result.surfels.normals.resize(n);
     result.surfels.radii.resize(n);
-    for (std::size_t j = 0; j < n; ++j)
-    {
-        result.surfels.normals[order[j]] = oriented.normals[j];
-        result.surfels.radii[order[j]] = radii[j];
-    }
+    parallel_blocks(n, gather_block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t j = begin; j < end; ++j)
+        {
+            result.surfels.normals[order[j]] = oriented.normals[j];
+            result.surfels.radii[order[j]] = radii[j];
+        }
+    });
     result.orientation = std::move(oriented);
     result.orientation.normals = result.surfels.normals;
     for (auto& index : result.orientation.unoriented)

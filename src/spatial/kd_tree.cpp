@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
 #include <utility>
 
@@ -99,20 +100,203 @@ private:
     std::size_t count_ = 0;
 };
 
+using Node = NanoTree::Node;
+using Offset = NanoTree::Offset;
+using BoundingBox = NanoTree::BoundingBox;
+
+/// nanoflann's divideTree(), node for node (same splits, same leaves, same order of indices),
+/// with the nodes taken in turn from `next`: each subtree built at once has a range of its own.
+Node* divide_tree(NanoTree& tree, std::span<const Vec3f> points, Node*& next, Offset left,
+                  Offset right, BoundingBox& bbox)
+{
+    Node* node = next++;
+    if (right - left <= tree.m_leaf_max_size)
+    {
+        node->child1 = node->child2 = nullptr;
+        node->node_type.lr.left = left;
+        node->node_type.lr.right = right;
+        for (int d = 0; d < 3; ++d)
+            bbox[d].low = bbox[d].high = points[tree.vAcc[left]][d];
+        for (Offset k = left + 1; k < right; ++k)
+            for (int d = 0; d < 3; ++d)
+            {
+                const float v = points[tree.vAcc[k]][d];
+                if (bbox[d].low > v)
+                    bbox[d].low = v;
+                if (bbox[d].high < v)
+                    bbox[d].high = v;
+            }
+        return node;
+    }
+    Offset index = 0;
+    NanoTree::Dimension cutfeat = 0;
+    float cutval = 0.0F;
+    tree.middleSplit_(tree, left, right - left, index, cutfeat, cutval, bbox);
+    node->node_type.sub.divfeat = cutfeat;
+    BoundingBox left_bbox(bbox);
+    left_bbox[cutfeat].high = cutval;
+    node->child1 = divide_tree(tree, points, next, left, left + index, left_bbox);
+    BoundingBox right_bbox(bbox);
+    right_bbox[cutfeat].low = cutval;
+    node->child2 = divide_tree(tree, points, next, left + index, right, right_bbox);
+    node->node_type.sub.divlow = left_bbox[cutfeat].high;
+    node->node_type.sub.divhigh = right_bbox[cutfeat].low;
+    for (int d = 0; d < 3; ++d)
+    {
+        bbox[d].low = std::min(left_bbox[d].low, right_bbox[d].low);
+        bbox[d].high = std::max(left_bbox[d].high, right_bbox[d].high);
+    }
+    return node;
+}
+
+/// Points a subtree at least, below which it is built by one thread (divide_tree()).
+constexpr std::size_t min_subtree = 8192;
+
 } // namespace
 
 struct KdTree::Impl
 {
     PositionSpan data;
     NanoTree tree;
+    /// The nodes of the subtrees built at once (the tree's own pool has the top ones): the
+    /// subtree of points [left, right) has nodes [2 left, 2 right), more than its at most
+    /// 2 (right - left) - 1. Left uninitialised, so only the pages used are ever resident; one
+    /// block allocated by this thread, rather than pools by the threads that build the
+    /// subtrees, which would keep the freed nodes in their own malloc arenas.
+    std::unique_ptr<Node[]> nodes;
 
     Impl(std::span<const Vec3f> points, std::size_t leaf)
-        : data{points}, tree(3, data, nanoflann::KDTreeSingleIndexAdaptorParams(leaf))
+        : data{points},
+          tree(3, data,
+               nanoflann::KDTreeSingleIndexAdaptorParams(
+                   leaf, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex))
     {
         if (!points.empty())
-            tree.buildIndex();
+            build();
     }
+
+    /// nanoflann's buildIndex(), giving the same tree, in parallel: the top nodes are split
+    /// level by level, the nodes of a level at once, down to subtrees of about n / 64 points
+    /// (at least min_subtree), which are then built at once; the top nodes' split bounds and
+    /// boxes are filled in last, from their children's boxes, bottom up.
+    void build();
 };
+
+void KdTree::Impl::build()
+{
+    const std::span<const Vec3f> points = data.points;
+    const std::size_t n = points.size();
+    tree.m_size = n;
+    tree.m_size_at_index_build = n;
+    tree.vAcc.resize(n);
+    constexpr std::size_t block = 1U << 16U;
+    const std::size_t blocks = (n + block - 1) / block;
+    std::vector<BoundingBox> block_boxes(blocks);
+    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        BoundingBox& box = block_boxes[begin / block];
+        for (int d = 0; d < 3; ++d)
+            box[d].low = box[d].high = points[begin][d];
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            tree.vAcc[i] = static_cast<std::uint32_t>(i);
+            for (int d = 0; d < 3; ++d)
+            {
+                const float v = points[i][d];
+                box[d].low = std::min(box[d].low, v);
+                box[d].high = std::max(box[d].high, v);
+            }
+        }
+    });
+    BoundingBox root_box = block_boxes[0];
+    for (const BoundingBox& box : block_boxes)
+        for (int d = 0; d < 3; ++d)
+        {
+            root_box[d].low = std::min(root_box[d].low, box[d].low);
+            root_box[d].high = std::max(root_box[d].high, box[d].high);
+        }
+
+    // The top of the tree: nodes in the order they are made, so a node's children come after it.
+    struct Top
+    {
+        Offset left;
+        Offset right;
+        BoundingBox bbox; // the box handed down; the points' own box once built
+        std::size_t child1 = 0;
+        std::size_t child2 = 0;
+        NanoTree::Dimension cutfeat = 0;
+        float cutval = 0.0F;
+        Offset index = 0;
+        bool split = false;
+        Node* node = nullptr;
+    };
+    const std::size_t grain = std::max({min_subtree, n / 64, tree.m_leaf_max_size});
+    std::vector<Top> top{{.left = 0, .right = n, .bbox = root_box}};
+    std::vector<std::size_t> level{0};
+    std::vector<std::size_t> subtrees;
+    while (!level.empty())
+    {
+        std::vector<std::size_t> splits;
+        for (const std::size_t t : level)
+            (top[t].right - top[t].left > grain ? splits : subtrees).push_back(t);
+        parallel_blocks(splits.size(), 1, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t s = begin; s < end; ++s)
+            {
+                Top& node = top[splits[s]];
+                tree.middleSplit_(tree, node.left, node.right - node.left, node.index, node.cutfeat,
+                                  node.cutval, node.bbox);
+                node.split = true;
+            }
+        });
+        level.clear();
+        for (const std::size_t t : splits)
+        {
+            Top low = top[t];
+            low.right = top[t].left + top[t].index;
+            low.bbox[top[t].cutfeat].high = top[t].cutval;
+            low.split = false;
+            Top high = top[t];
+            high.left = low.right;
+            high.bbox[top[t].cutfeat].low = top[t].cutval;
+            high.split = false;
+            top[t].child1 = top.size();
+            level.push_back(top.size());
+            top.push_back(low);
+            top[t].child2 = top.size();
+            level.push_back(top.size());
+            top.push_back(high);
+        }
+    }
+    nodes.reset(new Node[2 * n]); // NOLINT(cppcoreguidelines-owning-memory): not initialised
+    parallel_blocks(subtrees.size(), 1, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t s = begin; s < end; ++s)
+        {
+            Top& node = top[subtrees[s]];
+            Node* next = nodes.get() + 2 * node.left;
+            node.node = divide_tree(tree, points, next, node.left, node.right, node.bbox);
+        }
+    });
+    for (std::size_t t = top.size(); t-- > 0;)
+    {
+        Top& node = top[t];
+        if (!node.split)
+            continue;
+        const Top& low = top[node.child1];
+        const Top& high = top[node.child2];
+        node.node = tree.pool.allocate<Node>();
+        node.node->node_type.sub.divfeat = node.cutfeat;
+        node.node->child1 = low.node;
+        node.node->child2 = high.node;
+        node.node->node_type.sub.divlow = low.bbox[node.cutfeat].high;
+        node.node->node_type.sub.divhigh = high.bbox[node.cutfeat].low;
+        for (int d = 0; d < 3; ++d)
+        {
+            node.bbox[d].low = std::min(low.bbox[d].low, high.bbox[d].low);
+            node.bbox[d].high = std::max(low.bbox[d].high, high.bbox[d].high);
+        }
+    }
+    tree.root_bbox = top[0].bbox;
+    tree.root_node = top[0].node;
+}
 
 KdTree::KdTree(std::span<const Vec3f> positions, const KdTreeOptions& options)
 {

@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 namespace pointform {
 namespace {
@@ -24,11 +26,49 @@ std::uint64_t spread_bits(std::uint64_t x)
     return x;
 }
 
+/// bounding_box(positions), its minima and maxima taken by blocks at once (the same, as min and
+/// max do not depend on the order); serially when a coordinate is not finite, where they might.
+Aabb parallel_bounding_box(std::span<const Vec3f> positions)
+{
+    constexpr std::size_t block = 1U << 16U;
+    const std::size_t blocks = (positions.size() + block - 1) / block;
+    if (blocks <= 1)
+        return bounding_box(positions);
+    std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>> ranges(blocks);
+    std::vector<std::uint8_t> finite(blocks, 1);
+    parallel_blocks(positions.size(), block, [&](std::size_t begin, std::size_t end) {
+        Eigen::Vector3f lo = positions[begin];
+        Eigen::Vector3f hi = positions[begin];
+        bool all_finite = true;
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            lo = lo.cwiseMin(positions[i]);
+            hi = hi.cwiseMax(positions[i]);
+            all_finite = all_finite && positions[i].allFinite();
+        }
+        ranges[begin / block] = {lo, hi};
+        finite[begin / block] = all_finite ? 1 : 0;
+    });
+    if (std::find(finite.begin(), finite.end(), 0) != finite.end())
+        return bounding_box(positions);
+    Eigen::Vector3f lo = ranges[0].first;
+    Eigen::Vector3f hi = ranges[0].second;
+    for (const auto& [block_lo, block_hi] : ranges)
+    {
+        lo = lo.cwiseMin(block_lo);
+        hi = hi.cwiseMax(block_hi);
+    }
+    Aabb box;
+    box.min = Vec3d::Zero() + lo.cast<double>();
+    box.max = Vec3d::Zero() + hi.cast<double>();
+    return box;
+}
+
 } // namespace
 
 std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions)
 {
-    const Aabb box = bounding_box(positions);
+    const Aabb box = parallel_bounding_box(positions);
     // (Morton key, index) pairs: sorting them orders by key, ties by original index.
     std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(positions.size());
     std::vector<std::uint32_t> order(positions.size());
@@ -53,8 +93,10 @@ std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions)
         }
     });
     parallel_sort(keyed); // keys paired with their index: a strict order, std::sort's result
-    for (std::size_t j = 0; j < keyed.size(); ++j)
-        order[j] = keyed[j].second;
+    parallel_blocks(keyed.size(), 1U << 16U, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t j = begin; j < end; ++j)
+            order[j] = keyed[j].second;
+    });
     return order;
 }
 

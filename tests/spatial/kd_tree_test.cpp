@@ -10,6 +10,7 @@
 #include "support/thread_counts.h"
 
 #include <gtest/gtest.h>
+#include <nanoflann.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -165,6 +166,63 @@ TEST(KdTree, ResultsIndependentOfThreadCount)
         EXPECT_EQ(runs[0].indices, runs[i].indices) << i + 1 << " threads";
         EXPECT_EQ(runs[0].squared_distances, runs[i].squared_distances) << i + 1 << " threads";
     }
+}
+
+/// nanoflann's dataset adaptor over a vector of points, for a reference tree.
+struct ReferenceAdaptor
+{
+    const std::vector<Vec3f>* points;
+    [[nodiscard]] std::size_t kdtree_get_point_count() const { return points->size(); }
+    [[nodiscard]] float kdtree_get_pt(std::size_t i, std::size_t dim) const
+    {
+        return (*points)[i][static_cast<Eigen::Index>(dim)];
+    }
+    template <class Box>
+    bool kdtree_get_bbox(Box& /*box*/) const
+    {
+        return false;
+    }
+};
+
+// The tree is built in parallel (its top split level by level, then subtrees at once): it must be
+// nanoflann's own tree, node for node, whatever the thread count. A search that stops early
+// (nearest_within_factor) depends on the layout, so its answers, on points with many ties on
+// the split planes, are compared with those of nanoflann's serial buildIndex().
+TEST(KdTree, ParallelBuildIsNanoflannsTree)
+{
+    // 300,000 points on a coarse lattice, so many share coordinates with a split plane.
+    std::vector<Vec3f> points = random_points(300000, 17);
+    for (auto& p : points)
+        p = (p * 64.0F).array().round().matrix() / 64.0F;
+    using Reference = nanoflann::KDTreeSingleIndexAdaptor<
+        nanoflann::L2_Simple_Adaptor<float, ReferenceAdaptor, float, std::uint32_t>,
+        ReferenceAdaptor, 3, std::uint32_t>;
+    const ReferenceAdaptor adaptor{&points};
+    const Reference reference(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    const std::vector<Vec3f> queries = random_points(20000, 18);
+    std::vector<std::uint32_t> expected(queries.size());
+    for (std::size_t q = 0; q < queries.size(); ++q)
+    {
+        std::uint32_t index = 0;
+        float d2 = 0.0F;
+        nanoflann::KNNResultSet<float, std::uint32_t, std::size_t> result(1);
+        result.init(&index, &d2);
+        nanoflann::SearchParams params;
+        params.eps = 1.0F;
+        reference.findNeighbors(result, queries[q].data(), params);
+        expected[q] = index;
+    }
+    const auto runs = test::at_thread_counts(
+        [&] {
+            const KdTree tree(points);
+            std::vector<std::uint32_t> found(queries.size());
+            for (std::size_t q = 0; q < queries.size(); ++q)
+                found[q] = tree.nearest_within_factor(queries[q], 2.0F).value;
+            return found;
+        },
+        {.min_multi_block_loops = 2}, {1, 2, 3, 4});
+    for (const auto& found : runs)
+        EXPECT_EQ(found, expected);
 }
 
 TEST(KdTree, DuplicatePointsAreOrderedByIndex)
