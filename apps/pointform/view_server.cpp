@@ -320,7 +320,7 @@ std::string encode_distances(const ViewData& data, std::size_t level, const Poin
     return out;
 }
 
-std::vector<Triangle> parse_picked_request(const std::string& body, std::size_t sample_count)
+std::vector<Triangle> parse_picked_request(const std::string& body)
 {
     // Depth first: the request is three levels deep, and a hostile body of a million '['
     // must not reach a recursive parser or destructor.
@@ -354,9 +354,10 @@ std::vector<Triangle> parse_picked_request(const std::string& body, std::size_t 
         Triangle triangle{};
         for (std::size_t k = 0; k < 3; ++k)
         {
-            if (!t[k].is_number_unsigned() || t[k].get<std::uint64_t>() >= sample_count)
-                throw InvalidInput(which + ": " + t[k].dump() + " is not a sample index (0 to " +
-                                   std::to_string(sample_count - 1) + ")");
+            // Whether it names a sample is picked_vertices_from_samples()'s to say.
+            if (!t[k].is_number_unsigned() ||
+                t[k].get<std::uint64_t>() > std::numeric_limits<std::uint32_t>::max())
+                throw InvalidInput(which + ": " + t[k].dump() + " is not a sample index");
             triangle[k] = static_cast<std::uint32_t>(t[k].get<std::uint64_t>());
         }
         out.push_back(triangle);
@@ -705,18 +706,17 @@ void serve_view(std::vector<ViewData> inputs, const StaticFiles& files, const st
                       "no samples to reconstruct from: name a point cloud on the command line");
             return;
         }
-        std::vector<Triangle> picked;
+        PickedVertices vertices;
         try
         {
-            picked = parse_picked_request(req.body, samples->size());
+            vertices = picked_vertices_from_samples(parse_picked_request(req.body), *samples,
+                                                    "the picked base mesh");
         }
         catch (const InvalidInput& e)
         {
             set_error(res, 400, e.what());
             return;
         }
-        PickedVertices vertices =
-            picked_vertices_from_samples(picked, *samples, "the picked base mesh");
         const bool started = job.start([&, vertices = std::move(vertices)](
                                            ReconstructionJob& self, long long number) mutable {
             try

@@ -77,11 +77,11 @@ struct ViewData
 
 /// \brief The base mesh a page sends with POST /api/reconstruct: {"triangles": [[i, j, k],
 /// ...]} over the indices of the samples (the first point cloud's points), at most
-/// max_picked_triangles. \return the triangles over sample indices
+/// max_picked_triangles. \return the triangles over sample indices, not yet checked against
+/// the samples (picked_vertices_from_samples() does that)
 /// \throw InvalidInput saying what is wrong with the request (the server's 400)
 inline constexpr std::size_t max_picked_triangles = 100000;
-[[nodiscard]] std::vector<Triangle> parse_picked_request(const std::string& body,
-                                                         std::size_t sample_count);
+[[nodiscard]] std::vector<Triangle> parse_picked_request(const std::string& body);
 
 /// \brief One of the page's files, held in memory.
 struct StaticFile
