@@ -408,7 +408,11 @@ std::vector<Triangle> refine_split_level(MultiresMesh& mesh, MultiresMesh::Split
     // Folds: VEN for the vertices of folded child faces, then fall back to the prediction, then
     // to the midpoint.
     std::vector<char> folded;
-    find_folds(level, x, face_normal, options.fold_cosine, field, origin, folded);
+    // The folded child faces of the positions as they are now (x sees every move).
+    const auto refold = [&] {
+        find_folds(level, x, face_normal, options.fold_cosine, field, origin, folded);
+    };
+    refold();
     const std::vector<std::uint32_t> marked = vertices_of_folds(level, folded);
     stats.fold_vertices = marked.size();
     std::vector<char> used_ven(added, 0);
@@ -430,7 +434,7 @@ std::vector<Triangle> refine_split_level(MultiresMesh& mesh, MultiresMesh::Split
         // midpoint that cuts a crease's corner lies inside; put back there, it stays a spike).
         std::vector<std::optional<Vec3d>> nearest(added);
         {
-            find_folds(level, x, face_normal, options.fold_cosine, field, origin, folded);
+            refold();
             const std::vector<std::uint32_t> still = vertices_of_folds(level, folded);
             parallel_blocks(still.size(), 64, [&](std::size_t begin, std::size_t end) {
                 for (std::size_t m = begin; m < end; ++m)
@@ -443,7 +447,7 @@ std::vector<Triangle> refine_split_level(MultiresMesh& mesh, MultiresMesh::Split
         }
         for (int fallback = 0; fallback < 3; ++fallback)
         {
-            find_folds(level, x, face_normal, options.fold_cosine, field, origin, folded);
+            refold();
             std::vector<std::uint32_t> still = vertices_of_folds(level, folded);
             // Repeat: putting one vertex back can fold a neighbour's face.
             while (!still.empty())
@@ -477,7 +481,7 @@ std::vector<Triangle> refine_split_level(MultiresMesh& mesh, MultiresMesh::Split
                 }
                 if (!changed)
                     break;
-                find_folds(level, x, face_normal, options.fold_cosine, field, origin, folded);
+                refold();
                 still = vertices_of_folds(level, folded);
             }
         }
@@ -568,7 +572,7 @@ std::vector<Triangle> refine_split_level(MultiresMesh& mesh, MultiresMesh::Split
         // Undo the moves of vertices in folded faces until no folded face has a moved vertex.
         for (;;)
         {
-            find_folds(level, x, face_normal, options.fold_cosine, field, origin, folded);
+            refold();
             bool changed = false;
             for (const std::uint32_t j : vertices_of_folds(level, folded))
                 if (move[j] == Move::Made)
@@ -586,7 +590,7 @@ std::vector<Triangle> refine_split_level(MultiresMesh& mesh, MultiresMesh::Split
                 ++stats.relaxed;
     }
 
-    find_folds(level, x, face_normal, options.fold_cosine, field, origin, folded);
+    refold();
     stats.folded_faces = count_folds(folded);
     for (std::size_t j = 0; j < added; ++j)
     {
