@@ -225,7 +225,7 @@ void register_model(CLI::App& app, const GlobalOptions& global)
         add_base_faces_option(*cmd, options->refine.semi_regular)
             ->description(
                 "With --semi-regular: faces of the base mesh (default: the "
-                "marching-cubes mesh's faces / 16, within [max(8 per component, 200), 20000])"));
+                "marching-cubes mesh's faces / 16, within [max(8 per component, 200), 80000])"));
     for (CLI::Option* option : refine)
     {
         option->needs(semi);

@@ -207,7 +207,7 @@ CLI::Option* add_base_faces_option(CLI::App& cmd, SemiRegularOptions& options)
     return cmd
         .add_option("--base-faces", options.base_faces,
                     "Faces of the automatic base mesh (default: the intermediate mesh's faces / "
-                    "64, within [200, 20000])")
+                    "16, within [200, 80000], then fitted to the vertex budget: see docs)")
         ->check(at_least_one_face());
 }
 

@@ -652,7 +652,7 @@ std::size_t default_base_faces(std::size_t faces, std::size_t components, std::s
     const double equivalent = static_cast<double>(faces) * coarsening * coarsening;
     const auto wanted =
         static_cast<std::size_t>(std::min(equivalent / static_cast<double>(share), 1e12));
-    return std::min(std::clamp<std::size_t>(wanted, lower, 20000), faces);
+    return std::min(std::clamp<std::size_t>(wanted, lower, max_default_base_faces), faces);
 }
 
 std::string describe_topology_change(const MeshTopology& before, const MeshTopology& after)

@@ -47,8 +47,9 @@ std::string stop_reason(const SemiRegularReport& r)
                        format_number(detail) +
                        " on average, less than the field's residual at the samples (" +
                        format_number(r.refinement.field_residual) +
-                       ") and not half as much as the level before: these details follow the "
-                       "noise, so level " +
+                       "), and more than 0.35 times the level before (a smooth surface's shrink to "
+                       "a "
+                       "quarter): these details follow the noise, so level " +
                        std::to_string(finest) + " is the output (robust distance " +
                        format_number(robust) + ")";
             case RefineStop::VertexBudget:

@@ -50,7 +50,7 @@ TEST(ReconstructCli, SampledSphereBecomesAClosedSemiRegularMeshOnTheSphere)
     test::TempDir dir;
     const auto output = dir / "out.ply";
     const auto r = run("reconstruct " + quoted(write_sphere(dir)) + " -o " + quoted(output) +
-                       " --stop paper --json");
+                       " --stop paper --base-faces 200 --json");
     ASSERT_EQ(r.exit_code, 0) << r.out;
     const auto report = nlohmann::json::parse(r.out);
     EXPECT_EQ(report["stop_rule"].get<std::string>(), "paper");

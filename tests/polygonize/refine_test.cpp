@@ -508,8 +508,8 @@ double centroid_error(const MultiresMesh& mesh)
 TEST(RefineAutomaticStop, NoiseStopsRefinementAtTheNoiseFloor)
 {
     // With noise the field's residual at the samples is the noise, and once a level's details
-    // shrink by half or less (not fourfold, as a smooth surface's do) they follow the noise in
-    // the field: refinement stops there, before the budget (made ample here), and a further
+    // shrink by noise_decay or less (not fourfold, as a smooth surface's do) they follow the noise
+    // in the field: refinement stops there, before the budget (made ample here), and a further
     // level would not bring the mesh closer to the true sphere.
     const double sigma = 0.01;
     const PointCloud samples = noisy_sphere(20000, sigma);
@@ -529,7 +529,7 @@ TEST(RefineAutomaticStop, NoiseStopsRefinementAtTheNoiseFloor)
     if (report.stop == RefineStop::NoisyDetails)
     {
         EXPECT_LT(last, report.field_residual);
-        EXPECT_GT(last, 0.5 * before);
+        EXPECT_GT(last, RefineOptions{}.noise_decay * before);
     }
     else
         EXPECT_LE(last, report.detail_threshold);

@@ -57,8 +57,9 @@ class PointField;
 [[nodiscard]] double estimate_marching_cubes_faces(double surface_area, double cell);
 
 /// Intermediate faces above which the grid of the automatic base mesh's marching cubes is
-/// coarsened (intermediate_grid()): 32 times the largest default base-face target, so that the
-/// serial decimation to the base mesh costs the same from a million samples up.
+/// coarsened (intermediate_grid()): 8 times the largest default base-face target
+/// (max_default_base_faces), so that the serial decimation to the base mesh costs the same from
+/// a million samples up.
 inline constexpr double max_intermediate_faces = 640000.0;
 
 /// \brief The grid of the intermediate (marching-cubes) mesh that an automatic base mesh is

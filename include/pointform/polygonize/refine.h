@@ -53,17 +53,19 @@ enum class StopRule
     ///   RefineReport::detail_threshold). A finer level would move the mesh by less than the
     ///   field itself is sure of;
     /// - the next level's details are those of noise: below the field's residual, smaller than
-    ///   the previous level's by less than half, and none well above the residual (the 99th
-    ///   percentile of |f| at the midpoints at most tail_factor times it). On a smooth surface each
-    ///   level's details are about a quarter of the last (the chord error goes with the square of
-    ///   the edge length); where they shrink by half or less, the levels follow the roughness that
-    ///   noise leaves in the field. Measured on a sphere sampled 100k times with noise of 0.2% of
-    ///   its diagonal: levels 1, 2, 3 were 0.064%, 0.069%, 0.078% of the diagonal from the true
-    ///   sphere (Chamfer), their expected details shrank by 0.64 and 0.50, and this rule stops at
-    ///   level 1. A thin plate with the same noise shrinks its details by half as well, on its
-    ///   flat faces, but the 99th percentile stays 3-5 times the residual, at the rims where the
-    ///   chords cut the edge of the plate; levels 1, 2, 3 were 0.153%, 0.144% and 0.136% of the
-    ///   diagonal from the true plate (Chamfer), and the tail makes this rule go on.
+    ///   the previous level's by a factor above noise_decay (0.35), and none well above the
+    ///   residual (the 99th percentile of |f| at the midpoints at most tail_factor times it). On
+    ///   a smooth surface each level's details are about a quarter of the last (the chord error
+    ///   goes with the square of the edge length); where they shrink by half or less, the levels
+    ///   follow the roughness that noise leaves in the field (0.35 lies between the two, near
+    ///   their geometric mean). Measured on the noisy inputs of bench/peers (100k samples, noise
+    ///   0.2% of the diagonal, 8 holes): from level 1 to 2 the details shrank by 0.46-0.53 and
+    ///   level 2 was farther from the truth than level 1 on every one (Chamfer, % of the
+    ///   diagonal: torus 0.087 vs 0.095, thin plate 0.111 vs 0.117, CAD-like part 0.098 vs
+    ///   0.101, blobby 0.100 vs 0.104), with four times the vertices; a factor of 0.5 let three
+    ///   of the four go on. A thin plate's flat faces shrink their details by half too, but where
+    ///   a coarse level's chords cut the plate's rims the 99th percentile stays 3-5 times the
+    ///   residual, and the tail makes this rule go on.
     /// Both are measured before a level is made, so no level is made in vain. Unlike the
     /// paper's rule, no single sample decides: creases, noise, outliers and the rims of holes,
     /// where the largest distance stays above the sampling density at any level, do not drive
@@ -112,12 +114,15 @@ struct RefineOptions
     double detail_factor = 0.1;
     /// refine(), StopRule::Automatic: details below the field's residual that shrink by less
     /// than this factor per level are the field's noise; in (0, 1).
-    double noise_decay = 0.5;
+    double noise_decay = 0.35;
     /// refine(), StopRule::Automatic: ... unless the largest of them (the 99th percentile of |f|
     /// at the midpoints where f is defined) exceed this multiple of the field's residual: then
     /// some of the surface (a thin part's rim, a crease, a small feature) is still well off the
-    /// mesh, by more than noise moves the field, and the next level is made; at least 1.
-    double tail_factor = 2.0;
+    /// mesh, by more than noise moves the field, and the next level is made; at least 1. Rims
+    /// cut by a coarse level's chords keep it at 3-5; noise and resolved rims alone reach 2-3
+    /// (a noisy plate whose level 2 was 10% farther from the truth than level 1:
+    /// tests/polygonize/noisy_plate_stop_test.cpp).
+    double tail_factor = 3.0;
     /// refine(): stop once the one-sided Hausdorff distance from the samples to M^J is below
     /// this, in world units (§5.2.4). 0 = estimate_sampling_density(samples)
     /// (pointform/metrics/sampling_density.h).
