@@ -139,11 +139,20 @@ Vec3f tangent_of(const Vec3f& n)
     return n.cross(axis).normalized();
 }
 
-/// The local surface of sample i (see PackedSurfel) from its neighbours (the sample first);
-/// `positions` and `normals` are indexed like `neighbors` and i.
+/// How far apart, in standard deviations of their noise, the heights at a sample of its narrow
+/// and wide quadrics (PointFieldOptions::quadric_narrow_k) may lie before the narrow one is
+/// taken: each height's deviation from the narrow fit's residual (σ̂² = RSS / (k − 6)) and the
+/// fit's leverage at the sample, σ̂ √((XᵀX)⁻¹)₀₀, and the two added (the intersection of
+/// confidence intervals rule of adaptive-scale regression, Goldenshluger and Nemirovski).
+constexpr double narrow_fit_gamma = 2.0;
+
+/// The local surface of sample i (see PackedSurfel) from its neighbours (the sample first,
+/// nearest first); `positions` and `normals` are indexed like `neighbors` and i. A quadric fit
+/// to the narrowest `narrow_k` of them (0: none) replaces the one fit to all where the two
+/// differ by more than noise explains (narrow_fit_gamma).
 void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
                        std::span<const std::uint32_t> neighbors, std::size_t i, PlaneFit fit,
-                       PackedSurfel& out)
+                       std::size_t narrow_k, PackedSurfel& out)
 {
     const Vec3d s = positions[i].cast<double>();
     const Vec3d n = out.normal.cast<double>();
@@ -182,9 +191,23 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
         return; // too few to fit six coefficients: keep the centroid plane
     }
     // Least squares in coordinates scaled to the neighbourhood, for a well-conditioned system.
+    // The normal equations are accumulated nearest first, and kept at the narrow scale too, with
+    // Σ h² for the residuals (RSS = Σ h² − coefᵀ rhs).
     const double inv_scale = 1.0 / std::sqrt(scale2);
-    Eigen::Matrix<double, 6, 6> normal_matrix = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
+    using Mat6 = Eigen::Matrix<double, 6, 6>;
+    using Vec6 = Eigen::Matrix<double, 6, 1>;
+    Mat6 normal_matrix = Mat6::Zero();
+    Vec6 rhs = Vec6::Zero();
+    double heights2 = 0.0;
+    std::size_t count = 0;
+    struct Fit
+    {
+        Mat6 matrix;
+        Vec6 rhs;
+        double heights2;
+        std::size_t count;
+    };
+    std::optional<Fit> small;
     for (const std::uint32_t j : neighbors)
     {
         if (!(normals[j].dot(out.normal) > 0.5F))
@@ -194,22 +217,48 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
         const Vec3d x = (positions[j].cast<double>() - s) * inv_scale;
         const double u = x.dot(t1);
         const double v = x.dot(t2);
-        Eigen::Matrix<double, 6, 1> row;
+        Vec6 row;
         row << 1.0, u, v, u * u, u * v, v * v;
         normal_matrix.selfadjointView<Eigen::Lower>().rankUpdate(row);
-        rhs += row * x.dot(n);
+        const double h = x.dot(n);
+        rhs += row * h;
+        heights2 += h * h;
+        ++count;
+        if (count == narrow_k)
+            small = Fit{normal_matrix, rhs, heights2, count};
     }
-    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(
-        normal_matrix.selfadjointView<Eigen::Lower>());
-    const auto pivots = solver.vectorD();
-    if (solver.info() != Eigen::Success || !(pivots.minCoeff() > 1e-6 * pivots.maxCoeff()))
+    const auto solve = [](const Mat6& m, const Vec6& r) -> std::optional<std::pair<Vec6, double>> {
+        const Eigen::LDLT<Mat6> solver(m.selfadjointView<Eigen::Lower>());
+        const auto pivots = solver.vectorD();
+        if (solver.info() != Eigen::Success || !(pivots.minCoeff() > 1e-6 * pivots.maxCoeff()))
+            return std::nullopt;
+        const Vec6 coef = solver.solve(r);
+        Vec6 e0 = Vec6::Zero();
+        e0[0] = 1.0;
+        const double leverage = solver.solve(e0)[0];
+        if (!coef.allFinite() || !std::isfinite(leverage))
+            return std::nullopt;
+        return std::pair{coef, leverage};
+    };
+    const auto wide = solve(normal_matrix, rhs);
+    if (!wide)
     {
         return; // neighbours on a line, or too few spread: keep the centroid plane
     }
-    const Eigen::Matrix<double, 6, 1> coef = solver.solve(rhs);
-    if (!coef.allFinite())
+    Vec6 coef = wide->first;
+    if (small && small->count < count)
     {
-        return;
+        if (const auto narrow = solve(small->matrix, small->rhs))
+        {
+            // The intersection of confidence intervals: the wide fit unless its height at the
+            // sample differs from the narrow fit's by more than their noise explains.
+            const double rss = std::max(0.0, small->heights2 - narrow->first.dot(small->rhs));
+            const double sigma2 = rss / static_cast<double>(small->count - 6);
+            const double spread = std::sqrt(sigma2 * std::max(0.0, narrow->second)) +
+                                  std::sqrt(sigma2 * std::max(0.0, wide->second));
+            if (std::abs(narrow->first[0] - coef[0]) > narrow_fit_gamma * spread)
+                coef = narrow->first;
+        }
     }
     const double scale = std::sqrt(scale2);
     out.a = static_cast<float>(coef[0] * scale);
@@ -461,6 +510,11 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
     {
         throw InvalidInput("point field: quadric_k must be at least 2");
     }
+    if (options.quadric_narrow_k != 0 &&
+        (options.quadric_narrow_k < 10 || options.quadric_narrow_k > options.quadric_k))
+    {
+        throw InvalidInput("point field: quadric_narrow_k must be 0 or between 10 and quadric_k");
+    }
     impl_ = std::make_unique<Impl>(std::move(surfels), options);
     Impl& m = *impl_;
     const std::size_t n = m.surfels.size();
@@ -561,7 +615,7 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
             packed.normal = m.surfels.normals[i];
             packed.tangent = tangent_of(packed.normal);
             fit_local_surface(fit_positions, fit_normals, neighbors, samples[q], options.fit,
-                              packed);
+                              options.quadric_narrow_k, packed);
             m.packed[m.grid->slot_of(i)] = packed;
         }
         block_area[begin / block] = area;
