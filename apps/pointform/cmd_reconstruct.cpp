@@ -127,6 +127,11 @@ void register_reconstruct(CLI::App& app, const GlobalOptions& global)
                     "Picked base mesh (§5.1, Fig. 6): an OBJ whose vertices snap to the nearest "
                     "samples, or a text file of sample-index triples 'i j k', one triangle a line")
         ->excludes(base_faces);
+    cmd->add_option("--fill-holes", options->reconstruct.fill_holes,
+                    "Close the automatic base mesh's holes whose rim encloses at most this "
+                    "fraction of their component's area (0 keeps every hole)")
+        ->check(CLI::Range(0.0, 0.999999))
+        ->capture_default_str();
     add_refine_options(*cmd, options->refine);
     auto* resolution = cmd->add_option("--resolution", options->reconstruct.resolution,
                                        "Marching cubes: cells along the longest side of the "

@@ -58,9 +58,15 @@ void print_base_mesh(const BaseMeshStats& stats)
                   "% of the triangles below 20°, " +
                   format_number(100.0 * stats.share_below_20_degrees_off_boundary) +
                   "% away from the boundary)");
+    if (stats.holes_filled > 0)
+        print_row("holes filled", std::to_string(stats.holes_filled) + " (" +
+                                      std::to_string(stats.hole_vertices) + " vertices added; " +
+                                      format_number(100.0 * stats.hole_area_share) +
+                                      "% of the base mesh's area; --fill-holes 0 keeps them)");
     print_row("base topology",
               stats.topology_kept
-                  ? "kept (Euler characteristic " +
+                  ? std::string(stats.holes_filled > 0 ? "kept, the holes filled" : "kept") +
+                        " (Euler characteristic " +
                         std::to_string(stats.topology_after.euler_characteristic) + ", " +
                         std::to_string(stats.topology_after.boundary_loops) + " boundary loops, " +
                         std::to_string(stats.topology_after.components) + " components)"

@@ -169,6 +169,26 @@ def test_remesh_is_the_clis(tmp_path):
         pointform.remesh(pointform.read_mesh(BUNNY_SMALL))
 
 
+def test_reconstruct_fills_holes_as_the_cli_does(tmp_path):
+    # A sphere with four holes cut out: closed by default, open with fill_holes=0; the same
+    # bytes as `pointform reconstruct` either way.
+    points = tmp_path / "holes.ply"
+    run_cli("sample", "sphere", "-n", 20000, "--holes", 4, "--hole-radius", 0.04, "-o", points)
+    cloud = pointform.read_points(points)
+    for fill in (None, 0.0):
+        kwargs = {} if fill is None else {"fill_holes": fill}
+        hierarchy = pointform.reconstruct(cloud, **kwargs)
+        loops = hierarchy.report["base_mesh"]["boundary_loops"]
+        assert loops == (0 if fill is None else 4)
+        assert hierarchy.report["base_mesh"]["holes_filled"] == (4 if fill is None else 0)
+        out = tmp_path / f"cli{fill}.pfh"
+        run_cli("reconstruct", points, "-o", tmp_path / "cli.ply", "--save-hierarchy", out, "-q",
+                *([] if fill is None else ["--fill-holes", fill]))
+        mine = tmp_path / f"py{fill}.pfh"
+        hierarchy.save(mine)
+        assert mine.read_bytes() == out.read_bytes()
+
+
 def test_bad_reconstruct_input(sphere_cloud, tmp_path):
     with pytest.raises(pointform.InvalidInput, match="levels must not be negative"):
         pointform.reconstruct(sphere_cloud, levels=-1)
@@ -180,6 +200,8 @@ def test_bad_reconstruct_input(sphere_cloud, tmp_path):
         pointform.reconstruct(sphere_cloud, stop_rule="never")
     with pytest.raises(ValueError, match="resolution"):
         pointform.reconstruct(sphere_cloud, resolution=1)
+    with pytest.raises(ValueError, match="hole"):
+        pointform.reconstruct(sphere_cloud, fill_holes=1.0)
     with pytest.raises(ValueError):
         pointform.reconstruct(pointform.PointCloud(sphere_points(5)))
     not_pfh = tmp_path / "x.pfh"

@@ -352,6 +352,245 @@ void check_options(const BaseMeshOptions& options)
         throw InvalidInput("base mesh: smoothing rounds must be >= 0, got " +
                            std::to_string(options.max_smoothing_rounds));
     }
+    if (!(options.fill_holes >= 0.0 && options.fill_holes < 1.0))
+    {
+        throw InvalidInput(
+            "base mesh: the largest hole to fill must be in [0, 1) of its "
+            "component's area, got " +
+            std::to_string(options.fill_holes));
+    }
+}
+
+/// Loops longer than this are never filled (their patch would be built and faired in time
+/// quadratic in the loop).
+constexpr std::size_t max_filled_loop = 4096;
+
+/// Rounds of bi-Laplacian fairing of a patch's inner vertices.
+constexpr int fairing_rounds = 200;
+
+/// `loop` resampled at `count` points evenly spaced along its closed polyline, the first at
+/// loop[0].
+std::vector<Vec3d> resample_loop(const std::vector<Vec3d>& loop, std::size_t count)
+{
+    const std::size_t n = loop.size();
+    std::vector<double> at(n + 1, 0.0);
+    for (std::size_t i = 0; i < n; ++i)
+        at[i + 1] = at[i] + (loop[(i + 1) % n] - loop[i]).norm();
+    std::vector<Vec3d> out(count);
+    std::size_t segment = 0;
+    for (std::size_t j = 0; j < count; ++j)
+    {
+        const double s = at[n] * static_cast<double>(j) / static_cast<double>(count);
+        while (segment + 1 < n && at[segment + 1] < s)
+            ++segment;
+        const double length = at[segment + 1] - at[segment];
+        const double t = length > 0.0 ? (s - at[segment]) / length : 0.0;
+        out[j] = loop[segment] + t * (loop[(segment + 1) % n] - loop[segment]);
+    }
+    return out;
+}
+
+/// Fills the boundary loops of `mesh` that enclose at most `max_share` of their component's
+/// area (BaseMeshOptions::fill_holes) with patches of rings at the loop's edge length, then
+/// fairs the patches' vertices (bi-Laplacian, the rest of the mesh held). Loops that visit a
+/// vertex twice, or longer than max_filled_loop, are left open. `filled` marks the new vertices.
+void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vector<char>& filled)
+{
+    filled.assign(mesh.n_vertices(), 0);
+    if (!(max_share > 0.0))
+        return;
+    // Components of faces and their areas.
+    std::vector<int> component(mesh.n_faces(), -1);
+    std::vector<double> component_area;
+    double total_area = 0.0;
+    for (const auto f : mesh.faces())
+    {
+        if (component[static_cast<std::size_t>(f.idx())] >= 0)
+            continue;
+        const int id = static_cast<int>(component_area.size());
+        component_area.push_back(0.0);
+        std::vector<OmMesh::FaceHandle> stack{f};
+        component[static_cast<std::size_t>(f.idx())] = id;
+        while (!stack.empty())
+        {
+            const auto g = stack.back();
+            stack.pop_back();
+            const double area = 0.5 * area_normal(face_points(mesh, g)).norm();
+            component_area[static_cast<std::size_t>(id)] += area;
+            total_area += area;
+            for (const auto h : mesh.ff_range(g))
+            {
+                if (component[static_cast<std::size_t>(h.idx())] < 0)
+                {
+                    component[static_cast<std::size_t>(h.idx())] = id;
+                    stack.push_back(h);
+                }
+            }
+        }
+    }
+    // The loops, each as its boundary halfedges in order.
+    std::vector<std::vector<OmMesh::HalfedgeHandle>> loops;
+    std::vector<char> seen(mesh.n_halfedges(), 0);
+    for (const auto start : mesh.halfedges())
+    {
+        if (!mesh.is_boundary(start) || seen[static_cast<std::size_t>(start.idx())] != 0)
+            continue;
+        std::vector<OmMesh::HalfedgeHandle> loop;
+        auto h = start;
+        do
+        {
+            seen[static_cast<std::size_t>(h.idx())] = 1;
+            loop.push_back(h);
+            h = mesh.next_halfedge_handle(h);
+        } while (h != start && loop.size() <= max_filled_loop);
+        loops.push_back(std::move(loop));
+    }
+    double patch_area = 0.0;
+    for (const auto& loop : loops)
+    {
+        const std::size_t n = loop.size();
+        if (n < 3 || n > max_filled_loop)
+            continue;
+        std::vector<OmMesh::VertexHandle> rim(n);
+        std::vector<Vec3d> p(n);
+        for (std::size_t i = 0; i < n; ++i)
+        {
+            rim[i] = mesh.from_vertex_handle(loop[i]);
+            p[i] = to_eigen(mesh.point(rim[i]));
+        }
+        std::vector<OmMesh::VertexHandle> sorted = rim;
+        std::sort(sorted.begin(), sorted.end());
+        if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
+            continue; // the loop pinches at a vertex
+        const bool shared = std::any_of(rim.begin(), rim.end(), [&mesh](auto v) {
+            int boundary = 0;
+            for (const auto h : mesh.voh_range(v))
+                boundary += mesh.is_boundary(h) ? 1 : 0;
+            return boundary > 1;
+        });
+        if (shared)
+            continue; // a rim vertex of another loop too
+        Vec3d centre = Vec3d::Zero();
+        double perimeter = 0.0;
+        for (std::size_t i = 0; i < n; ++i)
+        {
+            centre += p[i];
+            perimeter += (p[(i + 1) % n] - p[i]).norm();
+        }
+        centre /= static_cast<double>(n);
+        Vec3d vector_area = Vec3d::Zero();
+        for (std::size_t i = 0; i < n; ++i)
+            vector_area += 0.5 * (p[i] - centre).cross(p[(i + 1) % n] - centre);
+        const auto opposite = mesh.face_handle(mesh.opposite_halfedge_handle(loop[0]));
+        const double area_of_component = component_area[static_cast<std::size_t>(
+            component[static_cast<std::size_t>(opposite.idx())])];
+        if (!(vector_area.norm() <= max_share * area_of_component))
+            continue;
+        // Rings from the rim inwards, each with about as many vertices as its length holds
+        // edges of the rim's length, and a centre vertex.
+        const double edge = perimeter / static_cast<double>(n);
+        double radius = 0.0;
+        for (const Vec3d& q : p)
+            radius += (q - centre).norm();
+        radius /= static_cast<double>(n);
+        const std::size_t rings = std::max<std::size_t>(
+            1, static_cast<std::size_t>(std::llround(radius / std::max(edge, 1e-300))));
+        std::vector<OmMesh::VertexHandle> outer = rim;
+        std::size_t added = 0;
+        bool ok = true;
+        const auto add_face = [&](OmMesh::VertexHandle a, OmMesh::VertexHandle b,
+                                  OmMesh::VertexHandle c) {
+            if (!mesh.add_face(a, b, c).is_valid())
+                ok = false;
+        };
+        if (n == 3)
+        {
+            add_face(rim[0], rim[1], rim[2]);
+        }
+        else
+        {
+            for (std::size_t k = 1; k < rings && ok; ++k)
+            {
+                const double t = static_cast<double>(k) / static_cast<double>(rings);
+                const auto count =
+                    static_cast<std::size_t>(std::llround(static_cast<double>(n) * (1.0 - t)));
+                if (count < 4)
+                    break;
+                const std::vector<Vec3d> ring = resample_loop(p, count);
+                std::vector<OmMesh::VertexHandle> inner(count);
+                for (std::size_t j = 0; j < count; ++j)
+                {
+                    inner[j] = mesh.add_vertex(to_om(centre + (1.0 - t) * (ring[j] - centre)));
+                    ++added;
+                }
+                // Zip the two rings, the shorter diagonal first (outer runs along the loop's
+                // halfedges, so its faces continue the mesh's orientation).
+                const std::size_t a = outer.size();
+                const std::size_t b = inner.size();
+                std::size_t i = 0;
+                std::size_t j = 0;
+                while ((i < a || j < b) && ok)
+                {
+                    const Vec3d ai = to_eigen(mesh.point(outer[i % a]));
+                    const Vec3d ai1 = to_eigen(mesh.point(outer[(i + 1) % a]));
+                    const Vec3d bj = to_eigen(mesh.point(inner[j % b]));
+                    const Vec3d bj1 = to_eigen(mesh.point(inner[(j + 1) % b]));
+                    const bool advance_outer =
+                        j == b || (i < a && (ai1 - bj).squaredNorm() <= (ai - bj1).squaredNorm());
+                    if (advance_outer)
+                    {
+                        add_face(outer[i % a], outer[(i + 1) % a], inner[j % b]);
+                        ++i;
+                    }
+                    else
+                    {
+                        add_face(inner[j % b], outer[i % a], inner[(j + 1) % b]);
+                        ++j;
+                    }
+                }
+                outer = std::move(inner);
+            }
+            if (ok)
+            {
+                const auto middle = mesh.add_vertex(to_om(centre));
+                ++added;
+                for (std::size_t j = 0; j < outer.size() && ok; ++j)
+                    add_face(outer[j], outer[(j + 1) % outer.size()], middle);
+            }
+        }
+        if (!ok)
+            throw Error("base mesh: filling a hole of " + std::to_string(n) +
+                        " rim vertices made a non-manifold patch");
+        filled.resize(mesh.n_vertices(), 1);
+        stats.hole_vertices += added;
+        ++stats.holes_filled;
+        patch_area += vector_area.norm();
+    }
+    stats.hole_area_share = total_area > 0.0 ? patch_area / total_area : 0.0;
+    if (stats.holes_filled == 0)
+        return;
+    // Fairing: each inner vertex to the mean of its neighbours (a membrane, Gauss-Seidel), the
+    // rest held. A membrane stays within the rim's hull, where a smoother (bi-Laplacian) patch
+    // would continue the rim's own noise into bulges.
+    std::vector<OmMesh::VertexHandle> inner;
+    for (const auto v : mesh.vertices())
+        if (filled[static_cast<std::size_t>(v.idx())] != 0)
+            inner.push_back(v);
+    for (int round = 0; round < fairing_rounds; ++round)
+    {
+        for (const auto v : inner)
+        {
+            Vec3d sum = Vec3d::Zero();
+            int count = 0;
+            for (const auto w : mesh.vv_range(v))
+            {
+                sum += to_eigen(mesh.point(w));
+                ++count;
+            }
+            if (count > 0)
+                mesh.set_point(v, to_om(sum / count));
+        }
+    }
 }
 
 /// The mesh in OpenMesh, in world coordinates (where the field is evaluated).
@@ -564,7 +803,8 @@ std::optional<Vec3d> project_vertex(const Field& field, const Vec3d& p, const Ve
 /// `relax`), then every vertex projected onto f = 0; a vertex whose relaxed position cannot be
 /// projected tries its old one, and keeps it if that fails too. Moves that fold a face (its
 /// normal turned by 90° or more, or its area gone) are undone.
-void relax_and_project(const OmMesh& mesh, const Field& field, bool relax, VertexState& state)
+void relax_and_project(const OmMesh& mesh, const Field& field, bool relax, VertexState& state,
+                       const std::vector<char>& filled)
 {
     const std::size_t n = mesh.n_vertices();
     const std::vector<Vec3d>& old = state.position;
@@ -598,7 +838,13 @@ void relax_and_project(const OmMesh& mesh, const Field& field, bool relax, Verte
             {
                 projected = project_vertex(field, old[i], normal, reach);
             }
-            if (projected)
+            if (!projected && filled[i] != 0)
+            {
+                // A filled hole's vertex beyond the field: relaxed on its patch.
+                next[i] = candidate;
+                next_on[i] = 0;
+            }
+            else if (projected)
             {
                 next[i] = *projected;
                 next_on[i] = 1;
@@ -810,6 +1056,8 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
         reporter.finish();
     }
     mesh.garbage_collection();
+    std::vector<char> filled;
+    fill_holes(mesh, options.fill_holes, stats, filled);
 
     // 2. Shape: rounds of flips and tangential relaxation, each followed by the projection of
     // every vertex onto f = 0 (or the projection alone).
@@ -864,7 +1112,7 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
             }
             if (options.project)
             {
-                relax_and_project(mesh, field, shape, state);
+                relax_and_project(mesh, field, shape, state, filled);
                 for (const auto v : mesh.vertices())
                 {
                     mesh.set_point(v, to_om(state.position[static_cast<std::size_t>(v.idx())]));
@@ -909,7 +1157,10 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
     stats.share_below_20_degrees = angles.sliver_share;
     stats.share_below_20_degrees_off_boundary = angles.interior_sliver_share;
     stats.topology_after = analyze_topology(out);
-    stats.topology_change = describe_topology_change(before, stats.topology_after);
+    MeshTopology expected = before;
+    expected.boundary_loops -= stats.holes_filled;
+    expected.euler_characteristic += static_cast<long long>(stats.holes_filled);
+    stats.topology_change = describe_topology_change(expected, stats.topology_after);
     stats.topology_kept = stats.topology_change.empty();
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;

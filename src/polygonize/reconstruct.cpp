@@ -187,8 +187,9 @@ SemiRegularReport semi_regular_mesh(const TriMesh& intermediate, const Field& fi
         options, intermediate, share, samples != nullptr ? samples->size() : 0, coarsening);
     if (options.levels)
         check_refinement_memory(target, *options.levels);
-    BaseMeshResult built =
-        build_base_mesh(intermediate, field, {.target_faces = target, .progress = progress});
+    BaseMeshResult built = build_base_mesh(
+        intermediate, field,
+        {.target_faces = target, .fill_holes = options.fill_holes, .progress = progress});
     const double base_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     SemiRegularReport r = refine_semi_regular(built.mesh, field, samples, options, progress);
@@ -225,6 +226,8 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
     check_semi_regular_options(options.semi_regular);
     if (!options.base_mesh.empty() && !options.picked_vertices.empty())
         throw InvalidInput("give a base-mesh file or picked vertices, not both");
+    if (!(options.fill_holes >= 0.0 && options.fill_holes < 1.0))
+        throw InvalidInput("the largest hole to fill must be in [0, 1) of its component's area");
     ReconstructReport report;
     StageClock clock(report.stage_seconds);
     const Aabb bounds = surfels.bounds();
@@ -276,8 +279,10 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
             options.min_component_samples ? *options.min_component_samples
                                           : default_min_component_samples(samples.size()));
         clock.lap("debris");
+        SemiRegularOptions semi_regular = options.semi_regular;
+        semi_regular.fill_holes = options.fill_holes;
         report.semi_regular =
-            semi_regular_mesh(mc.mesh, field, &samples, options.semi_regular, default_base_share,
+            semi_regular_mesh(mc.mesh, field, &samples, semi_regular, default_base_share,
                               options.progress, intermediate.coarsening);
     }
     report.stage_seconds.insert(report.stage_seconds.end(),

@@ -768,7 +768,8 @@ struct NextDetail
 {
     /// The robust statistic of |f| at the midpoints of the finest level's edges. Where f is
     /// undefined (beyond every influence radius) the detail is unknown and counts as infinite:
-    /// more than 5% of such midpoints make the next level needed.
+    /// more than 5% of such midpoints make the next level needed; unless f is undefined at both
+    /// ends of the edge too (a filled hole, BaseMeshOptions::fill_holes): those are left out.
     double robust = 0.0;
     /// The largest details: the 99th percentile of |f| over the midpoints where f is defined.
     double tail = 0.0;
@@ -783,15 +784,26 @@ NextDetail next_detail(const MultiresMesh& mesh, const Field& field)
                               mesh.world(static_cast<std::uint32_t>(edges[e] & 0xffffffffU)));
     std::vector<FieldSample> values(midpoints.size());
     field.evaluate(midpoints, values);
-    std::vector<double> detail(values.size());
+    // Where both ends lie beyond the field too (a filled hole), the midpoint says nothing.
+    const std::size_t vertex_count = mesh.vertex_count(mesh.finest_level());
+    std::vector<Vec3d> corners(vertex_count);
+    for (std::size_t v = 0; v < vertex_count; ++v)
+        corners[v] = mesh.world(static_cast<std::uint32_t>(v));
+    std::vector<FieldSample> at_corners(vertex_count);
+    field.evaluate(corners, at_corners);
+    std::vector<double> detail;
+    detail.reserve(values.size());
     std::vector<double> defined;
     defined.reserve(values.size());
     for (std::size_t e = 0; e < values.size(); ++e)
     {
-        detail[e] =
-            values[e].defined ? std::abs(values[e].value) : std::numeric_limits<double>::infinity();
+        if (!values[e].defined && !at_corners[edges[e] >> 32U].defined &&
+            !at_corners[edges[e] & 0xffffffffU].defined)
+            continue;
+        detail.push_back(values[e].defined ? std::abs(values[e].value)
+                                           : std::numeric_limits<double>::infinity());
         if (values[e].defined && std::isfinite(values[e].value))
-            defined.push_back(detail[e]);
+            defined.push_back(detail.back());
     }
     NextDetail out;
     out.robust = robust_stats(detail).robust;

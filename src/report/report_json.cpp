@@ -146,6 +146,9 @@ nlohmann::json report_json(const BaseMeshStats& stats)
     out["max_vertex_move"] = stats.max_vertex_move;
     out["topology_kept"] = stats.topology_kept;
     out["topology_change"] = stats.topology_change;
+    out["holes_filled"] = stats.holes_filled;
+    out["hole_vertices"] = stats.hole_vertices;
+    out["hole_area_share"] = stats.hole_area_share;
     out["euler_characteristic"] = stats.topology_after.euler_characteristic;
     out["boundary_loops"] = stats.topology_after.boundary_loops;
     out["components"] = stats.topology_after.components;

@@ -73,7 +73,7 @@ TEST(NoisyPlateStop, StopsAtTheLevelNearestTheTruePlate)
     // rule did not make.
     ReconstructOptions deeper;
     deeper.semi_regular.levels = chosen + 1;
-    deeper.semi_regular.base_faces = report.semi_regular.hierarchy.face_count(0);
+    deeper.semi_regular.base_faces = report.semi_regular.base->target_faces;
     const ReconstructReport all = reconstruct(std::move(samples), deeper);
     const MultiresMesh& mesh = all.semi_regular.hierarchy;
     ASSERT_EQ(mesh.vertex_count(chosen), report.semi_regular.hierarchy.vertex_count(chosen));

@@ -48,6 +48,18 @@ struct BaseMeshOptions
     /// Flips only between triangles whose normals differ by at most this, degrees, in [0, 90):
     /// a flip must not cut across a crease.
     double max_flip_dihedral_degrees = 40.0;
+    /// Holes filled: a boundary loop of the decimated mesh is closed by a patch (rings of
+    /// triangles at the loop's edge length, its inner vertices faired to a membrane spanning the
+    /// rim: each the mean of its neighbours)
+    /// when the area its rim encloses (the loop's vector area) is at most this fraction of its
+    /// component's surface area, in [0, 1); 0 = no hole filled. Scans leave holes where the
+    /// scanner saw nothing (occlusion, dark or shiny spots, the side an object stood on); the
+    /// default closes those, as the peers' Poisson does, but not the rim of a partial scan (a
+    /// single range image, a terrain), whose loop encloses about as much as the surface
+    /// itself. Filled vertices take the field's zero set where it is defined (near the rim) and
+    /// stay on the membrane where it is not. reconstruct() fills by default
+    /// (ReconstructOptions::fill_holes); remeshing keeps the input's holes.
+    double fill_holes = 0.0;
     /// Move every vertex onto f = 0 along the field gradient (§5.1 criterion 2); false keeps the
     /// decimated marching-cubes positions (and skips the relaxation, which needs projection).
     bool project = true;
@@ -75,9 +87,15 @@ struct BaseMeshStats
     double share_below_20_degrees = 0.0; ///< fraction of triangles with a min angle below 20°
     /// The same among triangles with no vertex on the boundary (holes force thin triangles).
     double share_below_20_degrees_off_boundary = 0.0;
+    /// Holes filled (BaseMeshOptions::fill_holes): loops closed, vertices added, and the area of
+    /// the patches over the base mesh's.
+    std::size_t holes_filled = 0;
+    std::size_t hole_vertices = 0;
+    double hole_area_share = 0.0;
     MeshTopology topology_before; ///< of the intermediate mesh
     MeshTopology topology_after;  ///< of the base mesh
-    /// Same Euler characteristic, boundary loops and components, and an oriented manifold.
+    /// Same Euler characteristic, boundary loops and components as the intermediate mesh (each
+    /// filled hole counted: one loop fewer, χ one higher), and an oriented manifold.
     bool topology_kept = false;
     /// Empty when topology_kept; otherwise what changed, in words, for the caller to print.
     std::string topology_change;

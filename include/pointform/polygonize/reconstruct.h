@@ -51,6 +51,8 @@ struct SemiRegularOptions
     /// Rounds of relaxation per level (§5.2.3), 0 = none.
     int relax_iterations = RefineOptions{}.relax_iterations;
     Relaxation relaxation = RefineOptions{}.relaxation;
+    /// Holes of the automatic base mesh filled (BaseMeshOptions::fill_holes); 0 = none.
+    double fill_holes = 0.0;
 };
 
 /// \brief A semi-regular mesh and how it was made.
@@ -159,6 +161,10 @@ struct ReconstructOptions
     /// (snap_picked_base_mesh(); what `pointform view` sends), instead of a file; at most one of
     /// `base_mesh` and `picked_vertices`.
     PickedVertices picked_vertices;
+    /// The automatic base mesh's holes that are filled: boundary loops enclosing at most this
+    /// fraction of their component's area (BaseMeshOptions::fill_holes), in [0, 1); 0 keeps
+    /// every hole. Replaces semi_regular.fill_holes.
+    double fill_holes = 0.05;
     SemiRegularOptions semi_regular;
     ProgressCallback progress;
 };

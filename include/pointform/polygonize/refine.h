@@ -122,7 +122,7 @@ struct RefineOptions
     /// cut by a coarse level's chords keep it at 3-5; noise and resolved rims alone reach 2-3
     /// (a noisy plate whose level 2 was 10% farther from the truth than level 1:
     /// tests/polygonize/noisy_plate_stop_test.cpp).
-    double tail_factor = 3.0;
+    double tail_factor = 4.0;
     /// refine(): stop once the one-sided Hausdorff distance from the samples to M^J is below
     /// this, in world units (§5.2.4). 0 = estimate_sampling_density(samples)
     /// (pointform/metrics/sampling_density.h).
