@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import faulthandler
+import hashlib
 import json
 import math
 import os
@@ -88,9 +89,11 @@ def thread_scaling(args) -> int:
                       work / "with_normals.ply"], env, args.timeout, work / "sample")
         raw = work / "raw.ply"
         write_points(raw, load_points(work / "with_normals.ply"))
-        print(f"| command | samples | threads | wall s | peak MiB | bytes per sample | result |")
-        print("|---|---|---|---|---|---|---|")
+        print("| command | samples | threads | wall s | peak MiB | bytes per sample | result | "
+              "same bytes as 1 thread | stages s |")
+        print("|---|---|---|---|---|---|---|---|---|")
         for command in args.commands.split(","):
+            first = None
             for threads in counts:
                 out = work / f"{command}_{threads}.ply"
                 status, wall, peak, report = run_measured(
@@ -100,8 +103,15 @@ def thread_scaling(args) -> int:
                 if report and command == "reconstruct":
                     result = f"level {report.get('finest_level')}, {report.get('vertices')} vertices"
                 per_sample = peak * 1048576 / args.scaling if peak else float("nan")
+                digest = hashlib.sha256(out.read_bytes()).hexdigest() if out.exists() else None
+                first = first or digest
+                stages = (report or {}).get("timings_s") or {}
+                stage_text = ", ".join(f"{k} {v:.1f}" for k, v in
+                                       (stages.items() if isinstance(stages, dict) else stages))
                 print(f"| {command} | {args.scaling} | {threads} | {wall:.1f} | {peak or 0:.0f} | "
-                      f"{per_sample:.0f} | {status if status != 'ok' else result} |", flush=True)
+                      f"{per_sample:.0f} | {status if status != 'ok' else result} | "
+                      f"{'yes' if digest and digest == first else 'NO'} | {stage_text} |",
+                      flush=True)
     return 0
 
 
@@ -117,7 +127,8 @@ def main(argv=None) -> int:
     ap.add_argument("--bpa", action="store_true", help="also ball pivoting (slow)")
     ap.add_argument("--reconstruct-args", default="", help="extra arguments for pointform reconstruct")
     ap.add_argument("--matched-levels", type=int, default=3,
-                    help="levels of the semi-regular mesh that marching cubes is matched against "
+                    help="levels of the semi-regular mesh that marching cubes is also matched "
+                         "against, 0 = none "
                          "(the automatic stop can end at a mesh coarser than any marching cubes "
                          "of the field: its cells would be larger than the influence radii)")
     ap.add_argument("--timeout", type=float, default=1800)
@@ -170,30 +181,47 @@ def main(argv=None) -> int:
                         row.update(mesh_quality(out))
                         row.update(evaluate_isolated(shape, out, truth, samples, diag,
                                                      args.pointform, work))
+                    if report and "cell" in report:
+                        row["cell"] = report["cell"]
                     rows.append(row)
                     print(json.dumps(row), flush=True)
                     return row
 
                 measure("pointform reconstruct",
-                               [args.pointform, "reconstruct", raw, "-o", work / "semi.ply", "--json",
-                                *args.reconstruct_args.split()], work / "semi.ply")
-                measure(f"pointform reconstruct --levels {args.matched_levels}",
-                        [args.pointform, "reconstruct", raw, "-o", work / "semi_j.ply", "--json",
-                         "--levels", str(args.matched_levels), *args.reconstruct_args.split()],
-                        work / "semi_j.ply")
-                # Marching cubes at that semi-regular mesh's vertex count: vertices grow with the
-                # square of the resolution, so one probe run sets the resolution.
-                target = o3d.io.read_triangle_mesh(str(work / "semi_j.ply")).vertices
-                probe = run_measured([args.pointform, "mc", raw, "-o", work / "probe.ply", "--json",
-                                      "--resolution", "128"], env, args.timeout, work / "probe")[3] or {}
-                if len(target) and probe.get("vertices"):
-                    resolution = max(8, round(128 * math.sqrt(len(target) / probe["vertices"])))
-                    measure(f"pointform mc at the same vertex count (resolution {resolution})",
+                        [args.pointform, "reconstruct", raw, "-o", work / "semi.ply", "--json",
+                         *args.reconstruct_args.split()], work / "semi.ply")
+                if args.matched_levels > 0:
+                    measure(f"pointform reconstruct --levels {args.matched_levels}",
+                            [args.pointform, "reconstruct", raw, "-o", work / "semi_j.ply",
+                             "--json", "--levels", str(args.matched_levels),
+                             *args.reconstruct_args.split()], work / "semi_j.ply")
+                default_mc = measure("pointform mc (default cell)",
+                                     [args.pointform, "mc", raw, "-o", work / "mc_default.ply",
+                                      "--json"], work / "mc_default.ply")
+                # Marching cubes at the vertex counts of the default mesh (the paper's Fig. 4
+                # claim at the default) and of the --levels one. Vertices grow with the square of
+                # the resolution: from the default cell's mesh (fine enough to be defined
+                # everywhere) an estimate, then one probe at it corrects it (coarser cells than
+                # the influence radii cut a mesh short).
+                side = float((samples.max(0) - samples.min(0)).max())
+                matched = [("the default's", work / "semi.ply")]
+                if args.matched_levels > 0:
+                    matched.append((f"--levels {args.matched_levels}'s", work / "semi_j.ply"))
+                for label, mesh_path in matched:
+                    target = o3d.io.read_triangle_mesh(str(mesh_path)).vertices
+                    if not (len(target) and default_mc.get("vertices") and default_mc.get("cell")):
+                        continue
+                    resolution = max(8, round(side / default_mc["cell"] *
+                                              math.sqrt(len(target) / default_mc["vertices"])))
+                    probe = run_measured([args.pointform, "mc", raw, "-o", work / "probe.ply",
+                                          "--json", "--resolution", str(resolution)], env,
+                                         args.timeout, work / "probe")[3] or {}
+                    if probe.get("vertices"):
+                        resolution = max(8, round(resolution *
+                                                  math.sqrt(len(target) / probe["vertices"])))
+                    measure(f"pointform mc at {label} vertex count (resolution {resolution})",
                             [args.pointform, "mc", raw, "-o", work / "mc.ply", "--json",
                              "--resolution", str(resolution)], work / "mc.ply")
-                measure("pointform mc (default cell)",
-                        [args.pointform, "mc", raw, "-o", work / "mc_default.ply", "--json"],
-                        work / "mc_default.ply")
                 if args.no_poisson:
                     continue
                 measure("Open3D Poisson 9",

@@ -361,11 +361,11 @@ void check_options(const BaseMeshOptions& options)
     }
 }
 
-/// Loops longer than this are never filled (their patch would be built and faired in time
-/// quadratic in the loop).
-constexpr std::size_t max_filled_loop = 4096;
+/// Loops longer than this are never filled: a patch of rings has about n²/12 vertices for a
+/// loop of n (80k at this bound), built and faired in time quadratic in the loop.
+constexpr std::size_t max_filled_loop = 1000;
 
-/// Rounds of bi-Laplacian fairing of a patch's inner vertices.
+/// Rounds of fairing of a patch's inner vertices (Gauss-Seidel: a patch is a few rings deep).
 constexpr int fairing_rounds = 200;
 
 /// `loop` resampled at `count` points evenly spaced along its closed polyline, the first at
@@ -392,8 +392,9 @@ std::vector<Vec3d> resample_loop(const std::vector<Vec3d>& loop, std::size_t cou
 
 /// Fills the boundary loops of `mesh` that enclose at most `max_share` of their component's
 /// area (BaseMeshOptions::fill_holes) with patches of rings at the loop's edge length, then
-/// fairs the patches' vertices (bi-Laplacian, the rest of the mesh held). Loops that visit a
-/// vertex twice, or longer than max_filled_loop, are left open. `filled` marks the new vertices.
+/// fairs the patches' vertices (a membrane: each the mean of its neighbours, the rest of the
+/// mesh held). Loops that visit a vertex twice, share one with another loop, or are longer than
+/// max_filled_loop, are left open. `filled` marks the new vertices.
 void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vector<char>& filled)
 {
     filled.assign(mesh.n_vertices(), 0);
@@ -442,7 +443,7 @@ void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vecto
             seen[static_cast<std::size_t>(h.idx())] = 1;
             loop.push_back(h);
             h = mesh.next_halfedge_handle(h);
-        } while (h != start && loop.size() <= max_filled_loop);
+        } while (h != start);
         loops.push_back(std::move(loop));
     }
     double patch_area = 0.0;
