@@ -524,20 +524,19 @@ void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vecto
                     inner[j] = mesh.add_vertex(to_om(centre + (1.0 - t) * (ring[j] - centre)));
                     ++added;
                 }
-                // Zip the two rings, the shorter diagonal first (outer runs along the loop's
-                // halfedges, so its faces continue the mesh's orientation).
+                // Zip the two rings (outer runs along the loop's halfedges, so its faces
+                // continue the mesh's orientation), each advanced when it is behind the other
+                // along their common parameter (both start at the loop's first vertex and are
+                // spaced evenly): the strip then closes at outer[0]-inner[0] and never joins a
+                // vertex to the same one twice, which a greedy choice by diagonal length did
+                // when a small inner ring wrapped round at one outer vertex.
                 const std::size_t a = outer.size();
                 const std::size_t b = inner.size();
                 std::size_t i = 0;
                 std::size_t j = 0;
-                while ((i < a || j < b) && ok)
+                while (i < a || j < b)
                 {
-                    const Vec3d ai = to_eigen(mesh.point(outer[i % a]));
-                    const Vec3d ai1 = to_eigen(mesh.point(outer[(i + 1) % a]));
-                    const Vec3d bj = to_eigen(mesh.point(inner[j % b]));
-                    const Vec3d bj1 = to_eigen(mesh.point(inner[(j + 1) % b]));
-                    const bool advance_outer =
-                        j == b || (i < a && (ai1 - bj).squaredNorm() <= (ai - bj1).squaredNorm());
+                    const bool advance_outer = i < a && (j == b || (i + 1) * b <= (j + 1) * a);
                     if (advance_outer)
                     {
                         add_face(outer[i % a], outer[(i + 1) % a], inner[j % b]);
