@@ -400,6 +400,25 @@ void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vecto
     filled.assign(mesh.n_vertices(), 0);
     if (!(max_share > 0.0))
         return;
+    // The loops, each as its boundary halfedges in order.
+    std::vector<std::vector<OmMesh::HalfedgeHandle>> loops;
+    std::vector<char> seen(mesh.n_halfedges(), 0);
+    for (const auto start : mesh.halfedges())
+    {
+        if (!mesh.is_boundary(start) || seen[static_cast<std::size_t>(start.idx())] != 0)
+            continue;
+        std::vector<OmMesh::HalfedgeHandle> loop;
+        auto h = start;
+        do
+        {
+            seen[static_cast<std::size_t>(h.idx())] = 1;
+            loop.push_back(h);
+            h = mesh.next_halfedge_handle(h);
+        } while (h != start);
+        loops.push_back(std::move(loop));
+    }
+    if (loops.empty())
+        return;
     // Components of faces and their areas.
     std::vector<int> component(mesh.n_faces(), -1);
     std::vector<double> component_area;
@@ -428,23 +447,6 @@ void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vecto
                 }
             }
         }
-    }
-    // The loops, each as its boundary halfedges in order.
-    std::vector<std::vector<OmMesh::HalfedgeHandle>> loops;
-    std::vector<char> seen(mesh.n_halfedges(), 0);
-    for (const auto start : mesh.halfedges())
-    {
-        if (!mesh.is_boundary(start) || seen[static_cast<std::size_t>(start.idx())] != 0)
-            continue;
-        std::vector<OmMesh::HalfedgeHandle> loop;
-        auto h = start;
-        do
-        {
-            seen[static_cast<std::size_t>(h.idx())] = 1;
-            loop.push_back(h);
-            h = mesh.next_halfedge_handle(h);
-        } while (h != start);
-        loops.push_back(std::move(loop));
     }
     double patch_area = 0.0;
     for (const auto& loop : loops)
@@ -801,7 +803,8 @@ std::optional<Vec3d> project_vertex(const Field& field, const Vec3d& p, const Ve
 
 /// One round: every interior vertex moved tangentially to the average of its neighbours (when
 /// `relax`), then every vertex projected onto f = 0; a vertex whose relaxed position cannot be
-/// projected tries its old one, and keeps it if that fails too. Moves that fold a face (its
+/// projected tries its old one, and keeps it if that fails too, except a vertex of a filled hole
+/// (`filled`), which keeps its relaxed position on the patch. Moves that fold a face (its
 /// normal turned by 90° or more, or its area gone) are undone.
 void relax_and_project(const OmMesh& mesh, const Field& field, bool relax, VertexState& state,
                        const std::vector<char>& filled)

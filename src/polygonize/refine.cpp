@@ -784,21 +784,31 @@ NextDetail next_detail(const MultiresMesh& mesh, const Field& field)
                               mesh.world(static_cast<std::uint32_t>(edges[e] & 0xffffffffU)));
     std::vector<FieldSample> values(midpoints.size());
     field.evaluate(midpoints, values);
-    // Where both ends lie beyond the field too (a filled hole), the midpoint says nothing.
-    const std::size_t vertex_count = mesh.vertex_count(mesh.finest_level());
-    std::vector<Vec3d> corners(vertex_count);
-    for (std::size_t v = 0; v < vertex_count; ++v)
-        corners[v] = mesh.world(static_cast<std::uint32_t>(v));
-    std::vector<FieldSample> at_corners(vertex_count);
-    field.evaluate(corners, at_corners);
+    // Where both ends lie beyond the field too (a filled hole), the midpoint says nothing: the
+    // ends of the edges whose midpoint is undefined, two per edge.
+    std::vector<std::size_t> undefined;
+    for (std::size_t e = 0; e < values.size(); ++e)
+        if (!values[e].defined)
+            undefined.push_back(e);
+    std::vector<Vec3d> ends(2 * undefined.size());
+    for (std::size_t u = 0; u < undefined.size(); ++u)
+    {
+        const std::uint64_t edge = edges[undefined[u]];
+        ends[2 * u] = mesh.world(static_cast<std::uint32_t>(edge >> 32U));
+        ends[2 * u + 1] = mesh.world(static_cast<std::uint32_t>(edge & 0xffffffffU));
+    }
+    std::vector<FieldSample> at_ends(ends.size());
+    field.evaluate(ends, at_ends);
+    std::vector<char> beyond(values.size(), 0);
+    for (std::size_t u = 0; u < undefined.size(); ++u)
+        beyond[undefined[u]] = !at_ends[2 * u].defined && !at_ends[2 * u + 1].defined ? 1 : 0;
     std::vector<double> detail;
     detail.reserve(values.size());
     std::vector<double> defined;
     defined.reserve(values.size());
     for (std::size_t e = 0; e < values.size(); ++e)
     {
-        if (!values[e].defined && !at_corners[edges[e] >> 32U].defined &&
-            !at_corners[edges[e] & 0xffffffffU].defined)
+        if (beyond[e] != 0)
             continue;
         detail.push_back(values[e].defined ? std::abs(values[e].value)
                                            : std::numeric_limits<double>::infinity());
