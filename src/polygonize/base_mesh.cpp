@@ -18,6 +18,8 @@
 #include "pointform/polygonize/projection.h"
 #include "pointform/spatial/kd_tree.h"
 
+#include <Eigen/SparseCholesky>
+
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <OpenMesh/Tools/Decimater/DecimaterT.hh>
 #include <OpenMesh/Tools/Decimater/ModNormalFlippingT.hh>
@@ -390,10 +392,69 @@ std::vector<Vec3d> resample_loop(const std::vector<Vec3d>& loop, std::size_t cou
     return out;
 }
 
+/// A filled hole: its rim (the loop's vertices), its new vertices [first, end), and the loop's
+/// centre, mean distance from it and unit vector area.
+struct Patch
+{
+    std::vector<OmMesh::VertexHandle> rim;
+    int first = 0;
+    int end = 0;
+    Vec3d centre;
+    double radius = 0.0;
+    Vec3d normal;
+};
+
+/// Fairs a patch to the smoothest surface that continues the mesh around its rim: its inner
+/// vertices minimise Σ ‖L x_i‖² over the patch and rim vertices i, with L the uniform
+/// Laplacian (the mean of the neighbours minus the vertex) and every vertex outside the patch
+/// held, so the patch meets the rim with the slope of the ring outside it (thin-plate
+/// fairing). Returns false, the patch untouched, where the system is singular.
+bool fair_patch_bilaplacian(OmMesh& mesh, const Patch& patch)
+{
+    const int count = patch.end - patch.first;
+    if (count <= 0)
+        return false;
+    std::vector<OmMesh::VertexHandle> rows(patch.rim);
+    for (int v = patch.first; v < patch.end; ++v)
+        rows.push_back(OmMesh::VertexHandle(v));
+    using Sparse = Eigen::SparseMatrix<double>;
+    std::vector<Eigen::Triplet<double>> entries;
+    Eigen::MatrixXd fixed = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), 3);
+    for (std::size_t r = 0; r < rows.size(); ++r)
+    {
+        const auto v = rows[r];
+        const auto degree = static_cast<double>(mesh.valence(v));
+        if (!(degree > 0.0))
+            continue;
+        const auto add = [&](OmMesh::VertexHandle w, double weight) {
+            if (w.idx() >= patch.first && w.idx() < patch.end)
+                entries.emplace_back(static_cast<int>(r), w.idx() - patch.first, weight);
+            else
+                fixed.row(static_cast<Eigen::Index>(r)) +=
+                    weight * to_eigen(mesh.point(w)).transpose();
+        };
+        for (const auto w : mesh.vv_range(v))
+            add(w, 1.0 / degree);
+        add(v, -1.0);
+    }
+    Sparse a(static_cast<Eigen::Index>(rows.size()), count);
+    a.setFromTriplets(entries.begin(), entries.end());
+    const Sparse normal = a.transpose() * a;
+    Eigen::SimplicialLDLT<Sparse> solver(normal);
+    if (solver.info() != Eigen::Success)
+        return false;
+    const Eigen::MatrixXd x = solver.solve(-(a.transpose() * fixed));
+    if (solver.info() != Eigen::Success || !x.allFinite())
+        return false;
+    for (int v = patch.first; v < patch.end; ++v)
+        mesh.set_point(OmMesh::VertexHandle(v), to_om(Vec3d(x.row(v - patch.first).transpose())));
+    return true;
+}
+
 /// Fills the boundary loops of `mesh` that enclose at most `max_share` of their component's
 /// area (BaseMeshOptions::fill_holes) with patches of rings at the loop's edge length, then
-/// fairs the patches' vertices (a membrane: each the mean of its neighbours, the rest of the
-/// mesh held). Loops that visit a vertex twice, share one with another loop, or are longer than
+/// fairs the patches' vertices (a membrane, then thin-plate fairing; the rest of the mesh
+/// held). Loops that visit a vertex twice, share one with another loop, or are longer than
 /// max_filled_loop, are left open. `filled` marks the new vertices.
 void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vector<char>& filled)
 {
@@ -449,6 +510,7 @@ void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vecto
         }
     }
     double patch_area = 0.0;
+    std::vector<Patch> patches;
     for (const auto& loop : loops)
     {
         const std::size_t n = loop.size();
@@ -500,6 +562,7 @@ void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vecto
             1, static_cast<std::size_t>(std::llround(radius / std::max(edge, 1e-300))));
         std::vector<OmMesh::VertexHandle> outer = rim;
         std::size_t added = 0;
+        const auto first_added = static_cast<int>(mesh.n_vertices());
         bool ok = true;
         const auto add_face = [&](OmMesh::VertexHandle a, OmMesh::VertexHandle b,
                                   OmMesh::VertexHandle c) {
@@ -564,6 +627,9 @@ void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vecto
             throw Error("base mesh: filling a hole of " + std::to_string(n) +
                         " rim vertices made a non-manifold patch");
         filled.resize(mesh.n_vertices(), 1);
+        if (added > 0)
+            patches.push_back(Patch{rim, first_added, static_cast<int>(mesh.n_vertices()), centre,
+                                    radius, vector_area.normalized()});
         stats.hole_vertices += added;
         ++stats.holes_filled;
         patch_area += vector_area.norm();
@@ -572,8 +638,8 @@ void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vecto
     if (stats.holes_filled == 0)
         return;
     // Fairing: each inner vertex to the mean of its neighbours (a membrane, Gauss-Seidel), the
-    // rest held. A membrane stays within the rim's hull, where a smoother (bi-Laplacian) patch
-    // would continue the rim's own noise into bulges.
+    // rest held; then each patch to the smoothest surface that continues the mesh around it
+    // (fair_patch_bilaplacian(), which keeps the membrane where its system is singular).
     std::vector<OmMesh::VertexHandle> inner;
     for (const auto v : mesh.vertices())
         if (filled[static_cast<std::size_t>(v.idx())] != 0)
@@ -593,6 +659,8 @@ void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vecto
                 mesh.set_point(v, to_om(sum / count));
         }
     }
+    for (const Patch& patch : patches)
+        fair_patch_bilaplacian(mesh, patch);
 }
 
 /// The mesh in OpenMesh, in world coordinates (where the field is evaluated).

@@ -296,6 +296,108 @@ TEST(PointField, NarrowQuadricsFollowCleanCreases)
                  InvalidInput);
 }
 
+TEST(PointField, EndsSoonAfterARimAndSpansHolesWhereRadiiAreRaised)
+{
+    // A plane sampled on a jittered grid (step 0.02) with a round hole of radius 0.2 at c. The
+    // field reaches a quarter of an automatic radius past the hole's rim (rim_reach), where the
+    // paper's field reaches a whole radius and extrapolates the rim's surfaces into the hole.
+    constexpr double step = 0.02;
+    const Vec3d c(0.6, 0.6, 0.5);
+    PointCloud samples;
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> jitter(-0.3 * step, 0.3 * step);
+    for (int i = 0; i < 60; ++i)
+        for (int j = 0; j < 60; ++j)
+        {
+            const Vec3d p(i * step + jitter(rng), j * step + jitter(rng), 0.5);
+            if ((p - c).norm() >= 0.2)
+                samples.positions.push_back(p.cast<float>());
+        }
+    const PointCloud surfels =
+        compute_surfels(samples, {.radius_scale = default_field_radius_scale}).surfels;
+    const PointField field(surfels);
+    const PointField paper(surfels, {.rim_reach = 1.0});
+    const double r = field.median_radius();
+    ASSERT_GT(r, 2.0 * step);
+    for (int a = 0; a < 36; ++a)
+    {
+        const double angle = a * std::numbers::pi / 18.0;
+        const Vec3d direction(std::cos(angle), std::sin(angle), 0.0);
+        const Vec3d on_rim = c + (0.2 + step) * direction;
+        EXPECT_TRUE(field.evaluate(on_rim).defined) << "angle " << a * 10;
+        EXPECT_LT(std::abs(field.evaluate(on_rim).value), 1e-3);
+        const Vec3d into = c + (0.2 - 0.6 * r) * direction;
+        EXPECT_FALSE(field.evaluate(into).defined) << "angle " << a * 10;
+        EXPECT_TRUE(paper.evaluate(into).defined) << "angle " << a * 10;
+    }
+    EXPECT_FALSE(field.evaluate(c).defined);
+    // Radii raised to span the hole (§4.1) still span it.
+    PointCloud raised = surfels;
+    for (float& radius : raised.radii)
+        radius *= 4.0F;
+    const PointField spanning(std::move(raised));
+    EXPECT_TRUE(spanning.evaluate(c).defined);
+    EXPECT_NEAR(spanning.evaluate(c).value, 0.0, 1e-3);
+    EXPECT_THROW((void)PointField(surfels, {.rim_reach = 0.0}), InvalidInput);
+    EXPECT_THROW((void)PointField(surfels, {.rim_reach = 1.5}), InvalidInput);
+}
+
+TEST(PointField, CreasesAreNotRims)
+{
+    // Outside the convex 90° edges of a machined part's block, diagonally, the field is defined
+    // as far as the paper's is: the other face's samples balance a crease sample's neighbours.
+    const PointCloud part = sample_shape(Shape::Part, {.count = 40000, .seed = 5});
+    const PointCloud surfels =
+        compute_surfels(part, {.radius_scale = default_field_radius_scale}).surfels;
+    const PointField field(surfels);
+    const PointField paper(surfels, {.rim_reach = 1.0});
+    const double d = 0.5 * field.median_radius() / std::sqrt(2.0);
+    std::size_t defined = 0;
+    std::size_t paper_defined = 0;
+    std::size_t total = 0;
+    for (int i = -18; i <= 18; ++i)
+    {
+        const double x = 0.05 * i;
+        for (const Vec3d& p : {Vec3d(x, 0.6 + d, 0.3 + d), Vec3d(x, -0.6 - d, 0.3 + d),
+                               Vec3d(x, 0.6 + d, -0.3 - d), Vec3d(x, -0.6 - d, -0.3 - d)})
+        {
+            defined += field.evaluate(p).defined ? 1U : 0U;
+            paper_defined += paper.evaluate(p).defined ? 1U : 0U;
+            ++total;
+        }
+    }
+    EXPECT_EQ(paper_defined, total);
+    EXPECT_EQ(defined, total);
+}
+
+TEST(PointField, NoisyFitsDoNotTurnTheFieldInsideOut)
+{
+    // Tori of 100k samples with noise σ = 0.2% of the diagonal (about the sampling step), as
+    // bench/peers' noisy torus. A few σ outside the true surface the field must be positive, as
+    // far inside negative. A quadric fitted to 16 noisy neighbours can rise at 60-70° from the
+    // sample's plane; taken as a narrow fit, it put bubbles of inside 0.03 above the tube (3 and
+    // 4 points on the wrong side here before plausible fits were asked for).
+    const PointCloud truth = sample_shape(Shape::Torus, {.count = 30000, .seed = 9});
+    for (const auto& [seed, sigmas] : {std::pair{1U, 4.0}, std::pair{3U, 3.0}})
+    {
+        const PointCloud noisy =
+            sample_shape(Shape::Torus, {.count = 100000, .seed = seed, .noise = 0.002});
+        const PointField field(
+            compute_surfels(noisy, {.radius_scale = default_field_radius_scale}).surfels);
+        const double offset = sigmas * 0.002 * noisy.bounds().diagonal();
+        std::size_t wrong = 0;
+        for (std::size_t i = 0; i < truth.size(); ++i)
+        {
+            const Vec3d p = truth.world(i);
+            const Vec3d axis = Vec3d(p.x(), p.y(), 0.0).normalized();
+            const Vec3d n = (p - axis).normalized();
+            wrong += field.evaluate(p + offset * n).value > 0.0 ? 0U : 1U;
+            wrong += field.evaluate(p - offset * n).value < 0.0 ? 0U : 1U;
+        }
+        EXPECT_EQ(wrong, 0U) << "seed " << seed << ", " << sigmas << " σ off the torus";
+    }
+}
+
 TEST(PointField, NoisyThinPlateIsInsideBetweenItsFacesOnly)
 {
     // The whole pipeline on a plate of side 2 and thickness 0.05 with noise σ = 0.2% of the

@@ -58,6 +58,16 @@ struct PointFieldOptions
     /// clean thin plate 0.0065 → 0.0052, noisy inputs within 2% either way; the shipped bunny
     /// 0.068 → 0.070 (the surface its field spans over the scan's holes bulges more).
     std::size_t quadric_narrow_k = 16;
+    /// Across a rim of the samples (a hole's edge, a partial scan's border: a sample whose
+    /// neighbours, whichever way they face, have their centroid well off it over its tangent
+    /// plane), the field is defined only this fraction of an automatic influence radius beyond
+    /// the sample, so that the surfaces fitted to one side are not extrapolated into the hole,
+    /// where noise makes them flare (bench/peers, noisy inputs with holes: patches and rims off
+    /// the truth by up to 3 times 0.5% of the diagonal). A radius raised above the automatic one
+    /// (a larger radius scale, a region of §4.1) keeps what it adds: it still spans the holes it
+    /// was raised to span. Crease samples are not rims (the other face's neighbours balance
+    /// the centroid). In (0, 1]; 1 = the whole radius, as elsewhere (the paper's field).
+    double rim_reach = 0.25;
     /// Answer deep-inside queries from the far grid (see PointField): constant time, within
     /// 2√3 h of the distance. False: the nearly nearest kd-tree search, as outside (within 1%),
     /// slower deep inside a closed scan; for callers that take inside values as distances
