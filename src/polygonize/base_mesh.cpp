@@ -392,31 +392,33 @@ std::vector<Vec3d> resample_loop(const std::vector<Vec3d>& loop, std::size_t cou
     return out;
 }
 
-/// A filled hole: its rim (the loop's vertices), its new vertices [first, end), and the loop's
-/// centre, mean distance from it and unit vector area.
+/// A filled hole: its new vertices [first, end).
 struct Patch
 {
-    std::vector<OmMesh::VertexHandle> rim;
     int first = 0;
     int end = 0;
-    Vec3d centre;
-    double radius = 0.0;
-    Vec3d normal;
 };
 
-/// Fairs a patch to the smoothest surface that continues the mesh around its rim: its inner
-/// vertices minimise Σ ‖L x_i‖² over the patch and rim vertices i, with L the uniform
-/// Laplacian (the mean of the neighbours minus the vertex) and every vertex outside the patch
-/// held, so the patch meets the rim with the slope of the ring outside it (thin-plate
-/// fairing). Returns false, the patch untouched, where the system is singular.
-bool fair_patch_bilaplacian(OmMesh& mesh, const Patch& patch)
+/// Fairs `free` vertices (those of a filled hole) to the smoothest surface that continues the
+/// mesh around them: they minimise Σ ‖L x_i‖² over themselves and their neighbours i, with L the
+/// uniform Laplacian (the mean of the neighbours minus the vertex) and every other vertex held,
+/// so the patch meets its rim with the slope of the ring outside it (thin-plate fairing).
+/// Returns false, the vertices untouched, where the system is singular.
+bool fair_bilaplacian(OmMesh& mesh, const std::vector<OmMesh::VertexHandle>& free)
 {
-    const int count = patch.end - patch.first;
-    if (count <= 0)
+    if (free.empty())
         return false;
-    std::vector<OmMesh::VertexHandle> rows(patch.rim);
-    for (int v = patch.first; v < patch.end; ++v)
-        rows.push_back(OmMesh::VertexHandle(v));
+    std::map<int, int> column;
+    for (const auto v : free)
+        column.emplace(v.idx(), static_cast<int>(column.size()));
+    std::vector<OmMesh::VertexHandle> rows(free);
+    std::map<int, char> in_rows;
+    for (const auto v : free)
+        in_rows.emplace(v.idx(), 1);
+    for (const auto v : free)
+        for (const auto w : mesh.vv_range(v))
+            if (in_rows.emplace(w.idx(), 1).second)
+                rows.push_back(w);
     using Sparse = Eigen::SparseMatrix<double>;
     std::vector<Eigen::Triplet<double>> entries;
     Eigen::MatrixXd fixed = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), 3);
@@ -427,8 +429,8 @@ bool fair_patch_bilaplacian(OmMesh& mesh, const Patch& patch)
         if (!(degree > 0.0))
             continue;
         const auto add = [&](OmMesh::VertexHandle w, double weight) {
-            if (w.idx() >= patch.first && w.idx() < patch.end)
-                entries.emplace_back(static_cast<int>(r), w.idx() - patch.first, weight);
+            if (const auto it = column.find(w.idx()); it != column.end())
+                entries.emplace_back(static_cast<int>(r), it->second, weight);
             else
                 fixed.row(static_cast<Eigen::Index>(r)) +=
                     weight * to_eigen(mesh.point(w)).transpose();
@@ -437,7 +439,7 @@ bool fair_patch_bilaplacian(OmMesh& mesh, const Patch& patch)
             add(w, 1.0 / degree);
         add(v, -1.0);
     }
-    Sparse a(static_cast<Eigen::Index>(rows.size()), count);
+    Sparse a(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(free.size()));
     a.setFromTriplets(entries.begin(), entries.end());
     const Sparse normal = a.transpose() * a;
     Eigen::SimplicialLDLT<Sparse> solver(normal);
@@ -446,8 +448,8 @@ bool fair_patch_bilaplacian(OmMesh& mesh, const Patch& patch)
     const Eigen::MatrixXd x = solver.solve(-(a.transpose() * fixed));
     if (solver.info() != Eigen::Success || !x.allFinite())
         return false;
-    for (int v = patch.first; v < patch.end; ++v)
-        mesh.set_point(OmMesh::VertexHandle(v), to_om(Vec3d(x.row(v - patch.first).transpose())));
+    for (std::size_t i = 0; i < free.size(); ++i)
+        mesh.set_point(free[i], to_om(Vec3d(x.row(static_cast<Eigen::Index>(i)).transpose())));
     return true;
 }
 
@@ -456,11 +458,12 @@ bool fair_patch_bilaplacian(OmMesh& mesh, const Patch& patch)
 /// fairs the patches' vertices (a membrane, then thin-plate fairing; the rest of the mesh
 /// held). Loops that visit a vertex twice, share one with another loop, or are longer than
 /// max_filled_loop, are left open. `filled` marks the new vertices.
-void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vector<char>& filled)
+std::vector<Patch> fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats,
+                              std::vector<char>& filled)
 {
     filled.assign(mesh.n_vertices(), 0);
     if (!(max_share > 0.0))
-        return;
+        return {};
     // The loops, each as its boundary halfedges in order.
     std::vector<std::vector<OmMesh::HalfedgeHandle>> loops;
     std::vector<char> seen(mesh.n_halfedges(), 0);
@@ -479,7 +482,7 @@ void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vecto
         loops.push_back(std::move(loop));
     }
     if (loops.empty())
-        return;
+        return {};
     // Components of faces and their areas.
     std::vector<int> component(mesh.n_faces(), -1);
     std::vector<double> component_area;
@@ -628,18 +631,17 @@ void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vecto
                         " rim vertices made a non-manifold patch");
         filled.resize(mesh.n_vertices(), 1);
         if (added > 0)
-            patches.push_back(Patch{rim, first_added, static_cast<int>(mesh.n_vertices()), centre,
-                                    radius, vector_area.normalized()});
+            patches.push_back(Patch{first_added, static_cast<int>(mesh.n_vertices())});
         stats.hole_vertices += added;
         ++stats.holes_filled;
         patch_area += vector_area.norm();
     }
     stats.hole_area_share = total_area > 0.0 ? patch_area / total_area : 0.0;
     if (stats.holes_filled == 0)
-        return;
+        return {};
     // Fairing: each inner vertex to the mean of its neighbours (a membrane, Gauss-Seidel), the
     // rest held; then each patch to the smoothest surface that continues the mesh around it
-    // (fair_patch_bilaplacian(), which keeps the membrane where its system is singular).
+    // (fair_bilaplacian(), which keeps the membrane where its system is singular).
     std::vector<OmMesh::VertexHandle> inner;
     for (const auto v : mesh.vertices())
         if (filled[static_cast<std::size_t>(v.idx())] != 0)
@@ -660,7 +662,13 @@ void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vecto
         }
     }
     for (const Patch& patch : patches)
-        fair_patch_bilaplacian(mesh, patch);
+    {
+        std::vector<OmMesh::VertexHandle> free;
+        for (int v = patch.first; v < patch.end; ++v)
+            free.push_back(OmMesh::VertexHandle(v));
+        (void)fair_bilaplacian(mesh, free);
+    }
+    return patches;
 }
 
 /// The mesh in OpenMesh, in world coordinates (where the field is evaluated).
@@ -1128,7 +1136,7 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
     }
     mesh.garbage_collection();
     std::vector<char> filled;
-    fill_holes(mesh, options.fill_holes, stats, filled);
+    const std::vector<Patch> patches = fill_holes(mesh, options.fill_holes, stats, filled);
 
     // 2. Shape: rounds of flips and tangential relaxation, each followed by the projection of
     // every vertex onto f = 0 (or the projection alone).
@@ -1190,6 +1198,39 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
                 }
             }
             reporter.update(round + 1, std::max(options.max_smoothing_rounds, 1));
+        }
+        // The vertices of a patch left off the surface (beyond the field), and those of the
+        // decimated mesh that are off it next to them (the coarse marching cubes put them
+        // between defined and undefined corners at the hole's rim), were moved only tangentially
+        // in the rounds, and a tangential move on a curved patch steps inside it: they sagged
+        // 0.01-0.05 inside a ball of radius 0.5 over a hole of the noisy blobby of bench/peers.
+        // They are faired (thin plate) against the rest as it ended. Unprojected vertices away
+        // from the patches keep their positions (the marching cubes' of the field).
+        if (options.project && !patches.empty())
+        {
+            std::vector<OmMesh::VertexHandle> free;
+            std::vector<char> taken(mesh.n_vertices(), 0);
+            const auto off = [&](OmMesh::VertexHandle v) {
+                const auto i = static_cast<std::size_t>(v.idx());
+                return state.on_surface[i] == 0 && taken[i] == 0 && !mesh.is_boundary(v);
+            };
+            for (const Patch& patch : patches)
+                for (int v = patch.first; v < patch.end; ++v)
+                    if (off(OmMesh::VertexHandle(v)))
+                    {
+                        taken[static_cast<std::size_t>(v)] = 1;
+                        free.push_back(OmMesh::VertexHandle(v));
+                    }
+            for (std::size_t q = 0; q < free.size(); ++q)
+                for (const auto w : mesh.vv_range(free[q]))
+                    if (off(w))
+                    {
+                        taken[static_cast<std::size_t>(w.idx())] = 1;
+                        free.push_back(w);
+                    }
+            if (fair_bilaplacian(mesh, free))
+                for (const auto v : free)
+                    state.position[static_cast<std::size_t>(v.idx())] = to_eigen(mesh.point(v));
         }
         reporter.finish();
     }
