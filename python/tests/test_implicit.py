@@ -39,6 +39,28 @@ def test_every_fit_and_defined(sphere_surfels):
         pointform.Field(sphere_surfels, fit="cubic")
 
 
+def test_field_ends_past_a_rim_as_asked():
+    # A plane sampled on a jittered grid with a round hole of radius 0.2: the default field
+    # ends a quarter of a radius past the rim; rim_reach=1 reaches a whole radius into the hole.
+    g = np.arange(60) * 0.02
+    x, y = np.meshgrid(g, g)
+    jitter = np.random.default_rng(11).uniform(-0.006, 0.006, (x.size, 2))
+    points = np.stack([x.ravel() + jitter[:, 0], y.ravel() + jitter[:, 1], np.full(x.size, 0.5)],
+                      axis=1)
+    centre = np.array([0.6, 0.6, 0.5])
+    points = points[np.linalg.norm(points - centre, axis=1) >= 0.2]
+    surfels, _ = pointform.surfels(pointform.PointCloud(points))
+    field = pointform.Field(surfels)
+    paper = pointform.Field(surfels, rim_reach=1.0)
+    r = field.median_radius
+    angles = np.linspace(0.0, 2.0 * np.pi, 24, endpoint=False)
+    into = centre + (0.2 - 0.6 * r) * np.stack([np.cos(angles), np.sin(angles), 0 * angles], 1)
+    assert not field.evaluate(into, defined=True)[2].any()
+    assert paper.evaluate(into, defined=True)[2].all()
+    with pytest.raises(pointform.InvalidInput, match="rim_reach"):
+        pointform.Field(surfels, rim_reach=0.0)
+
+
 def test_query_dtypes_and_orders_give_the_same_values(sphere_surfels):
     field = pointform.Field(sphere_surfels)
     points, _ = radial_queries([0.97, 1.02], n=50)
