@@ -82,7 +82,8 @@ struct PointFieldOptions
 /// the paper's f = ∞: `defined` is false, the value is ±‖p − s_k‖ with the sign of the nearest
 /// sample's surface, so inside and outside stay told apart (see FieldSample). Blend and Quadric
 /// widen "defined" to the union of the influence balls of the blended samples: with irregular
-/// sampling the nearest sample's ball alone leaves pinholes between clusters.
+/// sampling the nearest sample's ball alone leaves pinholes between clusters. Across a rim of
+/// the samples each ball is cut short (PointFieldOptions::rim_reach).
 ///
 /// Farther from every sample than the largest influence radius, s_k may be a sample a little
 /// farther than the nearest, at distance D: there every sample is about as far as the nearest
