@@ -29,6 +29,7 @@ struct McCommandOptions
     int resolution = 0;
     double cell = 0.0;
     PlaneFit fit = PlaneFit::Quadric;
+    double rim_reach = PointFieldOptions{}.rim_reach;
     SurfelsFromSamplesOptions surfels;
     bool ascii = false;
     bool json = false;
@@ -42,7 +43,7 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
     SurfelsFromSamples input = load_surfels(options.input, options.surfels, progress.callback());
     timings.lap(input.estimated_normals ? "read + surfels" : "read");
 
-    const PointField field(input.surfels, {.fit = options.fit});
+    const PointField field(input.surfels, {.fit = options.fit, .rim_reach = options.rim_reach});
     timings.lap("field");
     const Aabb box = field.bounds();
     const double cell =
@@ -77,6 +78,7 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
         out["samples"] = input.surfels.size();
         out["estimated_normals"] = input.estimated_normals;
         out["fit"] = std::string(to_string(options.fit));
+        out["rim_reach"] = options.rim_reach;
         out["cell"] = cell;
         out["vertices"] = result.mesh.vertex_count();
         out["faces"] = result.mesh.face_count();
@@ -147,6 +149,7 @@ void register_mc(CLI::App& app, const GlobalOptions& global)
                    "Local surfaces of the field: quadric (smooth blend of nearby local quadric "
                    "fits, the most accurate on exact and on noisy samples), blend (of centroid "
                    "planes), centroid (Hoppe's plane) or raw (the paper's plane)");
+    add_rim_reach_option(*cmd, options->rim_reach);
     add_surfel_input_options(*cmd, options->surfels);
     cmd->add_flag("--ascii", options->ascii, "Write ascii PLY instead of binary");
     cmd->add_flag("--json", options->json, "Print the report as JSON");

@@ -132,6 +132,7 @@ void register_reconstruct(CLI::App& app, const GlobalOptions& global)
                     "fraction of their component's area (0 keeps every hole)")
         ->check(CLI::Range(0.0, 0.999999))
         ->capture_default_str();
+    add_rim_reach_option(*cmd, options->reconstruct.rim_reach);
     add_refine_options(*cmd, options->refine);
     auto* resolution = cmd->add_option("--resolution", options->reconstruct.resolution,
                                        "Marching cubes: cells along the longest side of the "

@@ -136,6 +136,17 @@ CLI::Option* add_fit_option(CLI::App& cmd, PlaneFit& fit, const std::string& hel
                            help);
 }
 
+CLI::Option* add_rim_reach_option(CLI::App& cmd, double& rim_reach)
+{
+    return cmd
+        .add_option("--rim-reach", rim_reach,
+                    "How far past a rim of the samples (a hole's edge, a scan's border) the "
+                    "field reaches, as a fraction of an influence radius; 1 = a whole radius "
+                    "(the paper's field, which extrapolates the rim's surfaces into the hole)")
+        ->check(CLI::Range(1e-6, 1.0))
+        ->capture_default_str();
+}
+
 CLI::Option* add_rule_option(CLI::App& cmd, OrientationRule& rule, const std::string& help)
 {
     return add_enum_option(

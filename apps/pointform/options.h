@@ -33,6 +33,8 @@ CLI::Option* add_radius_regions_option(CLI::App& cmd, std::vector<RadiusRegion>&
 
 /// --fit quadric|blend|centroid|raw.
 CLI::Option* add_fit_option(CLI::App& cmd, PlaneFit& fit, const std::string& help);
+/// `--rim-reach F` (PointFieldOptions::rim_reach), in (0, 1].
+CLI::Option* add_rim_reach_option(CLI::App& cmd, double& rim_reach);
 
 /// --rule hoppe|reflection.
 CLI::Option* add_rule_option(CLI::App& cmd, OrientationRule& rule, const std::string& help);

@@ -175,16 +175,19 @@ def test_reconstruct_fills_holes_as_the_cli_does(tmp_path):
     points = tmp_path / "holes.ply"
     run_cli("sample", "sphere", "-n", 20000, "--holes", 4, "--hole-radius", 0.04, "-o", points)
     cloud = pointform.read_points(points)
-    for fill in (None, 0.0):
-        kwargs = {} if fill is None else {"fill_holes": fill}
+    for fill, reach in ((None, None), (0.0, None), (None, 1.0)):
+        kwargs = ({} if fill is None else {"fill_holes": fill}) | (
+            {} if reach is None else {"rim_reach": reach})
         hierarchy = pointform.reconstruct(cloud, **kwargs)
         loops = hierarchy.report["base_mesh"]["boundary_loops"]
         assert loops == (0 if fill is None else 4)
         assert hierarchy.report["base_mesh"]["holes_filled"] == (4 if fill is None else 0)
-        out = tmp_path / f"cli{fill}.pfh"
+        assert hierarchy.report["rim_reach"] == (0.25 if reach is None else reach)
+        out = tmp_path / f"cli{fill}{reach}.pfh"
         run_cli("reconstruct", points, "-o", tmp_path / "cli.ply", "--save-hierarchy", out, "-q",
-                *([] if fill is None else ["--fill-holes", fill]))
-        mine = tmp_path / f"py{fill}.pfh"
+                *([] if fill is None else ["--fill-holes", fill]),
+                *([] if reach is None else ["--rim-reach", reach]))
+        mine = tmp_path / f"py{fill}{reach}.pfh"
         hierarchy.save(mine)
         assert mine.read_bytes() == out.read_bytes()
 
@@ -202,6 +205,8 @@ def test_bad_reconstruct_input(sphere_cloud, tmp_path):
         pointform.reconstruct(sphere_cloud, resolution=1)
     with pytest.raises(ValueError, match="hole"):
         pointform.reconstruct(sphere_cloud, fill_holes=1.0)
+    with pytest.raises(ValueError, match="rim_reach"):
+        pointform.reconstruct(sphere_cloud, rim_reach=0.0)
     with pytest.raises(ValueError):
         pointform.reconstruct(pointform.PointCloud(sphere_points(5)))
     not_pfh = tmp_path / "x.pfh"

@@ -226,6 +226,7 @@ nlohmann::json report_json(const ReconstructReport& report, const ReconstructOpt
 {
     nlohmann::json out = report_json(report.semi_regular, options.semi_regular);
     out["fit"] = std::string(to_string(options.fit));
+    out["rim_reach"] = options.rim_reach;
     if (report.semi_regular.base)
     {
         out["cell"] = report.cell;

@@ -85,6 +85,15 @@ TEST(McCli, HolesInTheSamplesStayOpen)
     EXPECT_GE(report["boundary_loops"].get<int>(), 1);
     EXPECT_LE(report["boundary_loops"].get<int>(), 3);
     EXPECT_EQ(report["euler_characteristic"].get<int>(), 2 - report["boundary_loops"].get<int>());
+    EXPECT_EQ(report["rim_reach"].get<double>(), 0.25);
+    // The paper's field (a whole radius past the rims) reaches farther into the holes: more
+    // surface, over the same samples.
+    const auto paper = run("mc " + quoted(dir / "holey.ply") + " -o " + quoted(dir / "paper.ply") +
+                           " --reestimate --rim-reach 1 --json");
+    ASSERT_EQ(paper.exit_code, 0) << paper.out;
+    const auto paper_report = nlohmann::json::parse(paper.out);
+    EXPECT_EQ(paper_report["rim_reach"].get<double>(), 1.0);
+    EXPECT_GT(paper_report["faces"].get<double>(), report["faces"].get<double>());
 }
 
 TEST(McCli, BadOptionsAndInputsFailCleanly)
@@ -102,6 +111,8 @@ TEST(McCli, BadOptionsAndInputsFailCleanly)
         {"mc " + bunny + " -o " + quoted(output) + " --cell -1", "--cell"},
         {"mc " + bunny + " -o " + quoted(output) + " --cell 0.01 --resolution 10", "excludes"},
         {"mc " + bunny + " -o " + quoted(output) + " --fit smooth", "--fit"},
+        {"mc " + bunny + " -o " + quoted(output) + " --rim-reach 0", "--rim-reach"},
+        {"mc " + bunny + " -o " + quoted(output) + " --rim-reach 1.5", "--rim-reach"},
         {"mc " + bunny + " -o " + quoted(output) + " --cell 1e-9", "cells along an axis"},
     };
     // Surfels whose normals are all zero.

@@ -146,6 +146,9 @@ struct ReconstructOptions
 {
     /// The local surfaces of the field.
     PlaneFit fit = PointFieldOptions{}.fit;
+    /// How far past a rim of the samples the field reaches (PointFieldOptions::rim_reach), in
+    /// (0, 1]; 1 = a whole influence radius, the paper's field.
+    double rim_reach = PointFieldOptions{}.rim_reach;
     /// Marching cubes: cells along the longest side of the samples' bounding box (≥ 2), or
     /// else the cell size (> 0), or else (both 0) intermediate_grid() of default_cell_size():
     /// the field's cell, coarsened where that would make more faces than the base mesh needs.
