@@ -408,17 +408,21 @@ bool fair_bilaplacian(OmMesh& mesh, const std::vector<OmMesh::VertexHandle>& fre
 {
     if (free.empty())
         return false;
-    std::map<int, int> column;
-    for (const auto v : free)
-        column.emplace(v.idx(), static_cast<int>(column.size()));
+    // Per vertex: its column (a free vertex) or -1, and whether it has a row yet.
+    std::vector<int> column(mesh.n_vertices(), -1);
+    for (std::size_t i = 0; i < free.size(); ++i)
+        column[static_cast<std::size_t>(free[i].idx())] = static_cast<int>(i);
     std::vector<OmMesh::VertexHandle> rows(free);
-    std::map<int, char> in_rows;
+    std::vector<char> in_rows(mesh.n_vertices(), 0);
     for (const auto v : free)
-        in_rows.emplace(v.idx(), 1);
+        in_rows[static_cast<std::size_t>(v.idx())] = 1;
     for (const auto v : free)
         for (const auto w : mesh.vv_range(v))
-            if (in_rows.emplace(w.idx(), 1).second)
+            if (in_rows[static_cast<std::size_t>(w.idx())] == 0)
+            {
+                in_rows[static_cast<std::size_t>(w.idx())] = 1;
                 rows.push_back(w);
+            }
     using Sparse = Eigen::SparseMatrix<double>;
     std::vector<Eigen::Triplet<double>> entries;
     Eigen::MatrixXd fixed = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), 3);
@@ -429,8 +433,8 @@ bool fair_bilaplacian(OmMesh& mesh, const std::vector<OmMesh::VertexHandle>& fre
         if (!(degree > 0.0))
             continue;
         const auto add = [&](OmMesh::VertexHandle w, double weight) {
-            if (const auto it = column.find(w.idx()); it != column.end())
-                entries.emplace_back(static_cast<int>(r), it->second, weight);
+            if (const int c = column[static_cast<std::size_t>(w.idx())]; c >= 0)
+                entries.emplace_back(static_cast<int>(r), c, weight);
             else
                 fixed.row(static_cast<Eigen::Index>(r)) +=
                     weight * to_eigen(mesh.point(w)).transpose();
@@ -458,12 +462,11 @@ bool fair_bilaplacian(OmMesh& mesh, const std::vector<OmMesh::VertexHandle>& fre
 /// fairs the patches' vertices (a membrane, then thin-plate fairing; the rest of the mesh
 /// held). Loops that visit a vertex twice, share one with another loop, or are longer than
 /// max_filled_loop, are left open. `filled` marks the new vertices.
-std::vector<Patch> fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats,
-                              std::vector<char>& filled)
+void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vector<char>& filled)
 {
     filled.assign(mesh.n_vertices(), 0);
     if (!(max_share > 0.0))
-        return {};
+        return;
     // The loops, each as its boundary halfedges in order.
     std::vector<std::vector<OmMesh::HalfedgeHandle>> loops;
     std::vector<char> seen(mesh.n_halfedges(), 0);
@@ -482,7 +485,7 @@ std::vector<Patch> fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& sta
         loops.push_back(std::move(loop));
     }
     if (loops.empty())
-        return {};
+        return;
     // Components of faces and their areas.
     std::vector<int> component(mesh.n_faces(), -1);
     std::vector<double> component_area;
@@ -638,17 +641,22 @@ std::vector<Patch> fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& sta
     }
     stats.hole_area_share = total_area > 0.0 ? patch_area / total_area : 0.0;
     if (stats.holes_filled == 0)
-        return {};
-    // Fairing: each inner vertex to the mean of its neighbours (a membrane, Gauss-Seidel), the
-    // rest held; then each patch to the smoothest surface that continues the mesh around it
-    // (fair_bilaplacian(), which keeps the membrane where its system is singular).
-    std::vector<OmMesh::VertexHandle> inner;
-    for (const auto v : mesh.vertices())
-        if (filled[static_cast<std::size_t>(v.idx())] != 0)
-            inner.push_back(v);
-    for (int round = 0; round < fairing_rounds; ++round)
+        return;
+    // Fairing: each patch to the smoothest surface that continues the mesh around it
+    // (fair_bilaplacian()); where its system is singular, each inner vertex to the mean of its
+    // neighbours instead (a membrane, Gauss-Seidel), the rest held.
+    std::vector<OmMesh::VertexHandle> membrane;
+    for (const Patch& patch : patches)
     {
-        for (const auto v : inner)
+        std::vector<OmMesh::VertexHandle> free;
+        for (int v = patch.first; v < patch.end; ++v)
+            free.push_back(OmMesh::VertexHandle(v));
+        if (!fair_bilaplacian(mesh, free))
+            membrane.insert(membrane.end(), free.begin(), free.end());
+    }
+    for (int round = 0; round < fairing_rounds && !membrane.empty(); ++round)
+    {
+        for (const auto v : membrane)
         {
             Vec3d sum = Vec3d::Zero();
             int count = 0;
@@ -661,14 +669,6 @@ std::vector<Patch> fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& sta
                 mesh.set_point(v, to_om(sum / count));
         }
     }
-    for (const Patch& patch : patches)
-    {
-        std::vector<OmMesh::VertexHandle> free;
-        for (int v = patch.first; v < patch.end; ++v)
-            free.push_back(OmMesh::VertexHandle(v));
-        (void)fair_bilaplacian(mesh, free);
-    }
-    return patches;
 }
 
 /// The mesh in OpenMesh, in world coordinates (where the field is evaluated).
@@ -1136,7 +1136,7 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
     }
     mesh.garbage_collection();
     std::vector<char> filled;
-    const std::vector<Patch> patches = fill_holes(mesh, options.fill_holes, stats, filled);
+    fill_holes(mesh, options.fill_holes, stats, filled);
 
     // 2. Shape: rounds of flips and tangential relaxation, each followed by the projection of
     // every vertex onto f = 0 (or the projection alone).
@@ -1206,7 +1206,7 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
         // 0.01-0.05 inside a ball of radius 0.5 over a hole of the noisy blobby of bench/peers.
         // They are faired (thin plate) against the rest as it ended. Unprojected vertices away
         // from the patches keep their positions (the marching cubes' of the field).
-        if (options.project && !patches.empty())
+        if (options.project && stats.holes_filled > 0)
         {
             std::vector<OmMesh::VertexHandle> free;
             std::vector<char> taken(mesh.n_vertices(), 0);
@@ -1214,13 +1214,12 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
                 const auto i = static_cast<std::size_t>(v.idx());
                 return state.on_surface[i] == 0 && taken[i] == 0 && !mesh.is_boundary(v);
             };
-            for (const Patch& patch : patches)
-                for (int v = patch.first; v < patch.end; ++v)
-                    if (off(OmMesh::VertexHandle(v)))
-                    {
-                        taken[static_cast<std::size_t>(v)] = 1;
-                        free.push_back(OmMesh::VertexHandle(v));
-                    }
+            for (const auto v : mesh.vertices())
+                if (filled[static_cast<std::size_t>(v.idx())] != 0 && off(v))
+                {
+                    taken[static_cast<std::size_t>(v.idx())] = 1;
+                    free.push_back(v);
+                }
             for (std::size_t q = 0; q < free.size(); ++q)
                 for (const auto w : mesh.vv_range(free[q]))
                     if (off(w))
