@@ -146,15 +146,15 @@ Vec3f tangent_of(const Vec3f& n)
 /// confidence intervals rule of adaptive-scale regression, Goldenshluger and Nemirovski).
 constexpr double narrow_fit_gamma = 2.0;
 
-/// The steepest a narrow quadric may rise over the sample's plane (plausible_narrow_fit()), as a
-/// slope: 1.5 (56°). Measured on the 100k inputs of bench/peers, Chamfer in % of the diagonal
+/// The steepest a quadric may rise over the sample's plane (plausible_fit()), as a slope: 1.5
+/// (56°). Measured on the 100k inputs of bench/peers, Chamfer in % of the diagonal
 /// with 1 / 1.5 / 2 / no bound: clean blobby 0.0069 / 0.0067 / 0.0066 / 0.0066, clean part
 /// 0.0112 / 0.0107 / 0.0105 / 0.0103; F@0.5% of the noisy torus 0.9996 / 0.9996 / 0.9993 / 0.9964.
-constexpr double narrow_max_slope = 1.5;
+constexpr double max_fit_slope = 1.5;
 
-/// Whether a narrow quadric (coefficients in the wide fit's scaled coordinates; `reach` its
-/// farthest neighbour's scaled distance) is a surface at all: its slope at the sample, and its
-/// rise over its own neighbourhood (the slope's and the curvature's), at most narrow_max_slope.
+/// Whether a quadric (coefficients in the wide fit's scaled coordinates; `reach` its farthest
+/// neighbour's scaled distance) is a surface at all: its slope at the sample, and its rise over
+/// its own neighbourhood (the slope's and the curvature's), at most max_fit_slope.
 /// Sixteen noisy samples can fit a quadric that rises at 60-70° (noise of the sampling step on
 /// a torus: slopes of 1.8-3.2, curvatures 65 times the tube's), and its heights a few steps away
 /// put a sheet of the field inside out: a bubble of surface 0.03 off the torus. A crease's
@@ -164,8 +164,8 @@ bool plausible_fit(const Eigen::Matrix<double, 6, 1>& coef, double reach)
     const double slope = std::hypot(coef[1], coef[2]);
     const double curvature =
         std::max({std::abs(coef[3]), std::abs(coef[5]), 0.5 * std::abs(coef[4])});
-    return slope <= narrow_max_slope &&
-           slope * reach + curvature * reach * reach <= narrow_max_slope * reach;
+    return slope <= max_fit_slope &&
+           slope * reach + curvature * reach * reach <= max_fit_slope * reach;
 }
 
 /// The local surface of sample i (see PackedSurfel) from its neighbours (the sample first,
@@ -751,8 +751,11 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
             packed.radius = m.surfels.radii[i];
             packed.normal = m.surfels.normals[i];
             packed.tangent = tangent_of(packed.normal);
+            // Where the neighbours lie (a rim?): for the quadric's fit and the blend's rim limit.
             const NeighbourhoodOffset offset =
-                neighbourhood_offset(fit_positions, neighbors, samples[q], packed);
+                blends(options.fit)
+                    ? neighbourhood_offset(fit_positions, neighbors, samples[q], packed)
+                    : NeighbourhoodOffset{};
             fit_local_surface(fit_positions, fit_normals, neighbors, samples[q], options.fit,
                               options.quadric_narrow_k, offset.centroid.norm() >= rim_full, packed);
             m.packed[m.grid->slot_of(i)] = packed;
