@@ -7,11 +7,11 @@
 #include "pointform/core/parallel.h"
 #include "pointform/multires/level_of_detail.h"
 #include "pointform/spatial/kd_tree.h"
+#include "pointform/spatial/triangle_bvh.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -64,10 +64,9 @@ void for_each_chart_texel(const Atlas& atlas, Texel texel)
         for (std::size_t f = begin; f < end; ++f)
         {
             const auto& c = atlas.corners[f];
-            const std::array<Vec2d, 3> v{c[0] * size, c[1] * size, c[2] * size};
-            const Vec2d& a = v[0];
-            const Vec2d& b = v[1];
-            const Vec2d& d = v[2];
+            const Vec2d a = c[0] * size;
+            const Vec2d b = c[1] * size;
+            const Vec2d d = c[2] * size;
             const double area = (b - a).x() * (d - a).y() - (b - a).y() * (d - a).x();
             if (area == 0.0)
                 continue;
@@ -94,27 +93,16 @@ void for_each_chart_texel(const Atlas& atlas, Texel texel)
                         texel(x, y, static_cast<std::uint32_t>(f), w);
                         continue;
                     }
-                    // The nearest point of the triangle: on one of its edges.
-                    double best = std::numeric_limits<double>::infinity();
-                    Vec2d nearest = p;
-                    for (std::size_t k = 0; k < 3; ++k)
-                    {
-                        const Vec2d& e0 = v[k];
-                        const Vec2d e = v[(k + 1) % 3] - e0;
-                        const double t = std::clamp(
-                            (p - e0).dot(e) / std::max(e.squaredNorm(), 1e-300), 0.0, 1.0);
-                        const Vec2d q = e0 + t * e;
-                        const double dist = (p - q).norm();
-                        if (dist < best)
-                        {
-                            best = dist;
-                            nearest = q;
-                        }
-                    }
+                    // The nearest point of the triangle (in the plane z = 0).
+                    const auto lift = [](const Vec2d& q) {
+                        return Vec3d(q.x(), q.y(), 0.0);
+                    };
+                    const Vec3d w_near =
+                        closest_point_barycentric(lift(p), lift(a), lift(b), lift(d));
+                    const double best =
+                        (p - (w_near.x() * a + w_near.y() * b + w_near.z() * d)).norm();
                     if (best > reach)
                         continue;
-                    Vec3d w_near = weights(nearest).cwiseMax(0.0);
-                    w_near /= w_near.sum();
                     found.push_back(
                         {static_cast<std::size_t>(y) * static_cast<std::size_t>(atlas.size) +
                              static_cast<std::size_t>(x),
