@@ -254,7 +254,7 @@ void bind_polygonize(py::module_& m)
            const std::string& relaxation, double fill_holes, double rim_reach) {
             ReconstructOptions options;
             options.fill_holes = fill_holes; // checked by the base mesh
-            options.rim_reach = rim_reach;   // checked by reconstruct()
+            options.rim_reach = rim_reach;   // checked by the point field
             options.semi_regular = semi_regular_options(levels, base_faces, stop_rule, predictor,
                                                         relax_iterations, relaxation);
             options.fit = parse_plane_fit(fit);

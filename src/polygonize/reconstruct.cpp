@@ -228,8 +228,6 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
         throw InvalidInput("give a base-mesh file or picked vertices, not both");
     if (!(options.fill_holes >= 0.0 && options.fill_holes < 1.0))
         throw InvalidInput("the largest hole to fill must be in [0, 1) of its component's area");
-    if (!(options.rim_reach > 0.0 && options.rim_reach <= 1.0))
-        throw InvalidInput("rim_reach must be in (0, 1]");
     ReconstructReport report;
     StageClock clock(report.stage_seconds);
     const Aabb bounds = surfels.bounds();
