@@ -141,10 +141,23 @@ void parallel_blocks(std::size_t n, std::size_t block,
     }
     else
     {
-        const auto count = static_cast<std::ptrdiff_t>(blocks);
-#pragma omp parallel for schedule(dynamic, 1)
-        for (std::ptrdiff_t b = 0; b < count; ++b)
-            run_block(static_cast<std::size_t>(b), true);
+        // Each thread of the team first runs the blocks of its own index (t, t + T, ... below
+        // the number of threads asked for), then takes the rest one at a time as it frees up.
+        // Dynamic scheduling alone let one thread take every block of a short loop before the
+        // other woke (a 30-block loop on a busy machine), so that a run at -j 2 could not show
+        // that a second thread ran; now every thread of the team runs at least one block of a
+        // loop with as many blocks. Which thread runs a block never changes a result.
+        const std::size_t first = std::min(blocks, static_cast<std::size_t>(thread_count()));
+        std::atomic<std::size_t> next{first};
+#pragma omp parallel
+        {
+            const auto t = static_cast<std::size_t>(omp_get_thread_num());
+            const auto team_size = static_cast<std::size_t>(omp_get_num_threads());
+            for (std::size_t b = t; b < first; b += team_size)
+                run_block(b, true);
+            for (std::size_t b = next.fetch_add(1); b < blocks; b = next.fetch_add(1))
+                run_block(b, true);
+        }
     }
     stat_blocks.fetch_add(done.load(), std::memory_order_relaxed);
     record_max(stat_max_team, team.load(std::memory_order_relaxed));
