@@ -15,6 +15,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <string>
 #include <utility>
@@ -34,10 +35,15 @@ std::size_t graph_columns(const OrientationOptions& options, const KnnTable& nei
     return options.k == 0 ? neighbors.k : std::min(options.k, neighbors.k);
 }
 
+/// Whether `value` is among the first `columns` entries of the table's row: a scan without an
+/// early exit, which the compiler vectorises (the graph rows are short).
 bool row_contains(const KnnTable& table, std::size_t row, std::size_t columns, std::uint32_t value)
 {
-    const auto nbrs = table.neighbors(row).first(columns);
-    return std::find(nbrs.begin(), nbrs.end(), value) != nbrs.end();
+    const std::uint32_t* nbrs = table.indices.data() + row * table.k;
+    std::uint32_t hits = 0;
+    for (std::size_t c = 0; c < columns; ++c)
+        hits += nbrs[c] == value ? 1U : 0U;
+    return hits != 0;
 }
 
 bool usable(const Vec3f& n)
@@ -447,7 +453,9 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
     if (static_cast<double>(n) * static_cast<double>(columns) >= 0x1p33)
         throw InvalidInput("orientation: too many points times graph neighbours (" +
                            std::to_string(n) + " x " + std::to_string(columns) + ")");
-    std::vector<std::uint32_t> cost_bits(n * columns);
+    //    Written in full by the first round (in parallel, so the pages are touched where they
+    //    are used), hence not zeroed first.
+    auto cost_bits = std::make_unique_for_overwrite<std::uint32_t[]>(n * columns);
 
     // 2. Borůvka: each round, every component takes its cheapest edge to another component,
     //    found in parallel by atomic minima of 64-bit keys (cost, then edge index: the order of
@@ -467,8 +475,8 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
         while (key < seen && !shared.compare_exchange_weak(seen, key, std::memory_order_relaxed))
         {}
     };
-    DisjointSets sets(n);
     std::vector<std::uint32_t> label(n); // the component of each sample: a representative
+    std::vector<std::uint32_t> up(n);    // by label: the next label towards its round's root
     std::iota(label.begin(), label.end(), 0U);
     std::vector<std::uint32_t> alive(n); // the labels of this round's components
     std::iota(alive.begin(), alive.end(), 0U);
@@ -517,7 +525,7 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
                     continue;
                 const std::uint32_t la = label[i];
                 const auto row = neighbors.neighbors(i).first(columns);
-                std::uint32_t* costs = cost_bits.data() + i * columns;
+                std::uint32_t* costs = cost_bits.get() + i * columns;
                 std::uint64_t own = no_key; // the row's cheapest edge out of la
                 bool leaves = false;
                 for (std::size_t c = 0; c < columns; ++c)
@@ -541,91 +549,170 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
                     internal[i] = 1; // components only grow: it stays so
             }
         });
-        merged = false;
-        for (const std::uint32_t l : alive)
-        {
-            const std::uint64_t key = std::exchange(cheapest[l], no_key);
-            if (key == no_key)
-                continue;
-            const std::size_t edge = edge_of(key);
-            if (sets.unite(edge / columns, neighbors.neighbors(edge / columns)[edge % columns]))
+        //    Each component's cheapest edge links it to the component across. Two components
+        //    whose cheapest edges are one edge link each other (with distinct keys that is the
+        //    only cycle), and the smaller label becomes their root and keeps the edge; pointer
+        //    jumping then takes every label to its root. The tree edges are kept in the order of
+        //    `alive`, and every step is a function of this round's labels: no thread order shows.
+        const std::size_t count = alive.size();
+        parallel_blocks(count, block, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t q = begin; q < end; ++q)
             {
-                tree_keys.push_back(key);
-                merged = true;
+                const std::uint32_t l = alive[q];
+                up[l] = l;
+                if (cheapest[l] == no_key)
+                    continue;
+                const std::size_t edge = edge_of(cheapest[l]);
+                const std::uint32_t la = label[edge / columns];
+                const std::uint32_t lb = label[neighbors.neighbors(edge / columns)[edge % columns]];
+                up[l] = la == l ? lb : la;
             }
+        });
+        //    Then what each does: 0 nothing (no edge out), 1 keeps its edge, 2 keeps it and is a
+        //    root, 3 drops it (the other of a mutual pair holds the same edge).
+        std::vector<std::uint8_t> kind(count);
+        parallel_blocks(count, block, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t q = begin; q < end; ++q)
+            {
+                const std::uint32_t l = alive[q];
+                const std::uint32_t other = up[l];
+                kind[q] = other == l ? 0 : up[other] != l ? 1 : l < other ? 2 : 3;
+            }
+        });
+        merged = false;
+        for (std::size_t q = 0; q < count; ++q)
+        {
+            merged |= kind[q] != 0;
+            if (kind[q] == 1 || kind[q] == 2)
+                tree_keys.push_back(cheapest[alive[q]]);
         }
-        // Relabel: every component's new representative, then every sample.
+        parallel_blocks(count, block, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t q = begin; q < end; ++q)
+            {
+                cheapest[alive[q]] = no_key;
+                if (kind[q] == 2)
+                    up[alive[q]] = alive[q];
+            }
+        });
+        for (bool moved = true; moved;)
+        {
+            std::atomic<bool> any{false};
+            parallel_blocks(count, block, [&](std::size_t begin, std::size_t end) {
+                bool local = false;
+                for (std::size_t q = begin; q < end; ++q)
+                {
+                    const std::uint32_t l = alive[q];
+                    std::atomic_ref<std::uint32_t> mine(up[l]);
+                    const std::uint32_t parent = mine.load(std::memory_order_relaxed);
+                    const std::uint32_t grand =
+                        std::atomic_ref<std::uint32_t>(up[parent]).load(std::memory_order_relaxed);
+                    if (grand != parent)
+                    {
+                        mine.store(grand, std::memory_order_relaxed);
+                        local = true;
+                    }
+                }
+                if (local)
+                    any.store(true, std::memory_order_relaxed);
+            });
+            moved = any.load();
+        }
+        // Relabel: every component's root, then every sample.
         std::vector<std::uint32_t> next;
         for (const std::uint32_t l : alive)
-        {
-            const auto root = static_cast<std::uint32_t>(sets.find(l));
-            if (root == l)
+            if (up[l] == l)
                 next.push_back(l);
-            cheapest[l] = root; // borrowed as the relabelling map until the next round
-        }
         parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i)
-                label[i] = static_cast<std::uint32_t>(cheapest[label[i]]);
+                label[i] = up[label[i]];
         });
-        for (const std::uint32_t l : alive)
-            cheapest[l] = no_key;
         alive.swap(next);
     }
-    std::vector<std::uint32_t>().swap(cost_bits);
-    std::vector<std::uint32_t>().swap(label);
+    cost_bits.reset();
+    std::vector<std::uint32_t>().swap(up);
     std::vector<std::uint32_t>().swap(alive);
     std::vector<std::uint64_t>().swap(cheapest);
     std::vector<std::uint8_t>().swap(internal);
     progress.update(0.6, 1.0);
 
-    //    The tree edges in Kruskal's order: the costs summed and the trees walked as it would.
-    parallel_sort(tree_keys);
-    std::vector<std::uint32_t> degree(n + 1, 0);
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> tree_edges;
-    tree_edges.reserve(tree_keys.size());
-    for (const std::uint64_t key : tree_keys)
-    {
+    //    The forest's adjacency, each sample's tree edges in Kruskal's order (by key), so that
+    //    the trees are walked as Kruskal's algorithm would: counted and scattered in parallel,
+    //    then each sample's few edges sorted. The costs are summed in the order the rounds found
+    //    the edges, which does not depend on the thread count.
+    const auto ends_of = [&](std::uint64_t key) {
         const std::size_t edge = edge_of(key);
         const auto a = static_cast<std::uint32_t>(edge / columns);
-        const std::uint32_t b = neighbors.neighbors(a)[edge % columns];
-        tree_edges.emplace_back(a, b);
+        return std::pair{a, neighbors.neighbors(a)[edge % columns]};
+    };
+    for (const std::uint64_t key : tree_keys)
         forest.total_cost +=
             static_cast<double>(std::bit_cast<float>(static_cast<std::uint32_t>(key >> 33)));
-        ++degree[a + 1];
-        ++degree[b + 1];
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> tree_edges(tree_keys.size());
+    std::vector<std::uint32_t> degree(n + 1, 0);
+    parallel_blocks(tree_keys.size(), block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t e = begin; e < end; ++e)
+        {
+            tree_edges[e] = ends_of(tree_keys[e]);
+            const auto [a, b] = tree_edges[e];
+            std::atomic_ref<std::uint32_t>(degree[a + 1]).fetch_add(1, std::memory_order_relaxed);
+            std::atomic_ref<std::uint32_t>(degree[b + 1]).fetch_add(1, std::memory_order_relaxed);
+        }
+    });
+    for (std::size_t i = 0; i < n; ++i)
+        degree[i + 1] += degree[i];
+    std::vector<std::uint32_t> adjacent(degree[n]);
+    {
+        auto adjacent_keys = std::make_unique_for_overwrite<std::uint64_t[]>(degree[n]);
+        {
+            std::vector<std::uint32_t> fill(degree.begin(), degree.end() - 1);
+            parallel_blocks(tree_keys.size(), block, [&](std::size_t begin, std::size_t end) {
+                for (std::size_t e = begin; e < end; ++e)
+                {
+                    const auto [a, b] = tree_edges[e];
+                    for (const std::uint32_t v : {a, b})
+                        adjacent_keys[std::atomic_ref<std::uint32_t>(fill[v]).fetch_add(
+                            1, std::memory_order_relaxed)] = tree_keys[e];
+                }
+            });
+        }
+        std::vector<std::uint64_t>().swap(tree_keys);
+        std::vector<std::pair<std::uint32_t, std::uint32_t>>().swap(tree_edges);
+        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t v = begin; v < end; ++v)
+            {
+                std::uint64_t* first = adjacent_keys.get() + degree[v];
+                std::uint64_t* last = adjacent_keys.get() + degree[v + 1];
+                std::sort(first, last);
+                for (std::uint64_t* k = first; k != last; ++k)
+                {
+                    const auto [a, b] = ends_of(*k);
+                    adjacent[static_cast<std::size_t>(k - adjacent_keys.get())] = a == v ? b : a;
+                }
+            }
+        });
     }
-    std::vector<std::uint64_t>().swap(tree_keys);
 
     // 3. Components numbered by smallest sample; root = highest sample with a usable normal.
     std::vector<std::uint32_t> label_of_set(n, RiemannianForest::none);
     for (std::size_t i = 0; i < n; ++i)
     {
-        std::uint32_t& label = label_of_set[sets.find(static_cast<std::uint32_t>(i))];
-        if (label == RiemannianForest::none)
+        std::uint32_t& number = label_of_set[label[i]];
+        if (number == RiemannianForest::none)
         {
-            label = static_cast<std::uint32_t>(forest.roots.size());
+            number = static_cast<std::uint32_t>(forest.roots.size());
             forest.roots.push_back(RiemannianForest::none);
         }
-        forest.component[i] = label;
+        forest.component[i] = number;
         if (!usable(normals[i]))
             continue;
-        std::uint32_t& root = forest.roots[label];
+        std::uint32_t& root = forest.roots[number];
         if (root == RiemannianForest::none || positions[i].z() > positions[root].z())
             root = static_cast<std::uint32_t>(i);
     }
+    std::vector<std::uint32_t>().swap(label);
+    std::vector<std::uint32_t>().swap(label_of_set);
 
     // 4. Each tree walked breadth-first from its root: parents and a parent-first order.
-    for (std::size_t i = 0; i < n; ++i)
-        degree[i + 1] += degree[i];
-    std::vector<std::uint32_t> adjacent(degree[n]);
-    {
-        std::vector<std::uint32_t> fill(degree.begin(), degree.end() - 1);
-        for (const auto& [a, b] : tree_edges)
-        {
-            adjacent[fill[a]++] = b;
-            adjacent[fill[b]++] = a;
-        }
-    }
     forest.order.reserve(n);
     for (const std::uint32_t root : forest.roots)
     {
@@ -688,24 +775,54 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
 
     // 1. Propagate along the trees, but only across reliable tree edges: they cut each tree into
     //    patches inside which every step is trustworthy. A patch's first sample keeps its sign.
+    //    Each tree edge is judged in parallel, in the normals as they are: whether it joins v to
+    //    its parent's patch, and the sign of their agreement. Flipping the parent negates the
+    //    agreement exactly, so the walk in tree order only combines signs.
+    enum Step : std::uint8_t
+    {
+        cut,       // v starts a patch
+        agrees,    // joins; agreement > 0
+        disagrees, // joins; agreement < 0
+        neutral,   // joins; agreement 0 (or not a number): no flip either way
+    };
+    std::vector<std::uint8_t> step(n, cut);
+    parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            const auto v = static_cast<std::uint32_t>(i);
+            const std::uint32_t parent = forest.parent[v];
+            const bool joins = parent != RiemannianForest::none && parent != v &&
+                               usable(normals[v]) && usable(normals[parent]) &&
+                               !guide.jumps(positions, neighbors, parent, v) &&
+                               edge_cost(positions, normals, options.rule, parent, v) <=
+                                   static_cast<float>(options.patch_cost);
+            if (!joins)
+                continue;
+            const float a = agreement(positions, normals, options.rule, parent, v);
+            step[v] = a < 0.0F ? disagrees : a > 0.0F ? agrees : neutral;
+        }
+    });
     std::vector<std::uint32_t> patch(n, RiemannianForest::none);
     std::uint32_t patch_count = 0;
-    for (const std::uint32_t v : forest.order)
     {
-        const std::uint32_t parent = forest.parent[v];
-        const bool joins = parent != v && usable(normals[v]) && usable(normals[parent]) &&
-                           !guide.jumps(positions, neighbors, parent, v) &&
-                           edge_cost(positions, normals, options.rule, parent, v) <=
-                               static_cast<float>(options.patch_cost);
-        if (!joins)
+        std::vector<std::uint8_t> flipped(n, 0);
+        for (const std::uint32_t v : forest.order)
         {
-            patch[v] = patch_count++;
-            continue;
+            if (step[v] == cut)
+            {
+                patch[v] = patch_count++;
+                continue;
+            }
+            const std::uint32_t parent = forest.parent[v];
+            patch[v] = patch[parent];
+            if (step[v] == (flipped[parent] != 0 ? agrees : disagrees))
+            {
+                flipped[v] = 1;
+                result.normals[v] = -result.normals[v];
+            }
         }
-        patch[v] = patch[parent];
-        if (agreement(positions, result.normals, options.rule, parent, v) < 0.0F)
-            result.normals[v] = -result.normals[v];
     }
+    std::vector<std::uint8_t>().swap(step);
 
     // 2. Patches vote on their relative orientation over every graph edge between them, and a
     //    maximum spanning forest of the patch graph (by the size of the vote) decides each
@@ -824,16 +941,31 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
     //    the one tree edge that reached it. Jacobi sweeps over a snapshot: deterministic.
     //    Guide normals need none: they are smooth already, and the sign of a poor normal
     //    comes from its guide below.
+    //    After the first sweep only a sample with a neighbour flipped in the sweep before can
+    //    flip: with the same neighbours, it would decide as it did then.
     const std::size_t sweeps = guided ? 0 : options.smoothing_sweeps;
+    std::vector<std::uint8_t> changed(sweeps > 1 ? n : 0, 0);
+    std::vector<std::uint8_t> changed_before;
+    std::vector<Vec3f> snapshot;
     for (std::size_t sweep = 0; sweep < sweeps; ++sweep)
     {
-        const std::vector<Vec3f> snapshot = result.normals;
+        snapshot = result.normals;
+        changed_before.swap(changed);
+        changed.assign(sweep + 1 < sweeps ? n : 0, 0);
         parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i)
             {
                 const Vec3f& ni = snapshot[i];
                 if (!usable(ni) || patch[i] == RiemannianForest::none)
                     continue;
+                if (sweep > 0)
+                {
+                    bool affected = false;
+                    for (const std::uint32_t j : neighbors.neighbors(i))
+                        affected |= j != i && changed_before[j] != 0;
+                    if (!affected)
+                        continue;
+                }
                 Vec3f mean = Vec3f::Zero();
                 for (const std::uint32_t j : neighbors.neighbors(i))
                 {
@@ -846,10 +978,15 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
                     mean += tangential * snapshot[j];
                 }
                 if (ni.dot(mean) < 0.0F)
+                {
                     result.normals[i] = -ni;
+                    if (!changed.empty())
+                        changed[i] = 1;
+                }
             }
         });
     }
+    std::vector<Vec3f>().swap(snapshot);
 
     //    Each sample's own normal takes the sign of its oriented guide.
     if (guided)
