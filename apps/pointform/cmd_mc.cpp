@@ -7,7 +7,9 @@
 #include "pointform/implicit/point_field.h"
 #include "pointform/io/io.h"
 #include "pointform/metrics/hausdorff.h"
+#include "pointform/polygonize/base_mesh.h"
 #include "pointform/polygonize/marching_cubes.h"
+#include "pointform/polygonize/reconstruct.h"
 
 #include "common.h"
 #include "options.h"
@@ -30,6 +32,7 @@ struct McCommandOptions
     double cell = 0.0;
     PlaneFit fit = PlaneFit::Quadric;
     double rim_reach = PointFieldOptions{}.rim_reach;
+    double fill_holes = ReconstructOptions{}.fill_holes;
     SurfelsFromSamplesOptions surfels;
     bool ascii = false;
     bool json = false;
@@ -58,6 +61,8 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
             "marching cubes made no triangles: the field has no defined zero crossing "
             "at this cell size (try a smaller --cell or a larger --radius-scale)");
     }
+    const HoleFillStats holes = fill_mesh_holes(result.mesh, options.fill_holes);
+    timings.lap("fill holes");
     write_output(options.output, [&](const std::filesystem::path& path) {
         write_mesh(path, result.mesh, {.ascii = options.ascii});
     });
@@ -79,6 +84,11 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
         out["estimated_normals"] = input.estimated_normals;
         out["fit"] = std::string(to_string(options.fit));
         out["rim_reach"] = options.rim_reach;
+        out["fill_holes"] = options.fill_holes;
+        out["holes_filled"] = holes.holes_filled;
+        out["hole_vertices"] = holes.hole_vertices;
+        out["hole_area_share"] = holes.hole_area_share;
+        out["holes_skipped_not_manifold"] = holes.skipped_not_manifold;
         out["cell"] = cell;
         out["vertices"] = result.mesh.vertex_count();
         out["faces"] = result.mesh.face_count();
@@ -111,6 +121,12 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
     print_row("vertices", std::to_string(result.mesh.vertex_count()));
     print_row("faces", std::to_string(result.mesh.face_count()));
     print_row("components", std::to_string(topo.components));
+    print_row("holes filled", holes.skipped_not_manifold
+                                  ? std::string("none (the mesh is not an oriented 2-manifold)")
+                                  : std::to_string(holes.holes_filled) + " (" +
+                                        std::to_string(holes.hole_vertices) + " vertices, " +
+                                        format_number(100.0 * holes.hole_area_share) +
+                                        "% of the area)");
     print_row("boundary loops", std::to_string(topo.boundary_loops));
     print_row("Euler characteristic", std::to_string(topo.euler_characteristic));
     print_row("degenerate triangles",
@@ -130,8 +146,9 @@ void register_mc(CLI::App& app, const GlobalOptions& global)
     CLI::App* cmd = app.add_subcommand(
         "mc",
         "Level 2 -> mesh: marching cubes on the point field over the cells near the samples "
-        "(paper §4, Fig. 4); prints counts, boundary loops and the Hausdorff distance from the "
-        "samples to the mesh");
+        "(paper §4, Fig. 4), the scan's holes closed as reconstruct closes them (--fill-holes); "
+        "prints counts, boundary loops and the Hausdorff distance from the samples to the "
+        "mesh");
     cmd->add_option("input", options->input,
                     "Raw points (normals are estimated and oriented) or surfels (a file with "
                     "normals, and radius if present)")
@@ -149,6 +166,12 @@ void register_mc(CLI::App& app, const GlobalOptions& global)
                    "Local surfaces of the field: quadric (smooth blend of nearby local quadric "
                    "fits, the most accurate on exact and on noisy samples), blend (of centroid "
                    "planes), centroid (Hoppe's plane) or raw (the paper's plane)");
+    cmd->add_option("--fill-holes", options->fill_holes,
+                    "Close the mesh's holes whose rim encloses at most this fraction of their "
+                    "component's area with faired patches, as reconstruct does (0 keeps the "
+                    "zero set as it is)")
+        ->check(CLI::Range(0.0, 0.999999))
+        ->capture_default_str();
     add_rim_reach_option(*cmd, options->rim_reach);
     add_surfel_input_options(*cmd, options->surfels);
     cmd->add_flag("--ascii", options->ascii, "Write ascii PLY instead of binary");

@@ -5,6 +5,7 @@
 #include "pointform/hermite/surfels.h"
 #include "pointform/implicit/scans.h"
 #include "pointform/io/hierarchy.h"
+#include "pointform/polygonize/base_mesh.h"
 #include "pointform/polygonize/reconstruct.h"
 #include "pointform/polygonize/scene_mesh.h"
 #include "pointform/report/report_json.h"
@@ -242,6 +243,31 @@ void bind_polygonize(py::module_& m)
         py::arg("path"),
         "load_hierarchy(path) -> Hierarchy: reads a .pfh file, trusting nothing in it. Raises "
         "IoError for a missing, foreign, truncated or corrupt file.");
+
+    m.def(
+        "fill_holes",
+        [](const std::shared_ptr<TriMesh>& mesh, double max_share) {
+            auto filled = std::make_shared<TriMesh>(*mesh);
+            HoleFillStats stats;
+            {
+                py::gil_scoped_release release;
+                stats = fill_mesh_holes(*filled, max_share);
+            }
+            py::dict report;
+            report["holes_filled"] = stats.holes_filled;
+            report["hole_vertices"] = stats.hole_vertices;
+            report["hole_area_share"] = stats.hole_area_share;
+            report["skipped_not_manifold"] = stats.skipped_not_manifold;
+            return py::make_tuple(filled, report);
+        },
+        py::arg("mesh"), py::kw_only(), py::arg("max_share") = ReconstructOptions{}.fill_holes,
+        "fill_holes(mesh, *, max_share=0.05) -> (Mesh, dict)\n\n"
+        "The mesh with its holes closed, as `pointform mc` closes them (its --fill-holes): each "
+        "boundary loop whose rim encloses at most max_share of its component's area gets a "
+        "patch faired to continue the surface around it (0 closes none). The mesh's vertices "
+        "and faces stay in place, the patches' follow. The dict: holes_filled, hole_vertices, "
+        "hole_area_share, skipped_not_manifold (a mesh that is not an oriented 2-manifold is "
+        "returned unchanged). Raises InvalidInput for max_share outside [0, 1).");
 
     m.def(
         "reconstruct",

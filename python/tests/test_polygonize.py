@@ -192,6 +192,32 @@ def test_reconstruct_fills_holes_as_the_cli_does(tmp_path):
         assert mine.read_bytes() == out.read_bytes()
 
 
+def test_fill_holes_is_the_mc_clis(tmp_path):
+    # `pointform mc` closes a scan's holes by default: the same as its open zero set passed
+    # to pointform.fill_holes().
+    points = tmp_path / "holes.ply"
+    run_cli("sample", "sphere", "-n", 20000, "--holes", 3, "--hole-radius", 0.06, "--seed", 4,
+            "-o", points)
+    open_report = run_cli("mc", points, "-o", tmp_path / "open.ply", "--fill-holes", 0,
+                          "--json", json_output=True)
+    closed_report = run_cli("mc", points, "-o", tmp_path / "closed.ply", "--json",
+                            json_output=True)
+    mesh, report = pointform.fill_holes(pointform.read_mesh(tmp_path / "open.ply"))
+    assert report["holes_filled"] == closed_report["holes_filled"] == open_report[
+        "boundary_loops"] >= 1
+    assert report["hole_vertices"] == closed_report["hole_vertices"] > 0
+    assert not report["skipped_not_manifold"]
+    cli = pointform.read_mesh(tmp_path / "closed.ply")
+    assert np.array_equal(np.asarray(mesh.faces), np.asarray(cli.faces))
+    np.testing.assert_allclose(mesh.world(), cli.world(), rtol=0, atol=1e-6)
+    radius = np.linalg.norm(mesh.world(), axis=1)
+    assert np.max(np.abs(radius - 1.0)) < 0.02
+    same, none = pointform.fill_holes(mesh, max_share=0.0)
+    assert none["holes_filled"] == 0 and len(same.faces) == len(mesh.faces)
+    with pytest.raises(pointform.InvalidInput, match="share"):
+        pointform.fill_holes(mesh, max_share=1.0)
+
+
 def test_bad_reconstruct_input(sphere_cloud, tmp_path):
     with pytest.raises(pointform.InvalidInput, match="levels must not be negative"):
         pointform.reconstruct(sphere_cloud, levels=-1)

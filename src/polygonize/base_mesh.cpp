@@ -1746,4 +1746,120 @@ PickedBaseMesh snap_picked_base_mesh(const PickedVertices& picked, const PointCl
     return out;
 }
 
+HoleFillStats fill_mesh_holes(TriMesh& mesh, double max_share)
+{
+    if (!(max_share >= 0.0 && max_share < 1.0))
+        throw InvalidInput(
+            "fill holes: the largest hole's share of its component's area must be "
+            "in [0, 1), got " +
+            std::to_string(max_share));
+    HoleFillStats result;
+    if (max_share == 0.0 || mesh.face_count() == 0)
+        return result;
+    const MeshTopology topology = analyze_topology(mesh);
+    if (topology.boundary_loops == 0)
+        return result;
+    if (!topology.is_oriented_manifold())
+    {
+        result.skipped_not_manifold = true;
+        return result;
+    }
+    // Every vertex and face in place (isolated vertices too), so the mesh's indices stay and
+    // the patches' vertices and faces come after them.
+    OmMesh om;
+    const std::size_t vertex_count = mesh.vertex_count();
+    om.reserve(vertex_count, mesh.face_count() * 3 / 2, mesh.face_count());
+    for (std::size_t v = 0; v < vertex_count; ++v)
+        om.add_vertex(to_om(mesh.vertices.world(v)));
+    for (const Triangle& t : mesh.triangles)
+        if (!om.add_face(OmMesh::VertexHandle(static_cast<int>(t[0])),
+                         OmMesh::VertexHandle(static_cast<int>(t[1])),
+                         OmMesh::VertexHandle(static_cast<int>(t[2])))
+                 .is_valid())
+        {
+            result.skipped_not_manifold = true; // a complex vertex analyze_topology() let pass
+            return result;
+        }
+    BaseMeshStats stats;
+    std::vector<char> filled;
+    fill_holes(om, max_share, stats, filled);
+    result.holes_filled = stats.holes_filled;
+    result.hole_vertices = stats.hole_vertices;
+    result.hole_area_share = stats.hole_area_share;
+    if (stats.holes_filled == 0)
+        return result;
+
+    PointCloud& vertices = mesh.vertices;
+    const std::size_t total = om.n_vertices();
+    vertices.positions.resize(total);
+    for (std::size_t v = vertex_count; v < total; ++v)
+        vertices.positions[v] =
+            (to_eigen(om.point(OmMesh::VertexHandle(static_cast<int>(v)))) - vertices.origin)
+                .cast<float>();
+    const std::size_t face_count = mesh.face_count();
+    for (std::size_t f = face_count; f < om.n_faces(); ++f)
+    {
+        Triangle t{};
+        std::size_t corner = 0;
+        for (const auto v : om.fv_range(OmMesh::FaceHandle(static_cast<int>(f))))
+            t[corner++] = static_cast<std::uint32_t>(v.idx());
+        mesh.triangles.push_back(t);
+    }
+    // A patch vertex's normal: the area-weighted normal of its faces; its colour and radius the
+    // mean of its neighbours' that have one (the rim's, inwards ring by ring).
+    if (!vertices.normals.empty())
+    {
+        vertices.normals.resize(total);
+        for (std::size_t v = vertex_count; v < total; ++v)
+        {
+            Vec3d sum = Vec3d::Zero();
+            for (const auto f : om.vf_range(OmMesh::VertexHandle(static_cast<int>(v))))
+                sum += area_normal(face_points(om, f));
+            vertices.normals[v] =
+                sum.norm() > 0.0 ? Vec3f(sum.normalized().cast<float>()) : Vec3f::Zero();
+        }
+    }
+    //    Rings are added outside in, so a vertex's outer neighbours have theirs by then.
+    const auto spread = [&](std::size_t channels, const auto& get, const auto& set) {
+        for (std::size_t v = vertex_count; v < total; ++v)
+        {
+            std::array<double, 3> sum{};
+            int count = 0;
+            for (const auto w : om.vv_range(OmMesh::VertexHandle(static_cast<int>(v))))
+                if (const auto i = static_cast<std::size_t>(w.idx()); i < v)
+                {
+                    for (std::size_t c = 0; c < channels; ++c)
+                        sum[c] += get(i, c);
+                    ++count;
+                }
+            if (count > 0)
+                for (std::size_t c = 0; c < channels; ++c)
+                    set(v, c, sum[c] / count);
+        }
+    };
+    if (!vertices.colors.empty())
+    {
+        vertices.colors.resize(total);
+        const auto channel = [&](std::size_t i, std::size_t c) -> std::uint8_t& {
+            Color& colour = vertices.colors[i];
+            return c == 0 ? colour.r : c == 1 ? colour.g : colour.b;
+        };
+        spread(
+            3, [&](std::size_t i, std::size_t c) { return static_cast<double>(channel(i, c)); },
+            [&](std::size_t i, std::size_t c, double value) {
+                channel(i, c) = static_cast<std::uint8_t>(std::clamp(std::lround(value), 0L, 255L));
+            });
+    }
+    if (!vertices.radii.empty())
+    {
+        vertices.radii.resize(total);
+        spread(
+            1, [&](std::size_t i, std::size_t) { return static_cast<double>(vertices.radii[i]); },
+            [&](std::size_t i, std::size_t, double value) {
+                vertices.radii[i] = static_cast<float>(value);
+            });
+    }
+    return result;
+}
+
 } // namespace pointform

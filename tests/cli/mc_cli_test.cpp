@@ -37,8 +37,12 @@ TEST(McCli, BunnyScanToAMesh)
     const MeshTopology topo = analyze_topology(mesh);
     EXPECT_TRUE(topo.is_oriented_manifold());
     EXPECT_EQ(report["boundary_loops"].get<std::size_t>(), topo.boundary_loops);
-    // The scan has open holes underneath, which the field leaves open.
-    EXPECT_GE(topo.boundary_loops, 1U);
+    // The scan has holes underneath, which the field leaves open and the default closes.
+    EXPECT_EQ(report["fill_holes"].get<double>(), 0.05);
+    EXPECT_GE(report["holes_filled"].get<std::size_t>(), 1U);
+    EXPECT_GT(report["hole_vertices"].get<std::size_t>(), 0U);
+    EXPECT_LT(report["hole_area_share"].get<double>(), 0.05);
+    EXPECT_EQ(topo.boundary_loops, 0U);
     // Every sample lies within about a cell of the mesh.
     EXPECT_LT(report["hausdorff_samples_to_mesh"].get<double>(),
               2.0 * report["cell"].get<double>());
@@ -69,7 +73,7 @@ TEST(McCli, SurfelsWithoutRadiiAndEveryMeshFormat)
     }
 }
 
-TEST(McCli, HolesInTheSamplesStayOpen)
+TEST(McCli, HolesInTheSamplesAreClosedUnlessAsked)
 {
     test::TempDir dir;
     ASSERT_EQ(run("sample sphere -n 20000 --holes 3 --hole-radius 0.06 --seed 4 -o " +
@@ -77,23 +81,39 @@ TEST(McCli, HolesInTheSamplesStayOpen)
                   .exit_code,
               0);
     const auto r = run("mc " + quoted(dir / "holey.ply") + " -o " + quoted(dir / "out.ply") +
-                       " --reestimate --json");
+                       " --reestimate --fill-holes 0 --json");
     ASSERT_EQ(r.exit_code, 0) << r.out;
     const auto report = nlohmann::json::parse(r.out);
     EXPECT_TRUE(report["estimated_normals"].get<bool>());
+    EXPECT_EQ(report["holes_filled"].get<int>(), 0);
     // Three separate holes (they may overlap into fewer loops, never more).
-    EXPECT_GE(report["boundary_loops"].get<int>(), 1);
-    EXPECT_LE(report["boundary_loops"].get<int>(), 3);
-    EXPECT_EQ(report["euler_characteristic"].get<int>(), 2 - report["boundary_loops"].get<int>());
+    const int loops = report["boundary_loops"].get<int>();
+    EXPECT_GE(loops, 1);
+    EXPECT_LE(loops, 3);
+    EXPECT_EQ(report["euler_characteristic"].get<int>(), 2 - loops);
     EXPECT_EQ(report["rim_reach"].get<double>(), 0.25);
     // The paper's field (a whole radius past the rims) reaches farther into the holes: more
     // surface, over the same samples.
     const auto paper = run("mc " + quoted(dir / "holey.ply") + " -o " + quoted(dir / "paper.ply") +
-                           " --reestimate --rim-reach 1 --json");
+                           " --reestimate --rim-reach 1 --fill-holes 0 --json");
     ASSERT_EQ(paper.exit_code, 0) << paper.out;
     const auto paper_report = nlohmann::json::parse(paper.out);
     EXPECT_EQ(paper_report["rim_reach"].get<double>(), 1.0);
     EXPECT_GT(paper_report["faces"].get<double>(), report["faces"].get<double>());
+    // By default the holes are closed with patches near the sphere, the zero set kept.
+    const auto closed = run("mc " + quoted(dir / "holey.ply") + " -o " +
+                            quoted(dir / "closed.ply") + " --reestimate --json");
+    ASSERT_EQ(closed.exit_code, 0) << closed.out;
+    const auto closed_report = nlohmann::json::parse(closed.out);
+    EXPECT_EQ(closed_report["holes_filled"].get<int>(), loops);
+    EXPECT_EQ(closed_report["boundary_loops"].get<int>(), 0);
+    EXPECT_EQ(closed_report["euler_characteristic"].get<int>(), 2);
+    EXPECT_EQ(
+        closed_report["vertices"].get<std::size_t>(),
+        report["vertices"].get<std::size_t>() + closed_report["hole_vertices"].get<std::size_t>());
+    const TriMesh mesh = read_mesh(dir / "closed.ply");
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+        ASSERT_NEAR(mesh.vertices.world(v).norm(), 1.0, 0.02) << v;
 }
 
 TEST(McCli, BadOptionsAndInputsFailCleanly)
@@ -113,6 +133,8 @@ TEST(McCli, BadOptionsAndInputsFailCleanly)
         {"mc " + bunny + " -o " + quoted(output) + " --fit smooth", "--fit"},
         {"mc " + bunny + " -o " + quoted(output) + " --rim-reach 0", "--rim-reach"},
         {"mc " + bunny + " -o " + quoted(output) + " --rim-reach 1.5", "--rim-reach"},
+        {"mc " + bunny + " -o " + quoted(output) + " --fill-holes 1", "--fill-holes"},
+        {"mc " + bunny + " -o " + quoted(output) + " --fill-holes -0.1", "--fill-holes"},
         {"mc " + bunny + " -o " + quoted(output) + " --cell 1e-9", "cells along an axis"},
     };
     // Surfels whose normals are all zero.

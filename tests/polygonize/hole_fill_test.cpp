@@ -8,8 +8,10 @@
 #include "pointform/geometry/mesh_topology.h"
 #include "pointform/geometry/shapes.h"
 #include "pointform/hermite/surfels.h"
+#include "pointform/implicit/point_field.h"
 #include "pointform/implicit/primitives.h"
 #include "pointform/polygonize/base_mesh.h"
+#include "pointform/polygonize/marching_cubes.h"
 #include "pointform/polygonize/reconstruct.h"
 
 #include <gtest/gtest.h>
@@ -187,6 +189,94 @@ TEST(HoleFill, ElongatedAndTurnedHolesGetManifoldPatches)
         for (std::size_t v = 0; v < base.mesh.vertex_count(); ++v)
             EXPECT_NEAR(base.mesh.vertices.world(v).z(), 0.0, 1e-6);
     }
+}
+
+/// Marching cubes of the point field of `samples` (normals estimated), at the default cell.
+TriMesh zero_set(const PointCloud& samples)
+{
+    const PointCloud surfels = surfels_from_samples(samples).surfels;
+    const PointField field(surfels);
+    const double cell = choose_cell_size(field, surfels.bounds(), 0, 0.0);
+    return marching_cubes(field, grid_over(field.bounds(), cell)).mesh;
+}
+
+TEST(HoleFill, AMarchingCubesMeshIsClosedInPlace)
+{
+    // The zero set of a sphere scan with four holes of radius 0.21: the field ends soon after
+    // each rim, so the mesh has the holes (two may meet in one). Filling them keeps every vertex
+    // and triangle where it was, and the patches lie near the sphere with outward unit normals.
+    const PointCloud samples =
+        sample_shape(Shape::Sphere, {.count = 30000, .seed = 7, .holes = 4, .hole_radius = 0.06});
+    const TriMesh open = zero_set(samples);
+    const std::size_t loops = analyze_topology(open).boundary_loops; // holes may meet
+    ASSERT_GE(loops, 3U);
+    ASSERT_LE(loops, 4U);
+    ASSERT_FALSE(open.vertices.normals.empty());
+
+    TriMesh mesh = open;
+    const HoleFillStats stats = fill_mesh_holes(mesh, 0.05);
+    EXPECT_EQ(stats.holes_filled, loops);
+    EXPECT_FALSE(stats.skipped_not_manifold);
+    EXPECT_EQ(mesh.vertex_count(), open.vertex_count() + stats.hole_vertices);
+    EXPECT_GT(stats.hole_area_share, 0.0);
+    EXPECT_LT(stats.hole_area_share, 4.0 * 0.21 * 0.21 / 4.0);
+    const MeshTopology topology = analyze_topology(mesh);
+    EXPECT_TRUE(topology.is_closed());
+    EXPECT_TRUE(topology.is_oriented_manifold());
+    EXPECT_EQ(topology.euler_characteristic, 2);
+    for (std::size_t v = 0; v < open.vertex_count(); ++v)
+        ASSERT_EQ(mesh.vertices.world(v), open.vertices.world(v)) << v;
+    for (std::size_t f = 0; f < open.face_count(); ++f)
+        ASSERT_EQ(mesh.triangles[f], open.triangles[f]) << f;
+    ASSERT_EQ(mesh.vertices.normals.size(), mesh.vertex_count());
+    double worst = 0.0;
+    for (std::size_t v = open.vertex_count(); v < mesh.vertex_count(); ++v)
+    {
+        const Vec3d p = mesh.vertices.world(v);
+        worst = std::max(worst, std::abs(p.norm() - 1.0));
+        const Vec3f& n = mesh.vertices.normals[v];
+        EXPECT_NEAR(n.norm(), 1.0F, 1e-5F);
+        EXPECT_GT(n.cast<double>().dot(p.normalized()), 0.9) << v;
+    }
+    RecordProperty("worst", std::to_string(worst));
+    EXPECT_LT(worst, 0.02);
+
+    TriMesh kept = open;
+    EXPECT_EQ(fill_mesh_holes(kept, 0.0).holes_filled, 0U);
+    EXPECT_EQ(kept.vertex_count(), open.vertex_count());
+    EXPECT_EQ(kept.face_count(), open.face_count());
+    EXPECT_THROW((void)fill_mesh_holes(kept, 1.0), InvalidInput);
+    EXPECT_THROW((void)fill_mesh_holes(kept, -0.1), InvalidInput);
+    EXPECT_THROW((void)fill_mesh_holes(kept, std::nan("")), InvalidInput);
+}
+
+TEST(HoleFill, AMarchingCubesMeshOfAPartialScanKeepsItsRim)
+{
+    const PointCloud sphere = sample_shape(Shape::Sphere, {.count = 20000, .seed = 3});
+    PointCloud half;
+    half.origin = sphere.origin;
+    for (std::size_t i = 0; i < sphere.size(); ++i)
+        if (sphere.world(i).z() > 0.2)
+            half.positions.push_back(sphere.positions[i]);
+    TriMesh mesh = zero_set(half);
+    const std::size_t vertices = mesh.vertex_count();
+    EXPECT_EQ(fill_mesh_holes(mesh, 0.05).holes_filled, 0U);
+    EXPECT_EQ(mesh.vertex_count(), vertices);
+    EXPECT_EQ(analyze_topology(mesh).boundary_loops, 1U);
+}
+
+TEST(HoleFill, ANonManifoldMeshIsLeftAsItIs)
+{
+    // Two triangles sharing one vertex only, each with its boundary: a vertex with two fans.
+    TriMesh mesh;
+    for (const auto& p :
+         {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0), Vec3f(-1, 0, 0), Vec3f(0, -1, 0)})
+        mesh.vertices.positions.push_back(p);
+    mesh.triangles = {{0, 1, 2}, {0, 3, 4}};
+    const HoleFillStats stats = fill_mesh_holes(mesh, 0.9);
+    EXPECT_TRUE(stats.skipped_not_manifold);
+    EXPECT_EQ(stats.holes_filled, 0U);
+    EXPECT_EQ(mesh.face_count(), 2U);
 }
 
 TEST(HoleFill, OutOfRangeIsRefused)

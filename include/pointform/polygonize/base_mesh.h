@@ -197,6 +197,29 @@ MeshTopology check_intermediate_mesh(const TriMesh& intermediate);
 [[nodiscard]] BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
                                              const BaseMeshOptions& options = {});
 
+/// \brief What fill_mesh_holes() did.
+struct HoleFillStats
+{
+    std::size_t holes_filled = 0;  ///< boundary loops closed
+    std::size_t hole_vertices = 0; ///< vertices added
+    double hole_area_share = 0.0;  ///< the patches' area (their rims' vector areas) over the mesh's
+    /// The mesh is not an oriented 2-manifold, so no hole was filled.
+    bool skipped_not_manifold = false;
+};
+
+/// \brief Closes the holes of a mesh as the base mesh's are (BaseMeshOptions::fill_holes): each
+/// boundary loop whose rim encloses at most `max_share` of its component's area gets a patch of
+/// rings at the loop's edge length, faired to the smoothest surface that continues the mesh
+/// around it (thin-plate fairing, the rest of the mesh held). Loops that pinch, share a vertex
+/// with another loop, or have more than 1000 edges stay open. The mesh keeps its vertices and
+/// triangles in place; the patches' vertices and triangles follow them, with normals from
+/// their faces and colours and radii spread from the rim. A mesh that is not an oriented
+/// 2-manifold is left as it is (reported). For a marching-cubes mesh of a scan, whose field
+/// ends soon after the rims of the holes where the scanner saw nothing (PointFieldOptions::
+/// rim_reach), this closes them as the peers' Poisson reconstruction does.
+/// \throw InvalidInput for max_share outside [0, 1)
+HoleFillStats fill_mesh_holes(TriMesh& mesh, double max_share);
+
 /// \brief A base mesh picked by a user over sample indices (§5.1, Fig. 6).
 struct PickedBaseMesh
 {
