@@ -8,6 +8,7 @@
 #include "pointform/io/io.h"
 #include "pointform/metrics/hausdorff.h"
 #include "pointform/polygonize/base_mesh.h"
+#include "pointform/polygonize/components.h"
 #include "pointform/polygonize/marching_cubes.h"
 #include "pointform/polygonize/reconstruct.h"
 
@@ -20,6 +21,7 @@
 
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 namespace pointform::cli {
 namespace {
@@ -33,6 +35,7 @@ struct McCommandOptions
     PlaneFit fit = PlaneFit::Quadric;
     double rim_reach = PointFieldOptions{}.rim_reach;
     double fill_holes = ReconstructOptions{}.fill_holes;
+    std::optional<std::size_t> min_component_samples;
     SurfelsFromSamplesOptions surfels;
     bool ascii = false;
     bool json = false;
@@ -61,6 +64,11 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
             "marching cubes made no triangles: the field has no defined zero crossing "
             "at this cell size (try a smaller --cell or a larger --radius-scale)");
     }
+    const ComponentFilterReport debris = remove_unsupported_components(
+        result.mesh, input.surfels,
+        options.min_component_samples ? *options.min_component_samples
+                                      : default_min_component_samples(input.surfels.size()));
+    timings.lap("debris");
     const HoleFillStats holes = fill_mesh_holes(result.mesh, options.fill_holes);
     timings.lap("fill holes");
     write_output(options.output, [&](const std::filesystem::path& path) {
@@ -84,6 +92,9 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
         out["estimated_normals"] = input.estimated_normals;
         out["fit"] = std::string(to_string(options.fit));
         out["rim_reach"] = options.rim_reach;
+        out["min_component_samples"] = debris.min_samples;
+        out["components_removed"] = debris.removed_components;
+        out["faces_removed"] = debris.removed_faces;
         out["fill_holes"] = options.fill_holes;
         out["holes_filled"] = holes.holes_filled;
         out["hole_vertices"] = holes.hole_vertices;
@@ -120,7 +131,10 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
     print_row("cell", format_number(cell) + " (" + std::string(to_string(options.fit)) + " field)");
     print_row("vertices", std::to_string(result.mesh.vertex_count()));
     print_row("faces", std::to_string(result.mesh.face_count()));
-    print_row("components", std::to_string(topo.components));
+    print_row("components", std::to_string(topo.components) + " (" +
+                                std::to_string(debris.removed_components) +
+                                " removed: fewer than " + std::to_string(debris.min_samples) +
+                                " samples nearest)");
     print_row("holes filled", holes.skipped_not_manifold
                                   ? std::string("none (the mesh is not an oriented 2-manifold)")
                                   : std::to_string(holes.holes_filled) + " (" +
@@ -146,7 +160,8 @@ void register_mc(CLI::App& app, const GlobalOptions& global)
     CLI::App* cmd = app.add_subcommand(
         "mc",
         "Level 2 -> mesh: marching cubes on the point field over the cells near the samples "
-        "(paper §4, Fig. 4), the scan's holes closed as reconstruct closes them (--fill-holes); "
+        "(paper §4, Fig. 4), its debris removed and the scan's holes closed as reconstruct "
+        "does them (--min-component-samples, --fill-holes); "
         "prints counts, boundary loops and the Hausdorff distance from the samples to the "
         "mesh");
     cmd->add_option("input", options->input,
@@ -166,6 +181,11 @@ void register_mc(CLI::App& app, const GlobalOptions& global)
                    "Local surfaces of the field: quadric (smooth blend of nearby local quadric "
                    "fits, the most accurate on exact and on noisy samples), blend (of centroid "
                    "planes), centroid (Hoppe's plane) or raw (the paper's plane)");
+    cmd->add_option("--min-component-samples", options->min_component_samples,
+                    "Remove the components that fewer than N samples are nearest to (debris of "
+                    "stray samples or flipped normals), as reconstruct does; default: 0.1% of "
+                    "the samples, at least 32; 0 keeps every component")
+        ->check(CLI::NonNegativeNumber);
     cmd->add_option("--fill-holes", options->fill_holes,
                     "Close the mesh's holes whose rim encloses at most this fraction of their "
                     "component's area with faired patches, as reconstruct does (0 keeps the "

@@ -14,6 +14,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <numbers>
+#include <string>
 
 namespace pointform {
 namespace {
@@ -116,6 +118,52 @@ TEST(McCli, HolesInTheSamplesAreClosedUnlessAsked)
         ASSERT_NEAR(mesh.vertices.world(v).norm(), 1.0, 0.02) << v;
 }
 
+TEST(McCli, DebrisOfStraySamplesIsRemoved)
+{
+    // A sphere of 6,000 points and, far off, a flat cluster of 24 strays: the field makes a
+    // small surface of its own around them, which no more than 24 samples are nearest to.
+    test::TempDir dir;
+    std::string ply;
+    constexpr int sphere = 6000;
+    constexpr int strays = 24;
+    ply = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(sphere + strays) +
+          "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+    for (int i = 0; i < sphere; ++i)
+    {
+        const double z = 1.0 - 2.0 * (i + 0.5) / sphere;
+        const double rho = std::sqrt(1.0 - z * z);
+        ply += std::to_string(rho * std::cos(golden * i)) + " " +
+               std::to_string(rho * std::sin(golden * i)) + " " + std::to_string(z) + "\n";
+    }
+    for (int i = 0; i < strays; ++i)
+    {
+        const double rho = 0.08 * std::sqrt((i + 0.5) / strays);
+        ply += std::to_string(3.0 + rho * std::cos(golden * i)) + " " +
+               std::to_string(rho * std::sin(golden * i)) + " 0\n";
+    }
+    test::write_file(dir / "strays.ply", ply);
+    const auto kept = run("mc " + quoted(dir / "strays.ply") + " -o " + quoted(dir / "kept.ply") +
+                          " --min-component-samples 0 --json");
+    ASSERT_EQ(kept.exit_code, 0) << kept.out;
+    const auto kept_report = nlohmann::json::parse(kept.out);
+    EXPECT_EQ(kept_report["components_removed"].get<int>(), 0);
+    EXPECT_EQ(kept_report["components"].get<int>(), 2);
+
+    const auto r =
+        run("mc " + quoted(dir / "strays.ply") + " -o " + quoted(dir / "out.ply") + " --json");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const auto report = nlohmann::json::parse(r.out);
+    EXPECT_EQ(report["min_component_samples"].get<int>(), 32);
+    EXPECT_EQ(report["components_removed"].get<int>(), 1);
+    EXPECT_GT(report["faces_removed"].get<int>(), 0);
+    EXPECT_EQ(report["components"].get<int>(), 1);
+    EXPECT_EQ(report["boundary_loops"].get<int>(), 0);
+    const TriMesh mesh = read_mesh(dir / "out.ply");
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+        ASSERT_NEAR(mesh.vertices.world(v).norm(), 1.0, 0.02) << v;
+}
+
 TEST(McCli, BadOptionsAndInputsFailCleanly)
 {
     test::TempDir dir;
@@ -135,6 +183,8 @@ TEST(McCli, BadOptionsAndInputsFailCleanly)
         {"mc " + bunny + " -o " + quoted(output) + " --rim-reach 1.5", "--rim-reach"},
         {"mc " + bunny + " -o " + quoted(output) + " --fill-holes 1", "--fill-holes"},
         {"mc " + bunny + " -o " + quoted(output) + " --fill-holes -0.1", "--fill-holes"},
+        {"mc " + bunny + " -o " + quoted(output) + " --min-component-samples -1",
+         "--min-component-samples"},
         {"mc " + bunny + " -o " + quoted(output) + " --cell 1e-9", "cells along an axis"},
     };
     // Surfels whose normals are all zero.
