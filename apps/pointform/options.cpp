@@ -180,6 +180,13 @@ std::vector<CLI::Option*> add_level_options(CLI::App& cmd, SemiRegularCommandOpt
         "Where a new edge vertex starts before its projection onto the surface: midpoint, or "
         "butterfly (the displaced butterfly subdivision)"));
     added.push_back(
+        cmd.add_option("--denoise", semi.denoise_rounds,
+                       "Rounds of Taubin smoothing of the finest level when the automatic stop "
+                       "ends on noise (the next level's details would follow the field's noise); "
+                       "0 keeps the projected level")
+            ->check(CLI::Range(std::size_t{0}, max_denoise_rounds))
+            ->capture_default_str());
+    added.push_back(
         cmd.add_option("--relax", semi.relax_iterations,
                        "Rounds of tangential relaxation of the new vertices per level (§5.2.3), "
                        "each followed by their re-projection; 0 keeps the projected predictions")

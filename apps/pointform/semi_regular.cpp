@@ -88,6 +88,11 @@ void print_refinement(const SemiRegularReport& r)
                                         "threshold " +
                                         format_number(r.refinement.detail_threshold));
         print_row("vertex budget", std::to_string(r.refinement.vertex_budget) + " (the samples)");
+        if (r.refinement.denoise_rounds > 0)
+            print_row("denoised", std::to_string(r.refinement.denoise_rounds) +
+                                      " rounds of Taubin smoothing of the finest level (its "
+                                      "details were noise); farthest move " +
+                                      format_number(r.refinement.denoise_max_move));
     }
     print_row("VEN fix",
               "fold vertices whose fold the vertex-based edge normal fixed / fold "

@@ -126,6 +126,9 @@ def main(argv=None) -> int:
     ap.add_argument("--size", type=int, default=100000)
     ap.add_argument("--bpa", action="store_true", help="also ball pivoting (slow)")
     ap.add_argument("--reconstruct-args", default="", help="extra arguments for pointform reconstruct")
+    ap.add_argument("--mc-args", default="",
+                    help="extra arguments for every pointform mc run (e.g. \"--fill-holes 0\" "
+                         "beside a reconstruct that keeps the holes)")
     ap.add_argument("--matched-levels", type=int, default=3,
                     help="levels of the semi-regular mesh that marching cubes is also matched "
                          "against, 0 = none "
@@ -197,7 +200,7 @@ def main(argv=None) -> int:
                              *args.reconstruct_args.split()], work / "semi_j.ply")
                 default_mc = measure("pointform mc (default cell)",
                                      [args.pointform, "mc", raw, "-o", work / "mc_default.ply",
-                                      "--json"], work / "mc_default.ply")
+                                      "--json", *args.mc_args.split()], work / "mc_default.ply")
                 # Marching cubes at the vertex counts of the default mesh (the paper's Fig. 4
                 # claim at the default) and of the --levels one. Vertices grow with the square of
                 # the resolution: from the default cell's mesh (fine enough to be defined
@@ -214,14 +217,16 @@ def main(argv=None) -> int:
                     resolution = max(8, round(side / default_mc["cell"] *
                                               math.sqrt(len(target) / default_mc["vertices"])))
                     probe = run_measured([args.pointform, "mc", raw, "-o", work / "probe.ply",
-                                          "--json", "--resolution", str(resolution)], env,
+                                          "--json", "--resolution", str(resolution),
+                                          *args.mc_args.split()], env,
                                          args.timeout, work / "probe")[3] or {}
                     if probe.get("vertices"):
                         resolution = max(8, round(resolution *
                                                   math.sqrt(len(target) / probe["vertices"])))
                     measure(f"pointform mc at {label} vertex count (resolution {resolution})",
                             [args.pointform, "mc", raw, "-o", work / "mc.ply", "--json",
-                             "--resolution", str(resolution)], work / "mc.ply")
+                             "--resolution", str(resolution), *args.mc_args.split()],
+                            work / "mc.ply")
                 if args.no_poisson:
                     continue
                 measure("Open3D Poisson 9",

@@ -188,6 +188,10 @@ def reconstruct(
     predictor: str = ...,
     relax_iterations: int = ...,
     relaxation: str = ...,
+    base_triangles: object | None = None,
+    fill_holes: float = 0.05,
+    rim_reach: float = 0.25,
+    denoise_rounds: int = 5,
 ) -> Hierarchy: ...
 def remesh(
     mesh: Mesh,

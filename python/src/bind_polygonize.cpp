@@ -277,12 +277,17 @@ void bind_polygonize(py::module_& m)
            const std::optional<long long>& min_component_samples,
            const std::optional<std::filesystem::path>& base_mesh, const py::object& base_triangles,
            long long k, double radius_scale, const std::string& predictor, int relax_iterations,
-           const std::string& relaxation, double fill_holes, double rim_reach) {
+           const std::string& relaxation, double fill_holes, double rim_reach,
+           long long denoise_rounds) {
             ReconstructOptions options;
             options.fill_holes = fill_holes; // checked by the base mesh
             options.rim_reach = rim_reach;   // checked by the point field
             options.semi_regular = semi_regular_options(levels, base_faces, stop_rule, predictor,
                                                         relax_iterations, relaxation);
+            if (denoise_rounds < 0)
+                throw InvalidInput("denoise_rounds must not be negative, got " +
+                                   std::to_string(denoise_rounds));
+            options.semi_regular.denoise_rounds = static_cast<std::size_t>(denoise_rounds);
             options.fit = parse_plane_fit(fit);
             if (resolution != 0 && resolution < 2)
                 throw InvalidInput("resolution must be at least 2 (or 0 = automatic), got " +
@@ -338,11 +343,12 @@ void bind_polygonize(py::module_& m)
         py::arg("relaxation") = default_relaxation,
         py::arg("fill_holes") = ReconstructOptions{}.fill_holes,
         py::arg("rim_reach") = ReconstructOptions{}.rim_reach,
+        py::arg("denoise_rounds") = static_cast<long long>(RefineOptions{}.denoise_rounds),
         "reconstruct(cloud, *, levels=None, base_faces=None, stop_rule='auto', fit='quadric', "
         "resolution=0, cell=0.0, min_component_samples=None, base_mesh=None, base_triangles=None, "
         "k=16, "
         "radius_scale=1.5, predictor=..., relax_iterations=..., relaxation=..., fill_holes=0.05, "
-        "rim_reach=0.25) "
+        "rim_reach=0.25, denoise_rounds=5) "
         "-> Hierarchy\n\n"
         "Points to a semi-regular multiresolution mesh (paper §5), as `pointform reconstruct` "
         "does, with the same defaults and the same result: surfels (pointform.surfels() with "
@@ -354,7 +360,9 @@ void bind_polygonize(py::module_& m)
         "integer array of the cloud's sample indices, as picked in `pointform view`), its holes "
         "enclosing at most fill_holes of their component's area closed (0 keeps them), then "
         "1-to-4 refinement projected onto the field: exactly to "
-        "`levels` (0-8), or until stop_rule says so ('auto' or 'paper'). Raises InvalidInput "
+        "`levels` (0-8), or until stop_rule says so ('auto' or 'paper'); a level where 'auto' "
+        "stops on noise is smoothed by denoise_rounds rounds of Taubin's smoothing (0 = none). "
+        "Raises InvalidInput "
         "for bad points or options, or work that would not fit in memory.");
 
     m.def(

@@ -218,6 +218,35 @@ def test_fill_holes_is_the_mc_clis(tmp_path):
         pointform.fill_holes(mesh, max_share=1.0)
 
 
+def test_noisy_levels_are_denoised_as_the_cli_does(tmp_path):
+    # A noisy sphere stops on noise and is smoothed (denoise_rounds, `--denoise`): the same
+    # bytes and report as the CLI either way, and closer to the sphere when smoothed.
+    points = tmp_path / "noisy.ply"
+    run_cli("sample", "sphere", "-n", 20000, "--noise", 0.002, "--seed", 3, "-o", points)
+    cloud = pointform.read_points(points)
+    errors = {}
+    for rounds in (None, 0):
+        kwargs = {} if rounds is None else {"denoise_rounds": rounds}
+        hierarchy = pointform.reconstruct(cloud, **kwargs)
+        assert hierarchy.report["stop"] == "noisy details"
+        assert hierarchy.report["denoise_rounds"] == (5 if rounds is None else 0)
+        out = tmp_path / f"cli{rounds}.pfh"
+        cli_report = run_cli("reconstruct", points, "-o", tmp_path / "cli.ply", "--save-hierarchy",
+                             out, "--json", *([] if rounds is None else ["--denoise", rounds]),
+                             json_output=True)
+        assert cli_report["denoise_rounds"] == hierarchy.report["denoise_rounds"]
+        mine = tmp_path / f"py{rounds}.pfh"
+        hierarchy.save(mine)
+        assert mine.read_bytes() == out.read_bytes()
+        errors[rounds] = np.mean(np.abs(np.linalg.norm(hierarchy.level_mesh(-1).world(), axis=1)
+                                        - 1.0))
+    assert errors[None] < 0.9 * errors[0]
+    with pytest.raises(ValueError, match="denoise"):
+        pointform.reconstruct(cloud, denoise_rounds=-1)
+    with pytest.raises(ValueError, match="denoise"):
+        pointform.reconstruct(cloud, denoise_rounds=1001)
+
+
 def test_bad_reconstruct_input(sphere_cloud, tmp_path):
     with pytest.raises(pointform.InvalidInput, match="levels must not be negative"):
         pointform.reconstruct(sphere_cloud, levels=-1)

@@ -182,6 +182,10 @@ std::size_t count_folds(const std::vector<char>& folded)
 
 void check_options(const RefineOptions& options)
 {
+    if (options.denoise_rounds > max_denoise_rounds)
+        throw InvalidInput("refine: denoise_rounds must be at most " +
+                           std::to_string(max_denoise_rounds) + ", got " +
+                           std::to_string(options.denoise_rounds));
     if (!(options.search_scale > 0.0) || !std::isfinite(options.search_scale))
         throw InvalidInput("refine: search_scale must be positive and finite");
     if (!std::isfinite(options.fold_cosine) || options.fold_cosine >= 1.0 ||
@@ -829,6 +833,75 @@ NextDetail next_detail(const MultiresMesh& mesh, const Field& field)
     return out;
 }
 
+/// Taubin's λ|μ smoothing of the finest level (RefineOptions::denoise_rounds): `rounds` times
+/// every vertex moves λ of the way to the mean of its neighbours, then μ of it; a vertex on a
+/// boundary edge stays. Jacobi steps in parallel blocks: the same positions whatever the thread
+/// count. Returns the farthest move.
+double denoise_finest(MultiresMesh& mesh, std::size_t rounds)
+{
+    constexpr double lambda = 0.5;
+    constexpr double mu = -0.53;
+    const std::vector<Triangle> faces = mesh.faces(mesh.finest_level());
+    const std::size_t n = mesh.vertex_count();
+    // Neighbours in compressed rows, each row sorted and without repeats; an edge used by one
+    // face only marks its ends as boundary.
+    std::vector<std::uint64_t> directed;
+    directed.reserve(6 * faces.size());
+    for (const Triangle& t : faces)
+        for (std::size_t c = 0; c < 3; ++c)
+        {
+            const std::uint64_t a = t[c];
+            const std::uint64_t b = t[(c + 1) % 3];
+            directed.push_back(a << 32U | b);
+            directed.push_back(b << 32U | a);
+        }
+    parallel_sort(directed);
+    std::vector<std::uint8_t> boundary(n, 0);
+    std::vector<std::uint32_t> offsets(n + 1, 0);
+    std::vector<std::uint32_t> adjacent;
+    adjacent.reserve(directed.size() / 2);
+    for (std::size_t i = 0; i < directed.size();)
+    {
+        std::size_t j = i;
+        while (j < directed.size() && directed[j] == directed[i])
+            ++j;
+        const auto from = static_cast<std::uint32_t>(directed[i] >> 32U);
+        if (j - i == 1)
+            boundary[from] = 1; // the edge has one face: it appears once each way
+        adjacent.push_back(static_cast<std::uint32_t>(directed[i] & 0xffffffffU));
+        ++offsets[from + 1];
+        i = j;
+    }
+    std::vector<std::uint64_t>().swap(directed);
+    for (std::size_t v = 0; v < n; ++v)
+        offsets[v + 1] += offsets[v];
+    const std::span<Vec3d> x = mesh.mutable_positions();
+    const std::vector<Vec3d> start(x.begin(), x.end());
+    std::vector<Vec3d> next(n);
+    for (std::size_t round = 0; round < 2 * rounds; ++round)
+    {
+        const double step = round % 2 == 0 ? lambda : mu;
+        parallel_blocks(n, vertex_block, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t v = begin; v < end; ++v)
+            {
+                next[v] = x[v];
+                if (boundary[v] != 0 || offsets[v + 1] == offsets[v])
+                    continue;
+                Vec3d mean = Vec3d::Zero();
+                for (std::uint32_t e = offsets[v]; e < offsets[v + 1]; ++e)
+                    mean += x[adjacent[e]];
+                mean /= static_cast<double>(offsets[v + 1] - offsets[v]);
+                next[v] = x[v] + step * (mean - x[v]);
+            }
+        });
+        std::copy(next.begin(), next.end(), x.begin());
+    }
+    double farthest = 0.0;
+    for (std::size_t v = 0; v < n; ++v)
+        farthest = std::max(farthest, (x[v] - start[v]).norm());
+    return farthest;
+}
+
 } // namespace
 
 RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& samples,
@@ -928,6 +1001,31 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
             break;
         }
         report.levels.push_back(stats);
+    }
+    if (report.stop == RefineStop::NoisyDetails && options.denoise_rounds > 0)
+    {
+        report.denoise_rounds = options.denoise_rounds;
+        report.denoise_max_move = denoise_finest(mesh, options.denoise_rounds);
+        const Distances after = distances_from(
+            samples, mesh, mesh.faces(mesh.finest_level()), mesh.finest_level(),
+            [&](std::string_view, double fraction) {
+                return !options.progress || options.progress("refine: distance", fraction);
+            });
+        if (report.levels.empty())
+        {
+            report.initial_hausdorff = after.hausdorff;
+            report.initial_mean_distance = after.mean;
+            report.initial_robust_distance = after.robust;
+            report.initial_p90_distance = after.p90;
+        }
+        else
+        {
+            RefineLevelStats& finest = report.levels.back();
+            finest.hausdorff = after.hausdorff;
+            finest.mean_distance = after.mean;
+            finest.robust_distance = after.robust;
+            finest.p90_distance = after.p90;
+        }
     }
     return report;
 }

@@ -212,6 +212,8 @@ nlohmann::json report_json(const SemiRegularReport& r, const SemiRegularOptions&
         out["vertex_budget"] = r.refinement.vertex_budget;
         out["field_residual"] = r.refinement.field_residual;
         out["detail_threshold"] = r.refinement.detail_threshold;
+        out["denoise_rounds"] = r.refinement.denoise_rounds;
+        out["denoise_max_move"] = r.refinement.denoise_max_move;
     }
     // The level the paper's rule (§5.2.4: Hausdorff below the sampling density) picks, counted
     // from the base, or null when no level made reaches it.

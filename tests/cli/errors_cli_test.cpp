@@ -46,6 +46,9 @@ TEST(ErrorsCli, EveryCommandExits2OnABadOptionValue)
         {"model 'sphere([0,0,0],1)' -o out.ply --cell -1", "--cell"},
         {"morph 'sphere([0,0,0],1)' 'sphere([0,0,0],2)' -o seq --steps 0", "--steps"},
         {"reconstruct in.ply -o out.ply --levels 99", "--levels"},
+        {"reconstruct in.ply -o out.ply --denoise 1001", "--denoise"},
+        {"reconstruct in.ply -o out.ply --denoise -1", "--denoise"},
+        {"mc in.ply -o out.ply --fill-holes 2", "--fill-holes"},
         {"remesh in.off -o out.ply --levels abc", "--levels"},
         {"lod in.pfh -l abc", "--level"},
     };

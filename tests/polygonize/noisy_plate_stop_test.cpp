@@ -6,8 +6,10 @@
 // well above the noise: the rule must go on while a finer level is closer to the true plate,
 // and stop where the next one would only follow the noise.
 
+#include "pointform/core/error.h"
 #include "pointform/geometry/shapes.h"
 #include "pointform/hermite/radius.h"
+#include "pointform/hermite/surfels.h"
 #include "pointform/metrics/quality.h"
 #include "pointform/polygonize/reconstruct.h"
 #include "pointform/spatial/kd_tree.h"
@@ -88,6 +90,72 @@ TEST(NoisyPlateStop, StopsAtTheLevelNearestTheTruePlate)
     // Coarser levels than the one chosen are farther from the plate: the rule did not stop early.
     for (std::size_t level = 0; level < chosen; ++level)
         EXPECT_GT(error[level], error[chosen]) << "level " << level;
+}
+
+/// Mean distance to the unit sphere over a level's vertices and face centroids.
+double sphere_error(const MultiresMesh& mesh)
+{
+    double sum = 0.0;
+    std::size_t count = 0;
+    for (const Triangle& t : mesh.faces(mesh.finest_level()))
+    {
+        const Vec3d a = mesh.world(t[0]);
+        const Vec3d b = mesh.world(t[1]);
+        const Vec3d c = mesh.world(t[2]);
+        for (const Vec3d& p : {a, Vec3d((a + b + c) / 3.0)})
+        {
+            sum += std::abs(p.norm() - 1.0);
+            ++count;
+        }
+    }
+    return sum / static_cast<double>(count);
+}
+
+TEST(NoisyPlateStop, ALevelThatStopsOnNoiseIsSmoothed)
+{
+    // A noisy sphere stops where the next level would follow the noise; the zero set still
+    // carries that noise at the level's own scale, and Taubin's smoothing takes it out
+    // (RefineOptions::denoise_rounds) without shrinking the sphere.
+    PointCloud raw_points;
+    {
+        const PointCloud drawn =
+            sample_shape(Shape::Sphere, {.count = 40000, .seed = 9, .noise = 0.002});
+        raw_points.origin = drawn.origin;
+        raw_points.positions = drawn.positions; // raw points: normals estimated, as scans are
+    }
+    const PointCloud samples = surfels_from_samples(raw_points).surfels;
+    const ReconstructReport report = reconstruct(samples, {});
+    const RefineReport& refinement = report.semi_regular.refinement;
+    ASSERT_EQ(refinement.stop, RefineStop::NoisyDetails);
+    EXPECT_EQ(refinement.denoise_rounds, RefineOptions{}.denoise_rounds);
+    EXPECT_GT(refinement.denoise_max_move, 0.0);
+    ReconstructOptions projected;
+    projected.semi_regular.denoise_rounds = 0;
+    const ReconstructReport raw = reconstruct(samples, projected);
+    EXPECT_EQ(raw.semi_regular.refinement.denoise_rounds, 0U);
+    const double smoothed_error = sphere_error(report.semi_regular.hierarchy);
+    const double raw_error = sphere_error(raw.semi_regular.hierarchy);
+    RecordProperty("smoothed", std::to_string(smoothed_error));
+    RecordProperty("projected", std::to_string(raw_error));
+    EXPECT_LT(smoothed_error, 0.85 * raw_error);
+    // No shrinking: the mean radius stays within the noise's tenth of 1.
+    double radius = 0.0;
+    const MultiresMesh& mesh = report.semi_regular.hierarchy;
+    for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v)
+        radius += mesh.world(v).norm();
+    EXPECT_NEAR(radius / static_cast<double>(mesh.vertex_count()), 1.0, 0.0005);
+    // The finest level's distances are those of the smoothed mesh.
+    EXPECT_LT(*refinement.levels.back().mean_distance,
+              *raw.semi_regular.refinement.levels.back().mean_distance * 1.5);
+
+    // A clean sphere stops on its vertex budget and is left as projected.
+    const PointCloud clean =
+        surfels_from_samples(sample_shape(Shape::Sphere, {.count = 20000, .seed = 9})).surfels;
+    EXPECT_EQ(reconstruct(clean, {}).semi_regular.refinement.denoise_rounds, 0U);
+
+    ReconstructOptions too_many;
+    too_many.semi_regular.denoise_rounds = max_denoise_rounds + 1;
+    EXPECT_THROW((void)reconstruct(samples, too_many), InvalidInput);
 }
 
 } // namespace

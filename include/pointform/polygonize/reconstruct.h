@@ -51,6 +51,8 @@ struct SemiRegularOptions
     /// Rounds of relaxation per level (§5.2.3), 0 = none.
     int relax_iterations = RefineOptions{}.relax_iterations;
     Relaxation relaxation = RefineOptions{}.relaxation;
+    /// Smoothing rounds of a finest level that stopped on noise (RefineOptions::denoise_rounds).
+    std::size_t denoise_rounds = RefineOptions{}.denoise_rounds;
     /// Holes of the automatic base mesh filled (BaseMeshOptions::fill_holes); 0 = none.
     double fill_holes = 0.0;
 };
