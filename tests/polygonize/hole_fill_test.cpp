@@ -81,21 +81,27 @@ TEST(HoleFill, LargeHolesFollowTheCurvatureAroundThem)
     EXPECT_LT(worst, 0.015); // 0.010 measured; the membrane alone: 0.034
 }
 
+/// The samples of a sphere above z = 0.2, with their normals: one side, as a single range scan
+/// sees it.
+PointCloud sphere_cap(std::size_t count)
+{
+    const PointCloud sphere = sample_shape(Shape::Sphere, {.count = count, .seed = 3});
+    PointCloud cap;
+    cap.origin = sphere.origin;
+    for (std::size_t i = 0; i < sphere.size(); ++i)
+        if (sphere.world(i).z() > 0.2)
+        {
+            cap.positions.push_back(sphere.positions[i]);
+            cap.normals.push_back(sphere.normals[i]);
+        }
+    return cap;
+}
+
 TEST(HoleFill, APartialScanKeepsItsRim)
 {
     // One side of a sphere, as a single range scan sees it: its rim encloses about as much as
     // the surface, and stays open.
-    const PointCloud sphere = sample_shape(Shape::Sphere, {.count = 30000, .seed = 3});
-    PointCloud half;
-    half.origin = sphere.origin;
-    for (std::size_t i = 0; i < sphere.size(); ++i)
-    {
-        if (sphere.world(i).z() > 0.2)
-        {
-            half.positions.push_back(sphere.positions[i]);
-            half.normals.push_back(sphere.normals[i]);
-        }
-    }
+    const PointCloud half = sphere_cap(30000);
     const ReconstructReport report = reconstruct_samples(half, ReconstructOptions{}.fill_holes);
     EXPECT_EQ(report.semi_regular.base->holes_filled, 0U);
     const TriMesh mesh =
@@ -252,13 +258,7 @@ TEST(HoleFill, AMarchingCubesMeshIsClosedInPlace)
 
 TEST(HoleFill, AMarchingCubesMeshOfAPartialScanKeepsItsRim)
 {
-    const PointCloud sphere = sample_shape(Shape::Sphere, {.count = 20000, .seed = 3});
-    PointCloud half;
-    half.origin = sphere.origin;
-    for (std::size_t i = 0; i < sphere.size(); ++i)
-        if (sphere.world(i).z() > 0.2)
-            half.positions.push_back(sphere.positions[i]);
-    TriMesh mesh = zero_set(half);
+    TriMesh mesh = zero_set(sphere_cap(20000));
     const std::size_t vertices = mesh.vertex_count();
     EXPECT_EQ(fill_mesh_holes(mesh, 0.05).holes_filled, 0U);
     EXPECT_EQ(mesh.vertex_count(), vertices);
