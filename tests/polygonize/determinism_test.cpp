@@ -12,6 +12,7 @@
 #include "pointform/implicit/point_field.h"
 #include "pointform/polygonize/base_mesh.h"
 #include "pointform/polygonize/marching_cubes.h"
+#include "pointform/polygonize/reconstruct.h"
 #include "pointform/polygonize/refine.h"
 #include "pointform/spatial/triangle_bvh.h"
 
@@ -145,6 +146,45 @@ TEST(Determinism, Refinement)
             EXPECT_EQ(a.fold_vertices, b.fold_vertices) << threads << " threads, level " << l;
             EXPECT_EQ(a.unprojected, b.unprojected) << threads << " threads, level " << l;
         }
+    }
+}
+
+TEST(Determinism, NoisyLevelSmoothing)
+{
+    // The whole reconstruction of a noisy sphere, which stops on noise and smooths its finest
+    // level (RefineOptions::denoise_rounds, Jacobi rounds in blocks of 512 vertices).
+    PointCloud raw;
+    {
+        const PointCloud drawn =
+            sample_shape(Shape::Sphere, {.count = 20000, .seed = 4, .noise = 0.002});
+        raw.origin = drawn.origin;
+        raw.positions = drawn.positions;
+    }
+    const PointCloud samples = surfels_from_samples(raw).surfels;
+    struct Run
+    {
+        std::vector<Vec3d> positions;
+        RefineReport report;
+    };
+    const auto runs = at_thread_counts(
+        [&] {
+            ReconstructReport report = reconstruct(samples, {});
+            const MultiresMesh& mesh = report.semi_regular.hierarchy;
+            return Run{{mesh.positions().begin(), mesh.positions().end()},
+                       report.semi_regular.refinement};
+        },
+        several);
+    ASSERT_EQ(runs[0].report.stop, RefineStop::NoisyDetails);
+    ASSERT_GT(runs[0].report.denoise_rounds, 0U);
+    ASSERT_GT(runs[0].positions.size(), 4 * 512U);
+    for (std::size_t i = 1; i < runs.size(); ++i)
+    {
+        const int threads = static_cast<int>(i) + 1;
+        EXPECT_TRUE(runs[0].positions == runs[i].positions) << threads << " threads";
+        EXPECT_EQ(runs[0].report.denoise_max_move, runs[i].report.denoise_max_move) << threads;
+        EXPECT_EQ(runs[0].report.levels.back().mean_distance,
+                  runs[i].report.levels.back().mean_distance)
+            << threads;
     }
 }
 
