@@ -180,13 +180,6 @@ std::vector<CLI::Option*> add_level_options(CLI::App& cmd, SemiRegularCommandOpt
         "Where a new edge vertex starts before its projection onto the surface: midpoint, or "
         "butterfly (the displaced butterfly subdivision)"));
     added.push_back(
-        cmd.add_option("--denoise", semi.denoise_rounds,
-                       "Rounds of Taubin smoothing of the finest level when the automatic stop "
-                       "ends on noise (the next level's details would follow the field's noise); "
-                       "0 keeps the projected level")
-            ->check(CLI::Range(std::size_t{0}, max_denoise_rounds))
-            ->capture_default_str());
-    added.push_back(
         cmd.add_option("--relax", semi.relax_iterations,
                        "Rounds of tangential relaxation of the new vertices per level (§5.2.3), "
                        "each followed by their re-projection; 0 keeps the projected predictions")
@@ -216,6 +209,12 @@ void add_refine_options(CLI::App& cmd, SemiRegularCommandOptions& options)
                     "the samples, and would have no more vertices than there are samples) or "
                     "paper (§5.2.4: until the largest distance from a sample is below the "
                     "sampling density)");
+    cmd.add_option("--denoise", options.semi_regular.denoise_rounds,
+                   "Rounds of Taubin smoothing of the finest level when the automatic stop "
+                   "ends on noise (the next level's details would follow the field's noise); "
+                   "0 keeps the projected level")
+        ->check(CLI::Range(std::size_t{0}, max_denoise_rounds))
+        ->capture_default_str();
     cmd.add_flag("--ascii", options.ascii, "Write ascii PLY instead of binary");
     cmd.add_flag("--json", options.json, "Print the report as JSON");
 }

@@ -204,6 +204,7 @@ def remesh(
     seed: int = 1,
     k: int = 16,
     radius_scale: float = 1.5,
+    denoise_rounds: int = 5,
 ) -> Hierarchy: ...
 def model(
     expression_or_file: str,

@@ -87,9 +87,14 @@ py::dict seconds_dict(const std::vector<std::pair<std::string, double>>& stages)
 SemiRegularOptions semi_regular_options(const std::optional<long long>& levels,
                                         const std::optional<long long>& base_faces,
                                         const std::string& stop_rule, const std::string& predictor,
-                                        int relax_iterations, const std::string& relaxation)
+                                        int relax_iterations, const std::string& relaxation,
+                                        long long denoise_rounds)
 {
     SemiRegularOptions options;
+    if (denoise_rounds < 0)
+        throw InvalidInput("denoise_rounds must not be negative, got " +
+                           std::to_string(denoise_rounds));
+    options.denoise_rounds = static_cast<std::size_t>(denoise_rounds); // checked by refine()
     options.levels = optional_count(levels, "levels");
     options.base_faces = optional_count(base_faces, "base_faces");
     options.stop_rule = parse_stop_rule(stop_rule);
@@ -282,12 +287,9 @@ void bind_polygonize(py::module_& m)
             ReconstructOptions options;
             options.fill_holes = fill_holes; // checked by the base mesh
             options.rim_reach = rim_reach;   // checked by the point field
-            options.semi_regular = semi_regular_options(levels, base_faces, stop_rule, predictor,
-                                                        relax_iterations, relaxation);
-            if (denoise_rounds < 0)
-                throw InvalidInput("denoise_rounds must not be negative, got " +
-                                   std::to_string(denoise_rounds));
-            options.semi_regular.denoise_rounds = static_cast<std::size_t>(denoise_rounds);
+            options.semi_regular =
+                semi_regular_options(levels, base_faces, stop_rule, predictor, relax_iterations,
+                                     relaxation, denoise_rounds);
             options.fit = parse_plane_fit(fit);
             if (resolution != 0 && resolution < 2)
                 throw InvalidInput("resolution must be at least 2 (or 0 = automatic), got " +
@@ -370,11 +372,11 @@ void bind_polygonize(py::module_& m)
         [](const std::shared_ptr<TriMesh>& mesh, const std::optional<long long>& levels,
            const std::optional<long long>& base_faces, const std::string& stop_rule,
            const std::string& fit, long long samples, std::uint64_t seed, long long k,
-           double radius_scale) {
+           double radius_scale, long long denoise_rounds) {
             RemeshOptions options;
-            options.semi_regular =
-                semi_regular_options(levels, base_faces, stop_rule, default_predictor,
-                                     default_semi_regular.relax_iterations, default_relaxation);
+            options.semi_regular = semi_regular_options(
+                levels, base_faces, stop_rule, default_predictor,
+                default_semi_regular.relax_iterations, default_relaxation, denoise_rounds);
             options.fit = parse_plane_fit(fit);
             options.surfels = {.samples = non_negative(samples, "samples"),
                                .seed = seed,
@@ -393,8 +395,9 @@ void bind_polygonize(py::module_& m)
         py::arg("fit") = "quadric", py::arg("samples") = 0,
         py::arg("seed") = SurfelsFromMeshOptions{}.seed, py::arg("k") = default_neighbors,
         py::arg("radius_scale") = default_field_radius_scale,
+        py::arg("denoise_rounds") = static_cast<long long>(RefineOptions{}.denoise_rounds),
         "remesh(mesh, *, levels=None, base_faces=None, stop_rule='auto', fit='quadric', "
-        "samples=0, seed=1, k=16, radius_scale=1.5) -> Hierarchy\n\n"
+        "samples=0, seed=1, k=16, radius_scale=1.5, denoise_rounds=5) -> Hierarchy\n\n"
         "An irregular mesh to a semi-regular one (paper §6), as `pointform remesh` does: its "
         "surfels (pointform.surfels_from_mesh()), the mesh simplified to the base mesh "
         "(base_faces; default a quarter of its faces within [200, 20000]), refined on their "

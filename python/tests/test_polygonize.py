@@ -245,6 +245,8 @@ def test_noisy_levels_are_denoised_as_the_cli_does(tmp_path):
         pointform.reconstruct(cloud, denoise_rounds=-1)
     with pytest.raises(ValueError, match="denoise"):
         pointform.reconstruct(cloud, denoise_rounds=1001)
+    with pytest.raises(ValueError, match="denoise"):
+        pointform.remesh(pointform.read_mesh(SPOT), denoise_rounds=-1)
 
 
 def test_bad_reconstruct_input(sphere_cloud, tmp_path):
