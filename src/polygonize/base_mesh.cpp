@@ -671,26 +671,32 @@ void fill_holes(OmMesh& mesh, double max_share, BaseMeshStats& stats, std::vecto
     }
 }
 
-/// The mesh in OpenMesh, in world coordinates (where the field is evaluated).
+/// Adds every vertex of `mesh` (in world coordinates, where the field is evaluated) and every
+/// face to the empty `om`, each at its own index; false at the first face OpenMesh refuses
+/// (a complex vertex or edge).
+bool add_to_openmesh(const TriMesh& mesh, OmMesh& om)
+{
+    om.reserve(mesh.vertex_count(), mesh.face_count() * 3 / 2, mesh.face_count());
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+        om.add_vertex(to_om(mesh.vertices.world(v)));
+    for (const Triangle& t : mesh.triangles)
+        if (!om.add_face(OmMesh::VertexHandle(static_cast<int>(t[0])),
+                         OmMesh::VertexHandle(static_cast<int>(t[1])),
+                         OmMesh::VertexHandle(static_cast<int>(t[2])))
+                 .is_valid())
+            return false;
+    return true;
+}
+
+/// The mesh in OpenMesh, in world coordinates, without its isolated vertices.
 OmMesh to_openmesh(const TriMesh& mesh)
 {
     OmMesh om;
-    om.reserve(mesh.vertex_count(), mesh.face_count() * 3 / 2, mesh.face_count());
-    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+    if (!add_to_openmesh(mesh, om))
     {
-        om.add_vertex(to_om(mesh.vertices.world(v)));
-    }
-    for (const Triangle& t : mesh.triangles)
-    {
-        const auto f = om.add_face(OmMesh::VertexHandle(static_cast<int>(t[0])),
-                                   OmMesh::VertexHandle(static_cast<int>(t[1])),
-                                   OmMesh::VertexHandle(static_cast<int>(t[2])));
-        if (!f.is_valid())
-        {
-            throw InvalidInput(
-                "base mesh: the intermediate mesh is not a 2-manifold (a face could "
-                "not be added to the halfedge mesh)");
-        }
+        throw InvalidInput(
+            "base mesh: the intermediate mesh is not a 2-manifold (a face could "
+            "not be added to the halfedge mesh)");
     }
     om.delete_isolated_vertices(); // vertices no triangle uses do not belong to the base mesh
     om.garbage_collection();
@@ -1768,18 +1774,11 @@ HoleFillStats fill_mesh_holes(TriMesh& mesh, double max_share)
     // the patches' vertices and faces come after them.
     OmMesh om;
     const std::size_t vertex_count = mesh.vertex_count();
-    om.reserve(vertex_count, mesh.face_count() * 3 / 2, mesh.face_count());
-    for (std::size_t v = 0; v < vertex_count; ++v)
-        om.add_vertex(to_om(mesh.vertices.world(v)));
-    for (const Triangle& t : mesh.triangles)
-        if (!om.add_face(OmMesh::VertexHandle(static_cast<int>(t[0])),
-                         OmMesh::VertexHandle(static_cast<int>(t[1])),
-                         OmMesh::VertexHandle(static_cast<int>(t[2])))
-                 .is_valid())
-        {
-            result.skipped_not_manifold = true; // a complex vertex analyze_topology() let pass
-            return result;
-        }
+    if (!add_to_openmesh(mesh, om))
+    {
+        result.skipped_not_manifold = true; // a complex vertex analyze_topology() let pass
+        return result;
+    }
     BaseMeshStats stats;
     std::vector<char> filled;
     fill_holes(om, max_share, stats, filled);

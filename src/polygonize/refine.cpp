@@ -833,15 +833,14 @@ NextDetail next_detail(const MultiresMesh& mesh, const Field& field)
     return out;
 }
 
-/// Taubin's λ|μ smoothing of the finest level (RefineOptions::denoise_rounds): `rounds` times
-/// every vertex moves λ of the way to the mean of its neighbours, then μ of it; a vertex on a
+/// Taubin's λ|μ smoothing of the finest level, of `faces` (RefineOptions::denoise_rounds): `rounds`
+/// times every vertex moves λ of the way to the mean of its neighbours, then μ of it; a vertex on a
 /// boundary edge stays. Jacobi steps in parallel blocks: the same positions whatever the thread
 /// count. Returns the farthest move.
-double denoise_finest(MultiresMesh& mesh, std::size_t rounds)
+double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, std::size_t rounds)
 {
     constexpr double lambda = 0.5;
     constexpr double mu = -0.53;
-    const std::vector<Triangle> faces = mesh.faces(mesh.finest_level());
     const std::size_t n = mesh.vertex_count();
     // Neighbours in compressed rows, each row sorted and without repeats; an edge used by one
     // face only marks its ends as boundary.
@@ -1004,11 +1003,11 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
     }
     if (report.stop == RefineStop::NoisyDetails && options.denoise_rounds > 0)
     {
+        const std::vector<Triangle> faces = mesh.faces(mesh.finest_level());
         report.denoise_rounds = options.denoise_rounds;
-        report.denoise_max_move = denoise_finest(mesh, options.denoise_rounds);
+        report.denoise_max_move = denoise_finest(mesh, faces, options.denoise_rounds);
         const Distances after = distances_from(
-            samples, mesh, mesh.faces(mesh.finest_level()), mesh.finest_level(),
-            [&](std::string_view, double fraction) {
+            samples, mesh, faces, mesh.finest_level(), [&](std::string_view, double fraction) {
                 return !options.progress || options.progress("refine: distance", fraction);
             });
         if (report.levels.empty())
