@@ -424,17 +424,12 @@ std::size_t count_flipped(std::span<const Vec3f> before, std::span<const Vec3f> 
 namespace {
 
 /// riemannian_spanning_forest(), with the edges that jump between sheets (Guide::jumps()) at the
-/// worst cost.
+/// worst cost. The sizes and the table are checked by the caller.
 RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
                                  const Guide& guide, const KnnTable& neighbors,
                                  const OrientationOptions& options)
 {
     const std::size_t n = positions.size();
-    if (normals.size() != n || neighbors.rows() != n)
-        throw InvalidInput("orientation: " + std::to_string(n) + " points, " +
-                           std::to_string(normals.size()) + " normals and " +
-                           std::to_string(neighbors.rows()) + " neighbour rows must agree");
-    check_knn_table(neighbors, n, n, "orientation");
     if (n >= RiemannianForest::none)
         throw InvalidInput("orientation: too many points for 32-bit indices");
     RiemannianForest forest;
@@ -746,6 +741,11 @@ RiemannianForest riemannian_spanning_forest(std::span<const Vec3f> positions,
                                             const KnnTable& neighbors,
                                             const OrientationOptions& options)
 {
+    if (normals.size() != positions.size() || neighbors.rows() != positions.size())
+        throw InvalidInput("orientation: " + std::to_string(positions.size()) + " points, " +
+                           std::to_string(normals.size()) + " normals and " +
+                           std::to_string(neighbors.rows()) + " neighbour rows must agree");
+    check_knn_table(neighbors, positions.size(), positions.size(), "orientation");
     return spanning_forest(positions, normals, Guide{}, neighbors, options);
 }
 

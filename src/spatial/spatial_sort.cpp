@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -64,6 +66,57 @@ Aabb parallel_bounding_box(std::span<const Vec3f> positions)
     return box;
 }
 
+/// Sorts (key, index) pairs whose keys are below 2^63 as std::sort would (the pairs are
+/// distinct): a stable scatter by the top bucket_bits bits of the key, block by block (each
+/// block's counts, then every bucket's place for every block), then each bucket sorted on its
+/// own, all in parallel. The buckets of a surface's Morton keys hold a few thousand to some
+/// tens of thousands of samples each, so the sorts run in cache; a sort by comparison of the
+/// whole array would pass over it log n times.
+void bucket_sort(std::vector<std::pair<std::uint64_t, std::uint32_t>>& keyed)
+{
+    constexpr unsigned bucket_bits = 12;
+    constexpr std::size_t buckets = std::size_t{1} << bucket_bits;
+    constexpr unsigned shift = 63 - bucket_bits;
+    constexpr std::size_t block = std::size_t{1} << 18;
+    const std::size_t n = keyed.size();
+    const std::size_t blocks = (n + block - 1) / block;
+    if (blocks <= 1)
+    {
+        std::sort(keyed.begin(), keyed.end());
+        return;
+    }
+    std::vector<std::size_t> place(blocks * buckets, 0); // block-major counts, then offsets
+    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        std::size_t* counts = place.data() + (begin / block) * buckets;
+        for (std::size_t i = begin; i < end; ++i)
+            ++counts[keyed[i].first >> shift];
+    });
+    std::vector<std::size_t> bucket_start(buckets + 1, 0);
+    for (std::size_t b = 0, total = 0; b < buckets; ++b)
+    {
+        bucket_start[b] = total;
+        for (std::size_t k = 0; k < blocks; ++k)
+        {
+            const std::size_t count = place[k * buckets + b];
+            place[k * buckets + b] = total;
+            total += count;
+        }
+        bucket_start[b + 1] = total;
+    }
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> scattered(n);
+    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        std::size_t* next = place.data() + (begin / block) * buckets;
+        for (std::size_t i = begin; i < end; ++i)
+            scattered[next[keyed[i].first >> shift]++] = keyed[i];
+    });
+    parallel_blocks(buckets, 1, [&](std::size_t first, std::size_t last) {
+        for (std::size_t b = first; b < last; ++b)
+            std::sort(scattered.begin() + static_cast<std::ptrdiff_t>(bucket_start[b]),
+                      scattered.begin() + static_cast<std::ptrdiff_t>(bucket_start[b + 1]));
+    });
+    keyed.swap(scattered);
+}
+
 } // namespace
 
 std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions)
@@ -92,7 +145,7 @@ std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions)
                         static_cast<std::uint32_t>(i)};
         }
     });
-    parallel_sort(keyed); // keys paired with their index: a strict order, std::sort's result
+    bucket_sort(keyed); // keys paired with their index: a strict order, std::sort's result
     parallel_blocks(keyed.size(), 1U << 16U, [&](std::size_t begin, std::size_t end) {
         for (std::size_t j = begin; j < end; ++j)
             order[j] = keyed[j].second;

@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/spatial/spatial_sort.h"
+
+#include "pointform/geometry/shapes.h"
+
+#include "../support/thread_counts.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+namespace pointform {
+namespace {
+
+/// The Morton key of a point's cell: 21 bits a coordinate, interleaved x, y, z from the lowest
+/// bit, over a cube of `size` from `lo` (the order spatial_order() documents), bit by bit.
+std::uint64_t morton_key(const Vec3f& p, const Vec3d& lo, double size)
+{
+    std::uint64_t key = 0;
+    for (int axis = 0; axis < 3; ++axis)
+    {
+        const double q = (static_cast<double>(p[axis]) - lo[axis]) * (((1U << 21U) - 1U) / size);
+        const auto cell = static_cast<std::uint64_t>(std::clamp(q, 0.0, double{0x1FFFFF}));
+        for (unsigned bit = 0; bit < 21; ++bit)
+            key |= ((cell >> bit) & 1U) << (3U * bit + static_cast<unsigned>(axis));
+    }
+    return key;
+}
+
+TEST(SpatialOrder, MortonOrderTiesByIndexWhateverTheThreadCount)
+{
+    // Large enough for many blocks of the bucketed sort: a sphere's samples, shuffled, and
+    // piles of duplicates (ties) at a few of them.
+    PointCloud cloud = sample_shape(Shape::Sphere, {.count = 600000, .seed = 3});
+    std::vector<Vec3f> points = cloud.positions;
+    std::mt19937 rng(5);
+    std::shuffle(points.begin(), points.end(), rng);
+    for (std::size_t pile = 0; pile < 40; ++pile)
+        points.insert(points.end(), 500, points[pile * 997]);
+    const auto orders = test::at_thread_counts([&] { return spatial_order(points); });
+    EXPECT_EQ(orders[0], orders[1]);
+    EXPECT_EQ(orders[0], orders[2]);
+    const std::vector<std::uint32_t>& order = orders[0];
+    ASSERT_EQ(order.size(), points.size());
+    std::vector<std::uint8_t> seen(points.size(), 0);
+    Vec3d lo = points[0].cast<double>();
+    Vec3d hi = lo;
+    for (const Vec3f& p : points)
+    {
+        lo = lo.cwiseMin(p.cast<double>());
+        hi = hi.cwiseMax(p.cast<double>());
+    }
+    const double size = (hi - lo).maxCoeff();
+    std::size_t out_of_order = 0;
+    for (std::size_t j = 0; j < order.size(); ++j)
+    {
+        ASSERT_LT(order[j], points.size());
+        EXPECT_EQ(seen[order[j]]++, 0) << "index " << order[j] << " twice";
+        if (j == 0)
+            continue;
+        const std::uint64_t before = morton_key(points[order[j - 1]], lo, size);
+        const std::uint64_t key = morton_key(points[order[j]], lo, size);
+        out_of_order += before > key || (before == key && order[j - 1] > order[j]) ? 1U : 0U;
+    }
+    EXPECT_EQ(out_of_order, 0U);
+}
+
+} // namespace
+} // namespace pointform
