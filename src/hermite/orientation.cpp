@@ -51,22 +51,28 @@ bool usable(const Vec3f& n)
     return n.squaredNorm() > 0.5F;
 }
 
-/// Signed agreement of n_b with the orientation that rule predicts from n_a: its sign says whether
-/// b agrees with a, its magnitude how certain that is.
-float agreement(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
-                OrientationRule rule, std::uint32_t a, std::uint32_t b)
+/// The signed agreement of normal nb at pb with the orientation rule predicts from na at pa
+/// (agreement() takes them from one array).
+float agreement_of(const Vec3f& pa, const Vec3f& na, const Vec3f& pb, const Vec3f& nb,
+                   OrientationRule rule)
 {
-    const Vec3f& na = normals[a];
-    const Vec3f& nb = normals[b];
     const float hoppe = na.dot(nb);
     if (rule == OrientationRule::Hoppe)
         return hoppe;
-    const Vec3f e = positions[b] - positions[a];
+    const Vec3f e = pb - pa;
     const float len2 = e.squaredNorm();
     if (len2 == 0.0F)
         return hoppe;
     const Vec3f predicted = na - (2.0F * na.dot(e) / len2) * e;
     return nb.dot(predicted);
+}
+
+/// Signed agreement of n_b with the orientation that rule predicts from n_a: its sign says whether
+/// b agrees with a, its magnitude how certain that is.
+float agreement(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
+                OrientationRule rule, std::uint32_t a, std::uint32_t b)
+{
+    return agreement_of(positions[a], normals[a], positions[b], normals[b], rule);
 }
 
 float edge_cost(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
@@ -114,9 +120,55 @@ struct Guide
     /// neighbours and lies off a's sheet, or the other way round. Such edges would pass the
     /// orientation of one face of a thin plate to the opposite face unchanged, since their guides
     /// are parallel.
+    /// Entries of the table (row-major) whose edges pass no orientation, whatever the guides
+    /// (the subsample's graph, orient_by_subsample()); empty = none.
+    std::vector<std::uint8_t> blocked;
+    /// Whether `to` lies off the band of `from`'s sheet (false without guides).
+    [[nodiscard]] bool off_sheet(std::span<const Vec3f> positions, std::uint32_t from,
+                                 std::uint32_t to) const
+    {
+        if (reach.empty())
+            return false;
+        const float height = (positions[to] - positions[from]).dot(normals[from]);
+        return std::abs(height - centre[from]) > reach[from];
+    }
+    /// Entries of the table (row-major) across which the orientation turns the other way than
+    /// the rule says from the two normals (the subsample's graph, where the samples between two
+    /// members say so); empty = none.
+    std::vector<std::uint8_t> reversed;
+    /// -1 when the edge a–b is reversed (the entry of the lower-numbered row that lists the
+    /// other decides), else 1.
+    [[nodiscard]] float relation(const KnnTable& table, std::uint32_t a, std::uint32_t b) const
+    {
+        if (reversed.empty())
+            return 1.0F;
+        const auto entry = [&](std::uint32_t from, std::uint32_t to) -> int {
+            const auto row = table.neighbors(from);
+            for (std::size_t c = 0; c < row.size(); ++c)
+                if (row[c] == to)
+                    return reversed[from * table.k + c] != 0 ? -1 : 1;
+            return 0;
+        };
+        const std::uint32_t low = std::min(a, b);
+        const std::uint32_t high = std::max(a, b);
+        const int first = entry(low, high);
+        return (first != 0 ? first : entry(high, low)) < 0 ? -1.0F : 1.0F;
+    }
     [[nodiscard]] bool jumps(std::span<const Vec3f> positions, const KnnTable& table,
                              std::uint32_t a, std::uint32_t b) const
     {
+        if (!blocked.empty())
+        {
+            const auto entry_blocked = [&](std::uint32_t from, std::uint32_t to) {
+                const auto row = table.neighbors(from);
+                for (std::size_t c = 0; c < row.size(); ++c)
+                    if (row[c] == to && blocked[from * table.k + c] != 0)
+                        return true;
+                return false;
+            };
+            if (entry_blocked(a, b) || entry_blocked(b, a))
+                return true;
+        }
         if (reach.empty())
             return false;
         const auto off = [&](std::uint32_t from, std::uint32_t to) {
@@ -749,21 +801,59 @@ RiemannianForest riemannian_spanning_forest(std::span<const Vec3f> positions,
     return spanning_forest(positions, normals, Guide{}, neighbors, options);
 }
 
-OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
-                                   std::span<const Vec3f> fine_normals, const KnnTable& neighbors,
-                                   const OrientationOptions& options)
+namespace {
+
+/// The last two steps of orient_normals_mst() for every component (`component`: one a sample,
+/// RiemannianForest::none to leave a sample out): turn it so that its root (`roots`, one a
+/// component, or none) faces +z, then flip it if its area-weighted flux is clearly negative.
+void face_components(std::span<const Vec3f> positions, const KnnTable& neighbors,
+                     std::span<const std::uint32_t> component, std::span<const std::uint32_t> roots,
+                     std::span<Vec3f> normals)
 {
-    if (fine_normals.size() != positions.size() || neighbors.rows() != positions.size())
-        throw InvalidInput("orientation: " + std::to_string(positions.size()) + " points, " +
-                           std::to_string(fine_normals.size()) + " normals and " +
-                           std::to_string(neighbors.rows()) + " neighbour rows must agree");
-    check_knn_table(neighbors, positions.size(), positions.size(), "orientation");
-    // 0. On noisy clouds, orientation follows normals at a coarser scale and hands their signs to
-    //    the samples' own normals at the end (step 3).
-    //    Edges that jump between sheets (Guide::jumps()) pass no orientation.
-    Guide guide;
-    if (options.rule == OrientationRule::Hoppe && options.guide_rings > 0 && !positions.empty())
-        guide = guide_normals(positions, fine_normals, neighbors, options.guide_rings);
+    const std::size_t n = positions.size();
+    const std::size_t component_count = roots.size();
+    std::vector<std::uint8_t> root_down(component_count, 0);
+    for (std::size_t c = 0; c < component_count; ++c)
+        root_down[c] = roots[c] != RiemannianForest::none && normals[roots[c]].z() < 0.0F;
+    for (std::size_t i = 0; i < n; ++i)
+        if (component[i] != RiemannianForest::none && root_down[component[i]] != 0)
+            normals[i] = -normals[i];
+    //    Σ a_i n_i·(p_i − c), a_i ≈ squared k-th neighbour distance.
+    std::vector<Vec3d> centroid(component_count, Vec3d::Zero());
+    std::vector<double> count(component_count, 0.0);
+    for (std::size_t i = 0; i < n; ++i)
+        if (component[i] != RiemannianForest::none)
+        {
+            centroid[component[i]] += positions[i].cast<double>();
+            count[component[i]] += 1.0;
+        }
+    for (std::size_t c = 0; c < component_count; ++c)
+        centroid[c] /= count[c];
+    std::vector<double> flux(component_count, 0.0);
+    std::vector<double> magnitude(component_count, 0.0);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+        const std::uint32_t c = component[i];
+        if (c == RiemannianForest::none)
+            continue;
+        const double area = neighbors.farthest2(i);
+        const Vec3d d = positions[i].cast<double>() - centroid[c];
+        flux[c] += area * normals[i].cast<double>().dot(d);
+        magnitude[c] += area * d.norm();
+    }
+    for (std::size_t i = 0; i < n; ++i)
+        if (component[i] != RiemannianForest::none &&
+            flux[component[i]] < -flux_decision_threshold * magnitude[component[i]])
+            normals[i] = -normals[i];
+}
+
+/// Steps 1 to 5 of orient_normals_mst() over the whole graph of `neighbors`: spanning forest,
+/// patches, votes, sweeps, roots and flux. `guide` is empty for a clean cloud.
+OrientedNormals orient_graph(std::span<const Vec3f> positions, std::span<const Vec3f> fine_normals,
+                             const Guide& guide, const KnnTable& neighbors,
+                             const OrientationOptions& options,
+                             std::vector<std::uint32_t>* components_only = nullptr)
+{
     const bool guided = !guide.normals.empty();
     const std::span<const Vec3f> normals =
         guided ? std::span<const Vec3f>(guide.normals) : fine_normals;
@@ -798,7 +888,8 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
                                    static_cast<float>(options.patch_cost);
             if (!joins)
                 continue;
-            const float a = agreement(positions, normals, options.rule, parent, v);
+            const float a = agreement(positions, normals, options.rule, parent, v) *
+                            guide.relation(neighbors, parent, v);
             step[v] = a < 0.0F ? disagrees : a > 0.0F ? agrees : neutral;
         }
     });
@@ -847,7 +938,8 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
                 guide.jumps(positions, neighbors, static_cast<std::uint32_t>(i), j))
                 continue;
             const float w = agreement(positions, result.normals, options.rule,
-                                      static_cast<std::uint32_t>(i), j);
+                                      static_cast<std::uint32_t>(i), j) *
+                            guide.relation(neighbors, static_cast<std::uint32_t>(i), j);
             votes.push_back({std::min(pi, pj), std::max(pi, pj), w});
         }
     }
@@ -916,7 +1008,7 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
             result.normals[i] = -result.normals[i];
     //    A patch that no vote reached (each of its edges jumps between sheets: an outlier of the
     //    noise in the gap of a thin plate) takes the sign of its neighbours in reached patches.
-    if (guided)
+    if (guided || !guide.blocked.empty())
     {
         const auto reached = [&](std::size_t i) {
             return patch[i] != RiemannianForest::none && patch_flip[patch[i]] != unvisited;
@@ -928,7 +1020,9 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
                     if (reached(j))
                         pull[patch[i]] +=
                             static_cast<double>(agreement(positions, result.normals, options.rule,
-                                                          static_cast<std::uint32_t>(i), j));
+                                                          static_cast<std::uint32_t>(i), j)) *
+                            static_cast<double>(
+                                guide.relation(neighbors, static_cast<std::uint32_t>(i), j));
         for (std::size_t i = 0; i < n; ++i)
             if (patch[i] != RiemannianForest::none && !reached(i) && pull[patch[i]] < 0.0)
                 result.normals[i] = -result.normals[i];
@@ -943,7 +1037,7 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
     //    comes from its guide below.
     //    After the first sweep only a sample with a neighbour flipped in the sweep before can
     //    flip: with the same neighbours, it would decide as it did then.
-    const std::size_t sweeps = guided ? 0 : options.smoothing_sweeps;
+    const std::size_t sweeps = guided || !guide.reversed.empty() ? 0 : options.smoothing_sweeps;
     std::vector<std::uint8_t> changed(sweeps > 1 ? n : 0, 0);
     std::vector<std::uint8_t> changed_before;
     std::vector<Vec3f> snapshot;
@@ -1004,48 +1098,553 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
             ++result.inherited;
         }
     }
-    std::vector<std::uint8_t> root_down(forest.roots.size(), 0);
-    for (std::size_t c = 0; c < forest.roots.size(); ++c)
-        root_down[c] =
-            forest.roots[c] != RiemannianForest::none && result.normals[forest.roots[c]].z() < 0.0F;
-    for (std::size_t i = 0; i < n; ++i)
-        if (forest.component[i] != RiemannianForest::none && root_down[forest.component[i]] != 0)
-            result.normals[i] = -result.normals[i];
-
-    // 5. Flux test per component: Σ a_i n_i·(p_i − c), a_i ≈ squared k-th neighbour distance.
-    const std::size_t component_count = forest.roots.size();
-    std::vector<Vec3d> centroid(component_count, Vec3d::Zero());
-    std::vector<double> count(component_count, 0.0);
-    for (std::size_t i = 0; i < n; ++i)
+    if (components_only != nullptr)
     {
-        centroid[forest.component[i]] += positions[i].cast<double>();
-        count[forest.component[i]] += 1.0;
+        // The caller turns the components (orient_by_subsample()).
+        *components_only = forest.component;
+        return result;
     }
-    for (std::size_t c = 0; c < component_count; ++c)
-        centroid[c] /= count[c];
-    std::vector<double> flux(component_count, 0.0);
-    std::vector<double> magnitude(component_count, 0.0);
+    face_components(positions, neighbors, forest.component, forest.roots, result.normals);
     for (std::size_t i = 0; i < n; ++i)
-    {
-        const std::uint32_t c = forest.component[i];
-        const double area = neighbors.farthest2(i);
-        const Vec3d d = positions[i].cast<double>() - centroid[c];
-        flux[c] += area * result.normals[i].cast<double>().dot(d);
-        magnitude[c] += area * d.norm();
-    }
-    for (std::size_t i = 0; i < n; ++i)
-    {
-        const std::uint32_t c = forest.component[i];
         if (forest.parent[i] == RiemannianForest::none)
         {
             result.normals[i].setZero();
             result.unoriented.push_back(static_cast<std::uint32_t>(i));
         }
-        else if (flux[c] < -flux_decision_threshold * magnitude[c])
-            result.normals[i] = -result.normals[i];
+    result.flipped = count_flipped(fine_normals, result.normals);
+    return result;
+}
+
+/// Clouds smaller than this are oriented over their whole graph (OrientationOptions::subsample).
+constexpr std::size_t min_subsampled = 2048;
+/// Rounds of the subsample's selection before the samples still undecided join it outright.
+constexpr std::size_t max_selection_rounds = 64;
+/// An edge of the subsample's graph passes no orientation when it leaves both ends' tangent
+/// planes more steeply (|n·ê|) than this plus the sine of half the angle between their normals:
+/// along one smooth sheet an edge tilts by about half the turn of the normals, while an edge
+/// across a thin part (the two sides of a bunny's ear, less than two members apart) joins
+/// parallel normals at a steep angle, and Hoppe's rule would hand one side's orientation to the
+/// other unchanged.
+constexpr float steep_edge = 0.3F;
+/// Sweeps of every sample's sign by its neighbours' after the subsample's signs are passed on.
+constexpr std::size_t fine_sweeps = 1;
+/// Paths between two cells counted towards their edge's verdict before it counts as settled
+/// (the rest are not checked), and the margin of consistent over inconsistent paths (or the
+/// other way) that an edge needs to pass orientation on (or reversed); with less it is blocked.
+constexpr int settled_balance = 4;
+constexpr int min_balance = 2;
+
+/// A fixed pseudo-random priority of each sample, distinct for distinct samples (the index is its
+/// low half): the subsample depends on nothing but the indices.
+std::uint64_t priority(std::uint32_t i)
+{
+    std::uint64_t z = std::uint64_t{i} + 0x9E3779B97F4A7C15ULL;
+    z = (z ^ (z >> 30U)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27U)) * 0x94D049BB133111EBULL;
+    z ^= z >> 31U;
+    return (z << 32U) | i;
+}
+
+/// orient_normals_mst() on a subsample, whose signs then pass to every other sample.
+///
+/// 1. The subsample is a maximal independent set of the neighbour graph (its first
+///    graph_columns() columns), chosen by Luby's rounds with fixed pseudo-random priorities among
+///    the samples with a usable normal: every such sample is a member or has one among its
+///    neighbours (about one sample in six is a member with ten columns).
+/// 2. Every other sample belongs to the cell of its nearest member among its neighbours; two
+///    members are joined when a graph edge joins their cells. Every such edge i–j votes on the
+///    member edge s–t: whether the signs of the steps s–i, i–j and j–t, each reliable (as a tree
+///    step cheaper than patch_cost), compose to the sign the rule gives s–t directly. A clear
+///    majority for passes orientation on, one against reverses it (Guide::reversed), no clear
+///    verdict or an edge off the sheet (steep_edge) blocks it (Guide::blocked: it keeps the
+///    components whole but passes nothing). Each member keeps its nearest `columns` - 1.
+/// 3. orient_graph() orients the members (tree, patches, votes) on that graph; then every other
+///    sample takes the sign of the sum of the reliable agreements its decided neighbours
+///    predict, round by round from the members outwards, and one sweep lets every sample follow
+///    all its neighbours. Each component then faces +z at its highest sample and outwards by its
+///    flux, over all its samples as the whole graph's would; samples without a normal inherit
+///    one over the graph's edges either way.
+///
+/// Every round reads only the last round's state: the result does not depend on the thread
+/// count. On the clean test shapes, the 1M and 10M blobby and the bunny scans the signs are those
+/// of the whole graph (3 corner samples of 40,000 on a thin plate differ).
+OrientedNormals orient_by_subsample(std::span<const Vec3f> positions,
+                                    std::span<const Vec3f> fine_normals, const Guide& guide,
+                                    const KnnTable& neighbors, const OrientationOptions& options)
+{
+    const std::size_t n = positions.size();
+    const bool guided = !guide.normals.empty();
+    const std::span<const Vec3f> normals =
+        guided ? std::span<const Vec3f>(guide.normals) : fine_normals;
+    const std::size_t columns = graph_columns(options, neighbors);
+    constexpr std::size_t block = 8192;
+
+    // 1. The subsample: Luby's maximal independent set over the rows.
+    enum State : std::uint8_t
+    {
+        undecided,
+        member,
+        covered,
+        unusable,
+    };
+    std::vector<std::uint8_t> state(n);
+    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+            state[i] = usable(normals[i]) ? undecided : unusable;
+    });
+    std::vector<std::uint8_t> next(n);
+    for (std::size_t round = 0;; ++round)
+    {
+        std::atomic<bool> open{false};
+        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+            bool local = false;
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                next[i] = state[i];
+                if (state[i] != undecided)
+                    continue;
+                local = true;
+                const std::uint64_t mine = priority(static_cast<std::uint32_t>(i));
+                bool highest = true;
+                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                    highest &= j == i || state[j] != undecided || priority(j) < mine;
+                if (highest || round + 1 == max_selection_rounds)
+                    next[i] = member;
+            }
+            if (local)
+                open.store(true, std::memory_order_relaxed);
+        });
+        if (!open.load())
+            break;
+        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                state[i] = next[i];
+                if (next[i] != undecided)
+                    continue;
+                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                    if (next[j] == member)
+                        state[i] = covered;
+            }
+        });
+    }
+    std::vector<std::uint8_t>().swap(next);
+    std::vector<std::uint32_t> members;
+    for (std::size_t i = 0; i < n; ++i)
+        if (state[i] == member)
+            members.push_back(static_cast<std::uint32_t>(i));
+    const std::size_t m = members.size();
+    //    Each sample's cell: the index of its nearest member among its neighbours (a member is
+    //    its own), and each cell's samples.
+    std::vector<std::uint32_t> cell(n, RiemannianForest::none);
+    parallel_blocks(m, block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t q = begin; q < end; ++q)
+            cell[members[q]] = static_cast<std::uint32_t>(q);
+    });
+    std::vector<std::uint32_t> cell_start(m + 1, 0);
+    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            if (state[i] == covered)
+                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                    if (state[j] == member)
+                    {
+                        cell[i] = cell[j];
+                        break;
+                    }
+            if (cell[i] != RiemannianForest::none)
+                std::atomic_ref<std::uint32_t>(cell_start[cell[i] + 1])
+                    .fetch_add(1, std::memory_order_relaxed);
+        }
+    });
+    for (std::size_t q = 0; q < m; ++q)
+        cell_start[q + 1] += cell_start[q];
+    std::vector<std::uint32_t> cell_samples(cell_start[m]);
+    {
+        std::vector<std::uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
+        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i)
+                if (cell[i] != RiemannianForest::none)
+                    cell_samples[std::atomic_ref<std::uint32_t>(fill[cell[i]])
+                                     .fetch_add(1, std::memory_order_relaxed)] =
+                        static_cast<std::uint32_t>(i);
+        });
+    }
+
+    // 2. The subsample's own graph: each member's nearest `columns` - 1 members within two steps
+    //    (column 0 is the member itself, as in a neighbour table; short rows repeat it), less the
+    //    steep edges under Hoppe's rule.
+    const float reliable = 1.0F - static_cast<float>(options.patch_cost);
+    std::vector<Vec3f> sub_positions(m);
+    std::vector<Vec3f> sub_fine(m);
+    Guide sub_guide;
+    if (guided)
+    {
+        sub_guide.normals.resize(m);
+        sub_guide.centre.resize(m);
+        sub_guide.reach.resize(m);
+    }
+    KnnTable sub_table;
+    sub_table.k = columns;
+    sub_table.indices.resize(m * columns);
+    sub_table.squared_distances.resize(m * columns);
+    sub_guide.blocked.resize(m * columns);
+    sub_guide.reversed.resize(m * columns);
+    parallel_blocks(m, 1024, [&](std::size_t begin, std::size_t end) {
+        // The members whose cells touch this one: distinct, few (about six on a surface).
+        struct Candidate
+        {
+            float len2;
+            std::uint32_t index;
+            bool steep;
+            bool flips;  // the orientation rule's sign across s–t
+            int balance; // consistent minus inconsistent edges between the cells
+        };
+        std::vector<Candidate> found;
+        for (std::size_t q = begin; q < end; ++q)
+        {
+            const std::uint32_t s = members[q];
+            sub_positions[q] = positions[s];
+            sub_fine[q] = fine_normals[s];
+            if (guided)
+            {
+                sub_guide.normals[q] = guide.normals[s];
+                sub_guide.centre[q] = guide.centre[s];
+                sub_guide.reach[q] = guide.reach[s];
+            }
+            found.clear();
+            // Every neighbour graph edge i–j from s's cell to another: it is consistent with
+            // the edge s–t to j's member t when the steps s–i, i–j and j–t compose to the sign
+            // the rule gives s–t directly.
+            const auto flips = [&](std::uint32_t a, std::uint32_t b) {
+                return a != b && agreement(positions, normals, options.rule, a, b) < 0.0F;
+            };
+            // A step's sign, 0 when it is not reliable (as a tree edge dearer than patch_cost).
+            const auto step_sign = [&](std::uint32_t a, std::uint32_t b) {
+                if (a == b)
+                    return 1;
+                const float agree = agreement(positions, normals, options.rule, a, b);
+                return std::abs(agree) >= reliable ? (agree < 0.0F ? -1 : 1) : 0;
+            };
+            for (std::uint32_t c = cell_start[q]; c < cell_start[q + 1]; ++c)
+            {
+                const std::uint32_t i = cell_samples[c];
+                if (i != s && guide.jumps(positions, neighbors, s, i))
+                    continue;
+                const int first = step_sign(s, i);
+                if (first == 0)
+                    continue;
+                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                {
+                    const std::uint32_t other = cell[j];
+                    if (other == RiemannianForest::none || other == q)
+                        continue;
+                    const std::uint32_t t = members[other];
+                    auto at = std::find_if(found.begin(), found.end(),
+                                           [&](const Candidate& x) { return x.index == other; });
+                    if (at == found.end())
+                    {
+                        const Vec3f e = positions[t] - positions[s];
+                        const float len2 = e.squaredNorm();
+                        // Off the sheet: the edge leaves both tangent planes more steeply
+                        // than the turn of the normals explains (about half of it along one
+                        // smooth sheet; parallel normals across a thin part turn not at all).
+                        const float length = std::sqrt(len2);
+                        const float half_turn = std::sqrt(
+                            std::max(0.0F, 0.5F * (1.0F - std::abs(normals[s].dot(normals[t])))));
+                        const float limit = (half_turn + steep_edge) * length;
+                        const bool steep = options.rule == OrientationRule::Hoppe && len2 > 0.0F &&
+                                           std::abs(normals[s].dot(e)) > limit &&
+                                           std::abs(normals[t].dot(e)) > limit;
+                        found.push_back({len2, other, steep, flips(s, t), 0});
+                        at = found.end() - 1;
+                    }
+                    if (at->steep || std::abs(at->balance) >= settled_balance)
+                        continue;
+                    if (guide.jumps(positions, neighbors, i, j) ||
+                        (j != t && guide.jumps(positions, neighbors, t, j)))
+                    {
+                        at->balance -= 1;
+                        continue;
+                    }
+                    const int path = first * step_sign(i, j) * step_sign(j, t);
+                    if (path != 0)
+                        at->balance += (path < 0) == at->flips ? 1 : -1;
+                }
+            }
+            // The nearest members across mostly consistent edges, then the nearest of the rest
+            // as blocked edges: they keep the graph's components whole but pass no orientation.
+            std::sort(found.begin(), found.end(), [](const Candidate& x, const Candidate& y) {
+                const bool x_bad = x.steep || std::abs(x.balance) < min_balance;
+                const bool y_bad = y.steep || std::abs(y.balance) < min_balance;
+                if (x_bad != y_bad)
+                    return y_bad;
+                return x.len2 != y.len2 ? x.len2 < y.len2 : x.index < y.index;
+            });
+            const std::size_t kept = std::min(found.size(), columns - 1);
+            std::uint32_t* row = sub_table.indices.data() + q * columns;
+            float* d2 = sub_table.squared_distances.data() + q * columns;
+            row[0] = static_cast<std::uint32_t>(q);
+            d2[0] = 0.0F;
+            // Nearest first, as in a neighbour table; short rows repeat the member itself.
+            std::sort(found.begin(), found.begin() + static_cast<std::ptrdiff_t>(kept),
+                      [](const Candidate& x, const Candidate& y) {
+                          return x.len2 != y.len2 ? x.len2 < y.len2 : x.index < y.index;
+                      });
+            std::uint8_t* blocked = sub_guide.blocked.data() + q * columns;
+            std::uint8_t* reversed = sub_guide.reversed.data() + q * columns;
+            blocked[0] = 0;
+            reversed[0] = 0;
+            for (std::size_t c = 1; c < columns; ++c)
+            {
+                const bool real = c <= kept;
+                row[c] = real ? found[c - 1].index : static_cast<std::uint32_t>(q);
+                d2[c] = real ? found[c - 1].len2 : d2[c - 1];
+                blocked[c] =
+                    real && (found[c - 1].steep || std::abs(found[c - 1].balance) < min_balance)
+                        ? 1
+                        : 0;
+                reversed[c] = real && found[c - 1].balance <= -min_balance ? 1 : 0;
+            }
+        }
+    });
+    OrientationOptions sub_options = options;
+    sub_options.k = 0;
+    std::vector<std::uint32_t> sub_component;
+    OrientedNormals sub =
+        orient_graph(sub_positions, sub_fine, sub_guide, sub_table, sub_options, &sub_component);
+    std::vector<Vec3f>().swap(sub_positions);
+    std::vector<Vec3f>().swap(sub_fine);
+    sub_table = KnnTable();
+
+    // 3. Every other sample takes its sign from its decided neighbours, members first: the round
+    //    in which a sample is decided is its stamp, and a round reads only earlier stamps.
+    OrientedNormals result;
+    result.components = sub.components;
+    result.normals.assign(n, Vec3f::Zero());
+    constexpr std::uint32_t not_yet = 0xFFFFFFFFU;
+    std::vector<std::uint32_t> stamp(n, not_yet);
+    parallel_blocks(m, block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t q = begin; q < end; ++q)
+        {
+            result.normals[members[q]] = sub.normals[q];
+            stamp[members[q]] = 0;
+        }
+    });
+    std::vector<std::uint32_t>().swap(members);
+    sub = OrientedNormals();
+    const auto decided_before = [&](std::uint32_t j, std::uint32_t round) {
+        return std::atomic_ref<std::uint32_t>(stamp[j]).load(std::memory_order_relaxed) < round;
+    };
+    const auto decide = [&](std::size_t i, std::uint32_t round) {
+        std::atomic_ref<std::uint32_t>(stamp[i]).store(round, std::memory_order_relaxed);
+    };
+    //    Samples with a normal: the sum of the agreements their decided neighbours predict.
+    bool last_resort = false;
+    for (std::uint32_t round = 1;; ++round)
+    {
+        std::atomic<bool> progressed{false};
+        std::atomic<bool> left{false};
+        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+            bool local_progress = false;
+            bool local_left = false;
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                if (state[i] == unusable || stamp[i] != not_yet)
+                    continue;
+                const auto a = static_cast<std::uint32_t>(i);
+                float sum = 0.0F;
+                bool voted = false;
+                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                {
+                    if (j == a || !decided_before(j, round) || !usable(result.normals[j]) ||
+                        guide.jumps(positions, neighbors, a, j))
+                        continue;
+                    const float agree = agreement_of(positions[j], result.normals[j], positions[i],
+                                                     normals[i], options.rule);
+                    if (!(std::abs(agree) >= reliable) && !last_resort)
+                        continue;
+                    sum += agree;
+                    voted = true;
+                }
+                if (!voted)
+                {
+                    local_left = true;
+                    continue;
+                }
+                result.normals[i] = sum < 0.0F ? Vec3f(-normals[i]) : normals[i];
+                decide(i, round);
+                local_progress = true;
+            }
+            if (local_progress)
+                progressed.store(true, std::memory_order_relaxed);
+            if (local_left)
+                left.store(true, std::memory_order_relaxed);
+        });
+        if (!left.load() || (last_resort && !progressed.load()))
+            break;
+        last_resort = !progressed.load();
+    }
+    //    Then every sample re-decides by the sum of the agreements of all its neighbours
+    //    (Jacobi sweeps over a snapshot), so that a sample follows its own neighbourhood rather
+    //    than the one or two members among its neighbours.
+    for (std::size_t sweep = 0; sweep < fine_sweeps; ++sweep)
+    {
+        const std::vector<Vec3f> snapshot = result.normals;
+        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                if (state[i] == unusable || stamp[i] == not_yet)
+                    continue;
+                const auto a = static_cast<std::uint32_t>(i);
+                float sum = 0.0F;
+                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                {
+                    if (j == a || !usable(snapshot[j]) || guide.jumps(positions, neighbors, a, j))
+                        continue;
+                    const float agree = agreement_of(positions[j], snapshot[j], positions[i],
+                                                     snapshot[i], options.rule);
+                    if (std::abs(agree) >= reliable)
+                        sum += agree;
+                }
+                if (sum < 0.0F)
+                    result.normals[i] = -snapshot[i];
+            }
+        });
+    }
+    //    Samples with a normal that no decided sample reached (every edge jumps between sheets)
+    //    keep theirs; samples without one take their nearest decided neighbour's.
+    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+            if (state[i] != unusable && stamp[i] == not_yet)
+            {
+                result.normals[i] = normals[i];
+                stamp[i] = 0;
+            }
+    });
+    //    Over the graph's edges either way: a sample's own row first (nearest first), else the
+    //    lowest-numbered decided sample that lists it.
+    //    Each component faces +z at its highest sample, then outwards by its flux, as the
+    //    whole graph's would (decided over all its samples, not its members).
+    {
+        std::vector<std::uint32_t> component(n, RiemannianForest::none);
+        std::vector<std::uint32_t> roots(result.components, RiemannianForest::none);
+        for (std::size_t i = 0; i < n; ++i)
+        {
+            if (state[i] == unusable || cell[i] == RiemannianForest::none)
+                continue;
+            const std::uint32_t c = sub_component[cell[i]];
+            component[i] = c;
+            std::uint32_t& root = roots[c];
+            if (root == RiemannianForest::none || positions[i].z() > positions[root].z())
+                root = static_cast<std::uint32_t>(i);
+        }
+        face_components(positions, neighbors, component, roots, result.normals);
+    }
+    std::vector<std::uint8_t> inherited(n, 0);
+    std::vector<std::uint32_t> offer(n, not_yet);
+    for (std::uint32_t round = 1;; ++round)
+    {
+        std::atomic<bool> open{false};
+        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+            bool local = false;
+            for (std::size_t j = begin; j < end; ++j)
+            {
+                if (!decided_before(static_cast<std::uint32_t>(j), round) ||
+                    !usable(result.normals[j]))
+                {
+                    local |= stamp[j] == not_yet;
+                    continue;
+                }
+                for (const std::uint32_t i : neighbors.neighbors(j).first(columns))
+                    if (std::atomic_ref<std::uint32_t>(stamp[i]).load(std::memory_order_relaxed) ==
+                        not_yet)
+                    {
+                        std::atomic_ref<std::uint32_t> slot(offer[i]);
+                        std::uint32_t seen = slot.load(std::memory_order_relaxed);
+                        while (j < seen &&
+                               !slot.compare_exchange_weak(seen, static_cast<std::uint32_t>(j),
+                                                           std::memory_order_relaxed))
+                        {}
+                    }
+            }
+            if (local)
+                open.store(true, std::memory_order_relaxed);
+        });
+        if (!open.load())
+            break;
+        std::atomic<bool> progressed{false};
+        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+            bool local = false;
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                if (stamp[i] != not_yet)
+                    continue;
+                std::uint32_t from = offer[i];
+                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                    if (j != i && decided_before(j, round) && usable(result.normals[j]))
+                    {
+                        from = j;
+                        break;
+                    }
+                if (from == not_yet)
+                    continue;
+                result.normals[i] = result.normals[from];
+                inherited[i] = 1;
+                decide(i, round);
+                local = true;
+            }
+            if (local)
+                progressed.store(true, std::memory_order_relaxed);
+        });
+        if (!progressed.load())
+            break;
+    }
+    for (std::size_t i = 0; i < n; ++i)
+    {
+        result.inherited += inherited[i];
+        if (stamp[i] == not_yet)
+            result.unoriented.push_back(static_cast<std::uint32_t>(i));
+    }
+    //    The samples left are components of their own, without a usable normal.
+    if (!result.unoriented.empty())
+    {
+        std::vector<std::uint32_t> local(n, not_yet);
+        for (std::size_t u = 0; u < result.unoriented.size(); ++u)
+            local[result.unoriented[u]] = static_cast<std::uint32_t>(u);
+        DisjointSets groups(result.unoriented.size());
+        std::size_t count = result.unoriented.size();
+        for (std::size_t u = 0; u < result.unoriented.size(); ++u)
+            for (const std::uint32_t j : neighbors.neighbors(result.unoriented[u]).first(columns))
+                if (local[j] != not_yet && groups.unite(u, local[j]))
+                    --count;
+        result.components += count;
     }
     result.flipped = count_flipped(fine_normals, result.normals);
     return result;
+}
+
+} // namespace
+
+OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
+                                   std::span<const Vec3f> fine_normals, const KnnTable& neighbors,
+                                   const OrientationOptions& options)
+{
+    if (fine_normals.size() != positions.size() || neighbors.rows() != positions.size())
+        throw InvalidInput("orientation: " + std::to_string(positions.size()) + " points, " +
+                           std::to_string(fine_normals.size()) + " normals and " +
+                           std::to_string(neighbors.rows()) + " neighbour rows must agree");
+    check_knn_table(neighbors, positions.size(), positions.size(), "orientation");
+    // On noisy clouds, orientation follows normals at a coarser scale and hands their signs to
+    // the samples' own normals at the end. Edges that jump between sheets (Guide::jumps()) pass
+    // no orientation.
+    Guide guide;
+    if (options.rule == OrientationRule::Hoppe && options.guide_rings > 0 && !positions.empty())
+        guide = guide_normals(positions, fine_normals, neighbors, options.guide_rings);
+    if (options.subsample && options.rule == OrientationRule::Hoppe && guide.normals.empty() &&
+        positions.size() >= min_subsampled)
+        return orient_by_subsample(positions, fine_normals, guide, neighbors, options);
+    return orient_graph(positions, fine_normals, guide, neighbors, options);
 }
 
 OrientedNormals orient_normals_towards(std::span<const Vec3f> positions,
