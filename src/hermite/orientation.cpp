@@ -116,13 +116,14 @@ struct Guide
     /// How far from `centre` a point may lie and still be on the sample's sheet.
     std::vector<float> reach;
 
-    /// Whether the edge a–b of the neighbour table jumps between sheets: b is one of a's
-    /// neighbours and lies off a's sheet, or the other way round. Such edges would pass the
-    /// orientation of one face of a thin plate to the opposite face unchanged, since their guides
-    /// are parallel.
     /// Entries of the table (row-major) whose edges pass no orientation, whatever the guides
     /// (the subsample's graph, orient_by_subsample()); empty = none.
     std::vector<std::uint8_t> blocked;
+    /// Entries of the table (row-major) across which the orientation turns the other way than
+    /// the rule says from the two normals (the subsample's graph, where the samples between two
+    /// members say so); empty = none.
+    std::vector<std::uint8_t> reversed;
+
     /// Whether `to` lies off the band of `from`'s sheet (false without guides).
     [[nodiscard]] bool off_sheet(std::span<const Vec3f> positions, std::uint32_t from,
                                  std::uint32_t to) const
@@ -132,53 +133,51 @@ struct Guide
         const float height = (positions[to] - positions[from]).dot(normals[from]);
         return std::abs(height - centre[from]) > reach[from];
     }
-    /// Entries of the table (row-major) across which the orientation turns the other way than
-    /// the rule says from the two normals (the subsample's graph, where the samples between two
-    /// members say so); empty = none.
-    std::vector<std::uint8_t> reversed;
     /// -1 when the edge a–b is reversed (the entry of the lower-numbered row that lists the
     /// other decides), else 1.
     [[nodiscard]] float relation(const KnnTable& table, std::uint32_t a, std::uint32_t b) const
     {
         if (reversed.empty())
             return 1.0F;
-        const auto entry = [&](std::uint32_t from, std::uint32_t to) -> int {
-            const auto row = table.neighbors(from);
-            for (std::size_t c = 0; c < row.size(); ++c)
-                if (row[c] == to)
-                    return reversed[from * table.k + c] != 0 ? -1 : 1;
-            return 0;
-        };
         const std::uint32_t low = std::min(a, b);
         const std::uint32_t high = std::max(a, b);
-        const int first = entry(low, high);
-        return (first != 0 ? first : entry(high, low)) < 0 ? -1.0F : 1.0F;
+        std::size_t at = entry(table, low, high);
+        if (at == no_entry)
+            at = entry(table, high, low);
+        return at != no_entry && reversed[at] != 0 ? -1.0F : 1.0F;
     }
+    /// Whether the edge a–b of the neighbour table jumps between sheets: b is one of a's
+    /// neighbours and lies off a's sheet, or the other way round. Such edges would pass the
+    /// orientation of one face of a thin plate to the opposite face unchanged, since their guides
+    /// are parallel. Blocked entries jump too.
     [[nodiscard]] bool jumps(std::span<const Vec3f> positions, const KnnTable& table,
                              std::uint32_t a, std::uint32_t b) const
     {
         if (!blocked.empty())
         {
-            const auto entry_blocked = [&](std::uint32_t from, std::uint32_t to) {
-                const auto row = table.neighbors(from);
-                for (std::size_t c = 0; c < row.size(); ++c)
-                    if (row[c] == to && blocked[from * table.k + c] != 0)
-                        return true;
-                return false;
-            };
-            if (entry_blocked(a, b) || entry_blocked(b, a))
+            const std::size_t ab = entry(table, a, b);
+            const std::size_t ba = entry(table, b, a);
+            if ((ab != no_entry && blocked[ab] != 0) || (ba != no_entry && blocked[ba] != 0))
                 return true;
         }
-        if (reach.empty())
-            return false;
+        // The row is searched only where off the band, which is rare.
         const auto off = [&](std::uint32_t from, std::uint32_t to) {
-            const float height = (positions[to] - positions[from]).dot(normals[from]);
-            if (!(std::abs(height - centre[from]) > reach[from]))
-                return false;
-            const auto row = table.neighbors(from); // rarely searched: only where off the band
-            return std::find(row.begin(), row.end(), to) != row.end();
+            return off_sheet(positions, from, to) && entry(table, from, to) != no_entry;
         };
         return off(a, b) || off(b, a);
+    }
+
+private:
+    static constexpr std::size_t no_entry = ~std::size_t{0};
+    /// The table entry (row-major) of `to` in `from`'s row, or no_entry.
+    [[nodiscard]] static std::size_t entry(const KnnTable& table, std::uint32_t from,
+                                           std::uint32_t to)
+    {
+        const auto row = table.neighbors(from);
+        for (std::size_t c = 0; c < row.size(); ++c)
+            if (row[c] == to)
+                return from * table.k + c;
+        return no_entry;
     }
 };
 
@@ -1145,7 +1144,8 @@ std::uint64_t priority(std::uint32_t i)
     return (z << 32U) | i;
 }
 
-/// orient_normals_mst() on a subsample, whose signs then pass to every other sample.
+/// orient_normals_mst() on a subsample, whose signs then pass to every other sample: for clean
+/// clouds under Hoppe's rule (noisy clouds keep the guided whole graph, orient_graph()).
 ///
 /// 1. The subsample is a maximal independent set of the neighbour graph (its first
 ///    graph_columns() columns), chosen by Luby's rounds with fixed pseudo-random priorities among
@@ -1169,13 +1169,10 @@ std::uint64_t priority(std::uint32_t i)
 /// count. On the clean test shapes, the 1M and 10M blobby and the bunny scans the signs are those
 /// of the whole graph (3 corner samples of 40,000 on a thin plate differ).
 OrientedNormals orient_by_subsample(std::span<const Vec3f> positions,
-                                    std::span<const Vec3f> fine_normals, const Guide& guide,
-                                    const KnnTable& neighbors, const OrientationOptions& options)
+                                    std::span<const Vec3f> normals, const KnnTable& neighbors,
+                                    const OrientationOptions& options)
 {
     const std::size_t n = positions.size();
-    const bool guided = !guide.normals.empty();
-    const std::span<const Vec3f> normals =
-        guided ? std::span<const Vec3f>(guide.normals) : fine_normals;
     const std::size_t columns = graph_columns(options, neighbors);
     constexpr std::size_t block = 8192;
 
@@ -1271,19 +1268,13 @@ OrientedNormals orient_by_subsample(std::span<const Vec3f> positions,
         });
     }
 
-    // 2. The subsample's own graph: each member's nearest `columns` - 1 members within two steps
-    //    (column 0 is the member itself, as in a neighbour table; short rows repeat it), less the
-    //    steep edges under Hoppe's rule.
+    // 2. The subsample's own graph: each member's nearest `columns` - 1 members among those whose
+    //    cells touch its own (column 0 is the member itself, as in a neighbour table; short rows
+    //    repeat it), mostly consistent edges first; steep and undecided edges are blocked.
     const float reliable = 1.0F - static_cast<float>(options.patch_cost);
     std::vector<Vec3f> sub_positions(m);
     std::vector<Vec3f> sub_fine(m);
     Guide sub_guide;
-    if (guided)
-    {
-        sub_guide.normals.resize(m);
-        sub_guide.centre.resize(m);
-        sub_guide.reach.resize(m);
-    }
     KnnTable sub_table;
     sub_table.k = columns;
     sub_table.indices.resize(m * columns);
@@ -1305,13 +1296,7 @@ OrientedNormals orient_by_subsample(std::span<const Vec3f> positions,
         {
             const std::uint32_t s = members[q];
             sub_positions[q] = positions[s];
-            sub_fine[q] = fine_normals[s];
-            if (guided)
-            {
-                sub_guide.normals[q] = guide.normals[s];
-                sub_guide.centre[q] = guide.centre[s];
-                sub_guide.reach[q] = guide.reach[s];
-            }
+            sub_fine[q] = normals[s];
             found.clear();
             // Every neighbour graph edge i–j from s's cell to another: it is consistent with
             // the edge s–t to j's member t when the steps s–i, i–j and j–t compose to the sign
@@ -1329,8 +1314,6 @@ OrientedNormals orient_by_subsample(std::span<const Vec3f> positions,
             for (std::uint32_t c = cell_start[q]; c < cell_start[q + 1]; ++c)
             {
                 const std::uint32_t i = cell_samples[c];
-                if (i != s && guide.jumps(positions, neighbors, s, i))
-                    continue;
                 const int first = step_sign(s, i);
                 if (first == 0)
                     continue;
@@ -1361,12 +1344,6 @@ OrientedNormals orient_by_subsample(std::span<const Vec3f> positions,
                     }
                     if (at->steep || std::abs(at->balance) >= settled_balance)
                         continue;
-                    if (guide.jumps(positions, neighbors, i, j) ||
-                        (j != t && guide.jumps(positions, neighbors, t, j)))
-                    {
-                        at->balance -= 1;
-                        continue;
-                    }
                     const int path = first * step_sign(i, j) * step_sign(j, t);
                     if (path != 0)
                         at->balance += (path < 0) == at->flips ? 1 : -1;
@@ -1457,8 +1434,7 @@ OrientedNormals orient_by_subsample(std::span<const Vec3f> positions,
                 bool voted = false;
                 for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
                 {
-                    if (j == a || !decided_before(j, round) || !usable(result.normals[j]) ||
-                        guide.jumps(positions, neighbors, a, j))
+                    if (j == a || !decided_before(j, round) || !usable(result.normals[j]))
                         continue;
                     const float agree = agreement_of(positions[j], result.normals[j], positions[i],
                                                      normals[i], options.rule);
@@ -1500,7 +1476,7 @@ OrientedNormals orient_by_subsample(std::span<const Vec3f> positions,
                 float sum = 0.0F;
                 for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
                 {
-                    if (j == a || !usable(snapshot[j]) || guide.jumps(positions, neighbors, a, j))
+                    if (j == a || !usable(snapshot[j]))
                         continue;
                     const float agree = agreement_of(positions[j], snapshot[j], positions[i],
                                                      snapshot[i], options.rule);
@@ -1620,7 +1596,7 @@ OrientedNormals orient_by_subsample(std::span<const Vec3f> positions,
                     --count;
         result.components += count;
     }
-    result.flipped = count_flipped(fine_normals, result.normals);
+    result.flipped = count_flipped(normals, result.normals);
     return result;
 }
 
@@ -1643,7 +1619,7 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
         guide = guide_normals(positions, fine_normals, neighbors, options.guide_rings);
     if (options.subsample && options.rule == OrientationRule::Hoppe && guide.normals.empty() &&
         positions.size() >= min_subsampled)
-        return orient_by_subsample(positions, fine_normals, guide, neighbors, options);
+        return orient_by_subsample(positions, fine_normals, neighbors, options);
     return orient_graph(positions, fine_normals, guide, neighbors, options);
 }
 
