@@ -141,7 +141,10 @@ struct OrientedNormals
 /// into patches, which are flipped against each other by the summed agreement of every graph
 /// edge between them. Then `options.smoothing_sweeps` times, every sample takes the sign of its
 /// neighbours' weighted mean normal. On noisy clouds (Hoppe rule) all this runs on coarser-scale
-/// guide normals (`options.guide_rings`), which are then the output normals; there an edge whose
+/// guide normals (`options.guide_rings`), which are then the output normals (after a vote of
+/// each sample's neighbours on its sheet: a guide that fewer than 6 of them support within 30°,
+/// a stray of the noise, takes the principal axis of theirs, and every normal turns to the side
+/// they point to); there an edge whose
 /// end lies off the other end's sheet (its height along that end's guide more than 3 robust
 /// deviations of the local noise from the median of that end's neighbours) neither passes
 /// orientation nor votes, so the two faces of a noisy thin plate, whose outliers meet in the gap
