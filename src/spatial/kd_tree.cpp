@@ -80,24 +80,25 @@ public:
         }
         distances_[i] = dist;
         indices_[i] = index;
+        if (full())
+        {
+            // The bound only changes here: worked out once, not at every node of the search.
+            constexpr float slack = 1.0F + 0x1p-16F;
+            const float worst = distances_[capacity_ - 1];
+            bound_ = std::max(worst * slack, std::nextafter(worst, infinity));
+        }
         return true;
     }
 
-    [[nodiscard]] float worstDist() const
-    {
-        constexpr float infinity = std::numeric_limits<float>::infinity();
-        constexpr float slack = 1.0F + 0x1p-16F;
-        if (!full())
-            return infinity;
-        const float worst = distances_[capacity_ - 1];
-        return std::max(worst * slack, std::nextafter(worst, infinity));
-    }
+    [[nodiscard]] float worstDist() const { return bound_; }
 
 private:
     std::size_t capacity_;
     std::uint32_t* indices_;
     float* distances_;
     std::size_t count_ = 0;
+    static constexpr float infinity = std::numeric_limits<float>::infinity();
+    float bound_ = infinity; ///< worstDist(): infinite until full
 };
 
 using Node = NanoTree::Node;
