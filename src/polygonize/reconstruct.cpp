@@ -82,6 +82,26 @@ void check_semi_regular_options(const SemiRegularOptions& options)
         throw InvalidInput("the exact stop rule needs the levels to refine to");
 }
 
+/// The level count of a built base mesh whose finest level stays within a vertex budget (each
+/// 1-to-4 level adds an edge's worth of vertices: V' = V + E, E = V + F − χ), and the base-face
+/// target that fills the budget with that many levels (fit_base_faces_to_budget()).
+std::size_t target_for_affordable_levels(const TriMesh& base, std::size_t budget)
+{
+    const MeshTopology topology = analyze_topology(base);
+    auto v = static_cast<double>(topology.vertices);
+    auto f = static_cast<double>(topology.faces);
+    const auto chi = static_cast<double>(topology.euler_characteristic);
+    std::size_t levels = 0;
+    while (levels < max_exact_levels && v + (v + f - chi) <= static_cast<double>(budget))
+    {
+        v += v + f - chi;
+        f *= 4.0;
+        ++levels;
+    }
+    const double faces_wanted = 2.0 * default_budget_fill * static_cast<double>(budget);
+    return static_cast<std::size_t>(std::llround(faces_wanted / std::pow(4.0, levels)));
+}
+
 } // namespace
 
 std::size_t base_face_target(const SemiRegularOptions& options, const TriMesh& intermediate,
@@ -191,6 +211,19 @@ SemiRegularReport semi_regular_mesh(const TriMesh& intermediate, const Field& fi
     BaseMeshResult built = build_base_mesh(
         intermediate, field,
         {.target_faces = target, .fill_holes = options.fill_holes, .progress = progress});
+    if (!options.base_faces && !options.levels && options.stop_rule == StopRule::Automatic &&
+        samples != nullptr && !samples->empty())
+    {
+        // A base mesh whose topology (a scan of many handles) kept it well above the fitted
+        // target reaches the vertex budget a level early, at a quarter of the vertices the fit
+        // planned: built again for the levels it affords, with a target that fills the budget.
+        const std::size_t refit = std::min(
+            intermediate.face_count(), target_for_affordable_levels(built.mesh, samples->size()));
+        if (2 * refit > 3 * built.mesh.face_count())
+            built = build_base_mesh(
+                intermediate, field,
+                {.target_faces = refit, .fill_holes = options.fill_holes, .progress = progress});
+    }
     const double base_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     SemiRegularReport r = refine_semi_regular(built.mesh, field, samples, options, progress);

@@ -139,6 +139,10 @@ inline constexpr std::size_t max_default_base_faces = 80000;
                                              std::size_t share = default_base_share,
                                              double coarsening = 1.0);
 
+/// The share of a vertex budget that a base mesh's refinement levels are planned to reach
+/// (fit_base_faces_to_budget()).
+inline constexpr double default_budget_fill = 0.6;
+
 /// \brief Moves a base-face target by at most a factor of two so that some refinement level of
 /// it has about `fill` of a vertex budget: the level J nearest to log₄(2·fill·budget / target),
 /// and F0 = 2·fill·budget / 4^J (a closed mesh of F faces has about F / 2 vertices). With a
@@ -147,7 +151,7 @@ inline constexpr std::size_t max_default_base_faces = 80000;
 /// target that alone would exceed the budget is returned as it is.
 /// \pre 0 < fill <= 1
 [[nodiscard]] std::size_t fit_base_faces_to_budget(std::size_t target, std::size_t vertex_budget,
-                                                   double fill = 0.6);
+                                                   double fill = default_budget_fill);
 
 /// Most triangles around one vertex that build_base_mesh() takes. The decimation re-ranks every
 /// collapse around a vertex whenever its neighbourhood changes, and each test walks the vertex's
