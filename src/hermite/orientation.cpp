@@ -158,9 +158,11 @@ struct Guide
     {
         if (!blocked.empty())
         {
-            const std::size_t ab = entry(table, a, b);
-            const std::size_t ba = entry(table, b, a);
-            if ((ab != no_entry && blocked[ab] != 0) || (ba != no_entry && blocked[ba] != 0))
+            const auto is_blocked = [&](std::uint32_t from, std::uint32_t to) {
+                const std::size_t at = entry(table, from, to);
+                return at != no_entry && blocked[at] != 0;
+            };
+            if (is_blocked(a, b) || is_blocked(b, a))
                 return true;
         }
         // The row is searched only where off the band, which is rare.
@@ -452,20 +454,19 @@ Guide guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> nor
     std::vector<Moments>().swap(next);
     Guide result;
     result.normals.assign(n, Vec3f::Zero());
+    result.confidence.resize(n);
     parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
+        {
+            const float confidence = std::max(0.0F, 1.0F - best_flatness[i]);
+            result.confidence[i] = confidence * confidence;
             if (usable(normals[i]))
             {
                 const Vec3f axis = least_axis(best[i]);
                 result.normals[i] = best_flatness[i] < 1.0F && usable(axis) ? axis : normals[i];
             }
+        }
     });
-    result.confidence.resize(n);
-    for (std::size_t i = 0; i < n; ++i)
-    {
-        const float confidence = std::max(0.0F, 1.0F - best_flatness[i]);
-        result.confidence[i] = confidence * confidence;
-    }
     mark_sheets(positions, neighbors, result);
     return result;
 }

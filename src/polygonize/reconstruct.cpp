@@ -82,12 +82,11 @@ void check_semi_regular_options(const SemiRegularOptions& options)
         throw InvalidInput("the exact stop rule needs the levels to refine to");
 }
 
-/// The level count of a built base mesh whose finest level stays within a vertex budget (each
-/// 1-to-4 level adds an edge's worth of vertices: V' = V + E, E = V + F − χ), and the base-face
-/// target that fills the budget with that many levels (fit_base_faces_to_budget()).
-std::size_t target_for_affordable_levels(const TriMesh& base, std::size_t budget)
+/// The level count of a built base mesh (its topology) whose finest level stays within a vertex
+/// budget (each 1-to-4 level adds an edge's worth of vertices: V' = V + E, E = V + F − χ), and
+/// the base-face target that fills the budget with that many levels (fit_base_faces_to_budget()).
+std::size_t target_for_affordable_levels(const MeshTopology& topology, std::size_t budget)
 {
-    const MeshTopology topology = analyze_topology(base);
     auto v = static_cast<double>(topology.vertices);
     auto f = static_cast<double>(topology.faces);
     const auto chi = static_cast<double>(topology.euler_characteristic);
@@ -217,8 +216,9 @@ SemiRegularReport semi_regular_mesh(const TriMesh& intermediate, const Field& fi
         // A base mesh whose topology (a scan of many handles) kept it well above the fitted
         // target reaches the vertex budget a level early, at a quarter of the vertices the fit
         // planned: built again for the levels it affords, with a target that fills the budget.
-        const std::size_t refit = std::min(
-            intermediate.face_count(), target_for_affordable_levels(built.mesh, samples->size()));
+        const std::size_t refit =
+            std::min(intermediate.face_count(),
+                     target_for_affordable_levels(built.stats.topology_after, samples->size()));
         if (2 * refit > 3 * built.mesh.face_count())
             built = build_base_mesh(
                 intermediate, field,
