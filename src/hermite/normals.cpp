@@ -18,11 +18,17 @@ namespace {
 /// undefined. Relative, so independent of units.
 constexpr double collinear_ratio = 1e-10;
 
-/// fit_plane() on indices known to be in range (a checked neighbour table), at least one.
-LocalPlane fit_unchecked(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices)
+/// The covariance of positions[indices] about their mean, and that mean, summed in double about
+/// the first point (so the sums do not lose precision far from the origin). Indices in range,
+/// at least one.
+struct Moments
 {
-    LocalPlane fit;
-    // Shift by the first point so the sums do not lose precision far from the origin.
+    Vec3d centroid;
+    Mat3d covariance;
+};
+
+Moments moments_of(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices)
+{
     const Vec3d shift = positions[indices[0]].cast<double>();
     Vec3d sum = Vec3d::Zero();
     Mat3d outer = Mat3d::Zero();
@@ -34,18 +40,80 @@ LocalPlane fit_unchecked(std::span<const Vec3f> positions, std::span<const std::
     }
     const double count = static_cast<double>(indices.size());
     const Vec3d mean = sum / count;
-    const Mat3d covariance = outer / count - mean * mean.transpose();
-    fit.centroid = mean + shift;
+    return {mean + shift, outer / count - mean * mean.transpose()};
+}
 
+/// The sum of the principal 2×2 minors of a symmetric matrix (λ0λ1 + λ0λ2 + λ1λ2): about
+/// λ1λ2 when λ0 is small, zero on a line, to double rounding (the closed-form eigen-solve leaves
+/// an exact line's middle eigenvalue at up to a few 1e-9 of the largest).
+double second_invariant(const Mat3d& c)
+{
+    return c(0, 0) * c(1, 1) - c(0, 1) * c(0, 1) + c(0, 0) * c(2, 2) - c(0, 2) * c(0, 2) +
+           c(1, 1) * c(2, 2) - c(1, 2) * c(1, 2);
+}
+
+/// The plane of a covariance by Eigen's closed-form solve: its eigenvalues, and its normal unless
+/// the points are coincident or collinear (λ1 / λ2, or I2 / I1², below collinear_ratio).
+LocalPlane solve_plane(const Moments& moments)
+{
+    LocalPlane fit;
+    fit.centroid = moments.centroid;
     Eigen::SelfAdjointEigenSolver<Mat3d> solver;
-    solver.computeDirect(covariance);
+    solver.computeDirect(moments.covariance);
     fit.eigenvalues = solver.eigenvalues().cwiseMax(0.0);
     const double largest = fit.eigenvalues[2];
+    const double trace = moments.covariance.trace();
     fit.degenerate = !(largest > 0.0) || fit.eigenvalues[1] <= collinear_ratio * largest ||
+                     second_invariant(moments.covariance) <= collinear_ratio * trace * trace ||
                      !solver.eigenvectors().allFinite();
     if (!fit.degenerate)
         fit.normal = solver.eigenvectors().col(0).normalized();
     return fit;
+}
+
+/// Below this ratio I2 / I1² of a covariance's invariants (about λ1 / λ2 when λ0 is small, and
+/// at least λ1 / (3 λ2)) fast_normal() leaves the neighbourhood to solve_plane(): nearly a line,
+/// where the least eigenvalue is close to the middle one and the rule for a line applies.
+constexpr double fast_min_spread = 1e-6;
+
+/// The unit eigenvector of the least eigenvalue λ0 of a covariance C, without trigonometry:
+/// λ0 by Newton's method on the characteristic polynomial p(λ) = λ³ − I1 λ² + I2 λ − I3 from 0,
+/// which climbs to it without overshooting (p is increasing and concave below its least root,
+/// since λ0 ≤ I1 / 3), then the longest column of adj(C − λ0 I), which spans the kernel of
+/// C − λ0 I when λ0 is simple. Zero when C is nearly a line or λ0 is not clearly simple (the
+/// columns all but vanish): solve_plane() then decides.
+Vec3d fast_normal(const Mat3d& c)
+{
+    const double i1 = c.trace();
+    const double i2 = second_invariant(c);
+    if (!(i1 > 0.0) || !(i2 > fast_min_spread * i1 * i1))
+        return Vec3d::Zero();
+    const double i3 = c.determinant();
+    double lambda = 0.0;
+    for (int step = 0; step < 64; ++step)
+    {
+        const double value = ((lambda - i1) * lambda + i2) * lambda - i3;
+        const double slope = (3.0 * lambda - 2.0 * i1) * lambda + i2;
+        const double move = -value / slope;
+        if (!(move > 0.0) || !std::isfinite(move))
+            break; // at the root to rounding (or past it by rounding)
+        lambda += move;
+        if (move <= 1e-15 * i1)
+            break;
+    }
+    const Mat3d m = c - lambda * Mat3d::Identity();
+    const Vec3d a = m.row(1).cross(m.row(2)).transpose();
+    const Vec3d b = m.row(0).cross(m.row(2)).transpose();
+    const Vec3d d = m.row(0).cross(m.row(1)).transpose();
+    const double na = a.squaredNorm();
+    const double nb = b.squaredNorm();
+    const double nd = d.squaredNorm();
+    const Vec3d& longest = na >= nb && na >= nd ? a : (nb >= nd ? b : d);
+    const double length2 = std::max({na, nb, nd});
+    // The columns' length is about (λ1 − λ0)(λ2 − λ0): tiny against I2 when λ0 is (nearly) double.
+    if (!(length2 > (fast_min_spread * i2) * (fast_min_spread * i2)))
+        return Vec3d::Zero();
+    return longest / std::sqrt(length2);
 }
 
 } // namespace
@@ -59,7 +127,7 @@ LocalPlane fit_plane(std::span<const Vec3f> positions, std::span<const std::uint
             throw InvalidInput("fit_plane: index " + std::to_string(index) +
                                " is out of range for " + std::to_string(positions.size()) +
                                " points");
-    return fit_unchecked(positions, indices);
+    return solve_plane(moments_of(positions, indices));
 }
 
 Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
@@ -83,7 +151,15 @@ Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neigh
                                            " of row " + std::to_string(i) +
                                            " is out of range for " +
                                            std::to_string(positions.size()) + " points");
-                const LocalPlane fit = fit_unchecked(positions, row);
+                const Moments moments = moments_of(positions, row);
+                const Vec3d fast = fast_normal(moments.covariance);
+                if (fast.squaredNorm() > 0.0)
+                {
+                    result.normals[i] = fast.cast<float>();
+                    degenerate[i] = 0;
+                    continue;
+                }
+                const LocalPlane fit = solve_plane(moments);
                 result.normals[i] = fit.normal.cast<float>();
                 degenerate[i] = fit.degenerate ? 1 : 0;
             }

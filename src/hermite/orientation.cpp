@@ -92,6 +92,13 @@ float edge_cost(std::span<const Vec3f> positions, std::span<const Vec3f> normals
 /// plate thinner than the guide's reach scores 0, so it is never guided across its walls.
 constexpr float noisy_flatness = 0.02F;
 
+/// The noise test (guide_normals()) takes every noise_test_stride-th sample of clouds of at least
+/// noise_test_sampled samples (so at least 8,192 of them; a million give 125,000): its median
+/// then moves far less than the margin between clean and noisy clouds, at an eighth of the cost
+/// (the test was a tenth of the orientation of a clean cloud).
+constexpr std::size_t noise_test_stride = 8;
+constexpr std::size_t noise_test_sampled = 65536;
+
 /// A point lies off a sample's sheet when its height along the sample's guide is more than this
 /// many robust standard deviations of the noise from the median height of the sample's
 /// neighbours (mark_sheets()): under Gaussian noise 3 keeps 99.7% of a sheet's own samples,
@@ -392,19 +399,22 @@ Guide guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> nor
         }
         return finish({p.x(), p.y(), p.z()}, sum, outer, static_cast<float>(row.size()));
     };
-    // Clean enough when the median flatness (the value at n / 2 in order) is below
-    // noisy_flatness, that is when more than n / 2 samples are flatter: counted, not sorted, and
-    // nothing kept for a clean cloud, whose samples' own normals are the best guide.
+    // Clean enough when the median flatness (the value at half the count in order) is below
+    // noisy_flatness, that is when more than half the samples are flatter: counted, not sorted,
+    // and nothing kept for a clean cloud, whose samples' own normals are the best guide. Counted
+    // on every stride-th sample (in Morton order, an even spread over the surface).
     {
+        const std::size_t stride = n >= noise_test_sampled ? noise_test_stride : 1;
+        const std::size_t tested = (n + stride - 1) / stride;
         constexpr std::size_t block = 4096;
-        std::vector<std::size_t> flatter((n + block - 1) / block, 0);
-        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        std::vector<std::size_t> flatter((tested + block - 1) / block, 0);
+        parallel_blocks(tested, block, [&](std::size_t begin, std::size_t end) {
             std::size_t count = 0;
-            for (std::size_t i = begin; i < end; ++i)
-                count += flatness(own_moments(i).covariance) < noisy_flatness ? 1U : 0U;
+            for (std::size_t t = begin; t < end; ++t)
+                count += flatness(own_moments(t * stride).covariance) < noisy_flatness ? 1U : 0U;
             flatter[begin / block] = count;
         });
-        if (std::accumulate(flatter.begin(), flatter.end(), std::size_t{0}) > n / 2)
+        if (std::accumulate(flatter.begin(), flatter.end(), std::size_t{0}) > tested / 2)
             return {};
     }
     std::vector<Moments> current(n);
@@ -1332,6 +1342,16 @@ OrientedNormals orient_by_subsample(std::span<const Vec3f> positions,
         for (std::size_t q = begin; q < end; ++q)
             cell[members[q]] = static_cast<std::uint32_t>(q);
     });
+    //    A step's sign, 0 when it is not reliable (as a tree edge dearer than patch_cost); and
+    //    each sample's step from its member.
+    const float reliable = 1.0F - static_cast<float>(options.patch_cost);
+    const auto step_sign = [&](std::uint32_t a, std::uint32_t b) -> std::int8_t {
+        if (a == b)
+            return 1;
+        const float agree = agreement(positions, normals, options.rule, a, b);
+        return std::abs(agree) >= reliable ? (agree < 0.0F ? -1 : 1) : 0;
+    };
+    std::vector<std::int8_t> from_member(n, 0);
     std::vector<std::uint32_t> cell_start(m + 1, 0);
     parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
@@ -1341,8 +1361,11 @@ OrientedNormals orient_by_subsample(std::span<const Vec3f> positions,
                     if (state[j] == member)
                     {
                         cell[i] = cell[j];
+                        from_member[i] = step_sign(j, static_cast<std::uint32_t>(i));
                         break;
                     }
+            if (state[i] == member)
+                from_member[i] = 1;
             if (cell[i] != RiemannianForest::none)
                 std::atomic_ref<std::uint32_t>(cell_start[cell[i] + 1])
                     .fetch_add(1, std::memory_order_relaxed);
@@ -1365,7 +1388,6 @@ OrientedNormals orient_by_subsample(std::span<const Vec3f> positions,
     // 2. The subsample's own graph: each member's nearest `columns` - 1 members among those whose
     //    cells touch its own (column 0 is the member itself, as in a neighbour table; short rows
     //    repeat it), mostly consistent edges first; steep and undecided edges are blocked.
-    const float reliable = 1.0F - static_cast<float>(options.patch_cost);
     std::vector<Vec3f> sub_positions(m);
     std::vector<Vec3f> sub_fine(m);
     Guide sub_guide;
@@ -1398,17 +1420,10 @@ OrientedNormals orient_by_subsample(std::span<const Vec3f> positions,
             const auto flips = [&](std::uint32_t a, std::uint32_t b) {
                 return a != b && agreement(positions, normals, options.rule, a, b) < 0.0F;
             };
-            // A step's sign, 0 when it is not reliable (as a tree edge dearer than patch_cost).
-            const auto step_sign = [&](std::uint32_t a, std::uint32_t b) {
-                if (a == b)
-                    return 1;
-                const float agree = agreement(positions, normals, options.rule, a, b);
-                return std::abs(agree) >= reliable ? (agree < 0.0F ? -1 : 1) : 0;
-            };
             for (std::uint32_t c = cell_start[q]; c < cell_start[q + 1]; ++c)
             {
                 const std::uint32_t i = cell_samples[c];
-                const int first = step_sign(s, i);
+                const int first = from_member[i];
                 if (first == 0)
                     continue;
                 for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
@@ -1438,7 +1453,7 @@ OrientedNormals orient_by_subsample(std::span<const Vec3f> positions,
                     }
                     if (at->steep || std::abs(at->balance) >= settled_balance)
                         continue;
-                    const int path = first * step_sign(i, j) * step_sign(j, t);
+                    const int path = first * step_sign(i, j) * from_member[j];
                     if (path != 0)
                         at->balance += (path < 0) == at->flips ? 1 : -1;
                 }

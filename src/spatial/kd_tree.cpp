@@ -83,9 +83,11 @@ public:
         if (full())
         {
             // The bound only changes here: worked out once, not at every node of the search.
+            // Above the smallest normal float the slack is already more than one ulp.
             constexpr float slack = 1.0F + 0x1p-16F;
             const float worst = distances_[capacity_ - 1];
-            bound_ = std::max(worst * slack, std::nextafter(worst, infinity));
+            bound_ = worst >= std::numeric_limits<float>::min() ? worst * slack
+                                                                : std::nextafter(worst, infinity);
         }
         return true;
     }

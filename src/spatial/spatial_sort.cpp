@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -66,55 +68,103 @@ Aabb parallel_bounding_box(std::span<const Vec3f> positions)
     return box;
 }
 
-/// Sorts (key, index) pairs whose keys are below 2^63 as std::sort would (the pairs are
-/// distinct): a stable scatter by the top bucket_bits bits of the key, block by block (each
-/// block's counts, then every bucket's place for every block), then each bucket sorted on its
-/// own, all in parallel. The buckets of a surface's Morton keys hold a few thousand to some
-/// tens of thousands of samples each, so the sorts run in cache; a sort by comparison of the
-/// whole array would pass over it log n times.
-void bucket_sort(std::vector<std::pair<std::uint64_t, std::uint32_t>>& keyed)
+/// A Morton key and the index it was made for. No default member initialisers: arrays of them are
+/// filled by the passes that follow, not zeroed first by one thread.
+struct Keyed
 {
-    constexpr unsigned bucket_bits = 12;
-    constexpr std::size_t buckets = std::size_t{1} << bucket_bits;
-    constexpr unsigned shift = 63 - bucket_bits;
+    std::uint64_t key;
+    std::uint32_t index;
+
+    friend bool operator<(const Keyed& a, const Keyed& b)
+    {
+        return a.key != b.key ? a.key < b.key : a.index < b.index;
+    }
+};
+
+/// Bits of the key that each counting pass of bucket_sort() takes.
+constexpr unsigned radix_bits = 12;
+constexpr std::size_t radix = std::size_t{1} << radix_bits;
+/// Runs shorter than this are sorted by comparison rather than counted.
+constexpr std::size_t min_counted = 256;
+
+/// Sorts run by key, then index, as std::sort would: by the radix_bits of the key below
+/// `shift` + radix_bits (those above are the same throughout the run) into `scratch`, then each
+/// part sorted by comparison and moved back. On a surface a part holds a few dozen keys, and
+/// the run is in cache: two passes over it and short sorts instead of log n passes.
+void sort_run(std::span<Keyed> run, unsigned shift, std::vector<Keyed>& scratch,
+              std::vector<std::uint32_t>& counts)
+{
+    if (run.size() < min_counted)
+    {
+        std::sort(run.begin(), run.end());
+        return;
+    }
+    counts.assign(radix + 1, 0);
+    for (const Keyed& k : run)
+        ++counts[((k.key >> shift) & (radix - 1)) + 1];
+    for (std::size_t b = 0; b < radix; ++b)
+        counts[b + 1] += counts[b];
+    scratch.resize(run.size());
+    std::vector<std::uint32_t> next(counts.begin(), counts.end() - 1);
+    for (const Keyed& k : run) // stable: ties keep their order, and so their indices' order
+        scratch[next[(k.key >> shift) & (radix - 1)]++] = k;
+    for (std::size_t b = 0; b < radix; ++b)
+        if (counts[b + 1] - counts[b] > 1)
+            std::sort(scratch.begin() + counts[b], scratch.begin() + counts[b + 1]);
+    std::copy(scratch.begin(), scratch.begin() + static_cast<std::ptrdiff_t>(run.size()),
+              run.begin());
+}
+
+/// Sorts keys below 2^63 as std::sort would: a stable scatter by the top radix_bits bits of the
+/// key, block by block (each block's counts, then every bucket's place for every block), then
+/// each bucket by its next radix_bits bits (sort_run()), all in parallel. The buckets of a
+/// surface's Morton keys hold a few thousand to some tens of thousands of samples each, so
+/// their sorts run in cache; a sort by comparison of the whole array would pass over it log n
+/// times.
+std::unique_ptr<Keyed[]> bucket_sort(std::unique_ptr<Keyed[]> keyed, std::size_t n)
+{
+    constexpr unsigned shift = 63 - radix_bits;
     constexpr std::size_t block = std::size_t{1} << 18;
-    const std::size_t n = keyed.size();
     const std::size_t blocks = (n + block - 1) / block;
     if (blocks <= 1)
     {
-        std::sort(keyed.begin(), keyed.end());
-        return;
+        std::sort(keyed.get(), keyed.get() + n);
+        return keyed;
     }
-    std::vector<std::size_t> place(blocks * buckets, 0); // block-major counts, then offsets
+    std::vector<std::size_t> place(blocks * radix, 0); // block-major counts, then offsets
     parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
-        std::size_t* counts = place.data() + (begin / block) * buckets;
+        std::size_t* counts = place.data() + (begin / block) * radix;
         for (std::size_t i = begin; i < end; ++i)
-            ++counts[keyed[i].first >> shift];
+            ++counts[keyed[i].key >> shift];
     });
-    std::vector<std::size_t> bucket_start(buckets + 1, 0);
-    for (std::size_t b = 0, total = 0; b < buckets; ++b)
+    std::vector<std::size_t> bucket_start(radix + 1, 0);
+    for (std::size_t b = 0, total = 0; b < radix; ++b)
     {
         bucket_start[b] = total;
         for (std::size_t k = 0; k < blocks; ++k)
         {
-            const std::size_t count = place[k * buckets + b];
-            place[k * buckets + b] = total;
+            const std::size_t count = place[k * radix + b];
+            place[k * radix + b] = total;
             total += count;
         }
         bucket_start[b + 1] = total;
     }
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> scattered(n);
+    // NOLINTNEXTLINE(cppcoreguidelines-owning-memory): not initialised, every entry is written
+    std::unique_ptr<Keyed[]> scattered(new Keyed[n]);
     parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
-        std::size_t* next = place.data() + (begin / block) * buckets;
+        std::size_t* next = place.data() + (begin / block) * radix;
         for (std::size_t i = begin; i < end; ++i)
-            scattered[next[keyed[i].first >> shift]++] = keyed[i];
+            scattered[next[keyed[i].key >> shift]++] = keyed[i];
     });
-    parallel_blocks(buckets, 1, [&](std::size_t first, std::size_t last) {
+    keyed.reset();
+    parallel_blocks(radix, 1, [&](std::size_t first, std::size_t last) {
+        std::vector<Keyed> scratch;
+        std::vector<std::uint32_t> counts;
         for (std::size_t b = first; b < last; ++b)
-            std::sort(scattered.begin() + static_cast<std::ptrdiff_t>(bucket_start[b]),
-                      scattered.begin() + static_cast<std::ptrdiff_t>(bucket_start[b + 1]));
+            sort_run({scattered.get() + bucket_start[b], bucket_start[b + 1] - bucket_start[b]},
+                     shift - radix_bits, scratch, counts);
     });
-    keyed.swap(scattered);
+    return scattered;
 }
 
 } // namespace
@@ -123,14 +173,16 @@ std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions)
 {
     const Aabb box = parallel_bounding_box(positions);
     // (Morton key, index) pairs: sorting them orders by key, ties by original index.
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(positions.size());
-    std::vector<std::uint32_t> order(positions.size());
-    if (positions.empty())
+    const std::size_t n = positions.size();
+    std::vector<std::uint32_t> order(n);
+    if (n == 0)
         return order;
+    // NOLINTNEXTLINE(cppcoreguidelines-owning-memory): not initialised, every entry is written
+    std::unique_ptr<Keyed[]> keyed(new Keyed[n]);
     const Vec3d extent = box.size();
     const double largest = std::max({extent.x(), extent.y(), extent.z()});
     const double scale = largest > 0.0 ? static_cast<double>((1U << 21U) - 1U) / largest : 0.0;
-    parallel_blocks(positions.size(), 16384, [&](std::size_t begin, std::size_t end) {
+    parallel_blocks(n, 16384, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
         {
             const Vec3d q = (positions[i].cast<double>() - box.min) * scale;
@@ -145,10 +197,10 @@ std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions)
                         static_cast<std::uint32_t>(i)};
         }
     });
-    bucket_sort(keyed); // keys paired with their index: a strict order, std::sort's result
-    parallel_blocks(keyed.size(), 1U << 16U, [&](std::size_t begin, std::size_t end) {
+    keyed = bucket_sort(std::move(keyed), n); // keys paired with their index: a strict order
+    parallel_blocks(n, 1U << 16U, [&](std::size_t begin, std::size_t end) {
         for (std::size_t j = begin; j < end; ++j)
-            order[j] = keyed[j].second;
+            order[j] = keyed[j].index;
     });
     return order;
 }
