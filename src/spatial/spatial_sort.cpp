@@ -87,31 +87,39 @@ constexpr std::size_t radix = std::size_t{1} << radix_bits;
 /// Runs shorter than this are sorted by comparison rather than counted.
 constexpr std::size_t min_counted = 256;
 
+/// A thread's buffers for sort_run(), reused from run to run.
+struct RunScratch
+{
+    std::vector<Keyed> keys;
+    std::vector<std::uint32_t> start; ///< each part's first place, then its end
+    std::vector<std::uint32_t> next;  ///< each part's next free place
+};
+
 /// Sorts run by key, then index, as std::sort would: by the radix_bits of the key below
-/// `shift` + radix_bits (those above are the same throughout the run) into `scratch`, then each
+/// `shift` + radix_bits (those above are the same throughout the run) into scratch, then each
 /// part sorted by comparison and moved back. On a surface a part holds a few dozen keys, and
 /// the run is in cache: two passes over it and short sorts instead of log n passes.
-void sort_run(std::span<Keyed> run, unsigned shift, std::vector<Keyed>& scratch,
-              std::vector<std::uint32_t>& counts)
+void sort_run(std::span<Keyed> run, unsigned shift, RunScratch& scratch)
 {
     if (run.size() < min_counted)
     {
         std::sort(run.begin(), run.end());
         return;
     }
+    std::vector<std::uint32_t>& counts = scratch.start;
     counts.assign(radix + 1, 0);
     for (const Keyed& k : run)
         ++counts[((k.key >> shift) & (radix - 1)) + 1];
     for (std::size_t b = 0; b < radix; ++b)
         counts[b + 1] += counts[b];
-    scratch.resize(run.size());
-    std::vector<std::uint32_t> next(counts.begin(), counts.end() - 1);
-    for (const Keyed& k : run) // stable: ties keep their order, and so their indices' order
-        scratch[next[(k.key >> shift) & (radix - 1)]++] = k;
+    scratch.keys.resize(run.size());
+    scratch.next.assign(counts.begin(), counts.end() - 1);
+    for (const Keyed& k : run)
+        scratch.keys[scratch.next[(k.key >> shift) & (radix - 1)]++] = k;
     for (std::size_t b = 0; b < radix; ++b)
         if (counts[b + 1] - counts[b] > 1)
-            std::sort(scratch.begin() + counts[b], scratch.begin() + counts[b + 1]);
-    std::copy(scratch.begin(), scratch.begin() + static_cast<std::ptrdiff_t>(run.size()),
+            std::sort(scratch.keys.begin() + counts[b], scratch.keys.begin() + counts[b + 1]);
+    std::copy(scratch.keys.begin(), scratch.keys.begin() + static_cast<std::ptrdiff_t>(run.size()),
               run.begin());
 }
 
@@ -157,12 +165,12 @@ std::unique_ptr<Keyed[]> bucket_sort(std::unique_ptr<Keyed[]> keyed, std::size_t
             scattered[next[keyed[i].key >> shift]++] = keyed[i];
     });
     keyed.reset();
-    parallel_blocks(radix, 1, [&](std::size_t first, std::size_t last) {
-        std::vector<Keyed> scratch;
-        std::vector<std::uint32_t> counts;
+    // Sixteen buckets a block, sharing one set of buffers.
+    parallel_blocks(radix, 16, [&](std::size_t first, std::size_t last) {
+        RunScratch scratch;
         for (std::size_t b = first; b < last; ++b)
             sort_run({scattered.get() + bucket_start[b], bucket_start[b + 1] - bucket_start[b]},
-                     shift - radix_bits, scratch, counts);
+                     shift - radix_bits, scratch);
     });
     return scattered;
 }
