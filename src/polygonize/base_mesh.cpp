@@ -17,6 +17,7 @@
 #include "pointform/metrics/quality.h"
 #include "pointform/polygonize/projection.h"
 #include "pointform/spatial/kd_tree.h"
+#include "pointform/spatial/spatial_sort.h"
 
 #include <Eigen/SparseCholesky>
 
@@ -37,6 +38,7 @@
 #include <numbers>
 #include <numeric>
 #include <optional>
+#include <span>
 #include <string_view>
 #include <utility>
 
@@ -78,7 +80,7 @@ public:
         const HalfedgeHandle v1v0 = opposite_halfedge_handle(v0v1);
         const VertexHandle v0 = to_vertex_handle(v1v0);
         const VertexHandle v1 = to_vertex_handle(v0v1);
-        if (status(v0).deleted() || status(v1).deleted())
+        if (status(v0).deleted() || status(v1).deleted() || (keep_locked_ && status(v1).locked()))
         {
             return false;
         }
@@ -125,8 +127,13 @@ public:
         return !(is_boundary(v0) && is_boundary(v1) && !is_boundary(v0v1) && !is_boundary(v1v0));
     }
 
+    /// Refuse collapses onto a locked vertex too (the Decimater refuses those that remove one):
+    /// a locked vertex's faces then stay as they are.
+    void keep_locked(bool on) { keep_locked_ = on; }
+
 private:
     std::vector<VertexHandle> ring_;
+    bool keep_locked_ = false;
 };
 
 Vec3d to_eigen(const OpenMesh::Vec3d& p)
@@ -1053,7 +1060,7 @@ MeshTopology check_intermediate_mesh(const TriMesh& intermediate)
         }
     }
     const auto highest = std::max_element(valence.begin(), valence.end());
-    if (*highest > max_intermediate_valence)
+    if (highest != valence.end() && *highest > max_intermediate_valence)
     {
         throw InvalidInput(
             "base mesh: vertex " + std::to_string(highest - valence.begin()) + " is in " +
@@ -1064,6 +1071,145 @@ MeshTopology check_intermediate_mesh(const TriMesh& intermediate)
     }
     return topology;
 }
+
+namespace {
+
+/// Edge collapses of `mesh` (its face normals requested and up to date) down to `target` faces:
+/// by quadric error, no remaining face's normal turned by more than the bound, the rims of holes
+/// kept (ModBoundaryT); `observer` (may be null) sees the progress and may stop it.
+void collapse_to(OmMesh& mesh, std::size_t target, const BaseMeshStats& stats,
+                 const BaseMeshOptions& options, OpenMesh::Decimater::Observer* observer)
+{
+    OpenMesh::Decimater::DecimaterT<OmMesh> decimater(mesh);
+    OpenMesh::Decimater::ModQuadricT<OmMesh>::Handle quadric;
+    OpenMesh::Decimater::ModNormalFlippingT<OmMesh>::Handle normal_flipping;
+    ModBoundaryT<OmMesh>::Handle boundary;
+    decimater.add(quadric);
+    decimater.add(normal_flipping);
+    decimater.add(boundary);
+    decimater.module(boundary).set_tolerances(stats.boundary_tolerance,
+                                              outward_factor * stats.boundary_tolerance);
+    decimater.module(quadric).unset_max_err();
+    decimater.module(normal_flipping)
+        .set_max_normal_deviation(options.max_normal_deviation_degrees);
+    decimater.initialize();
+    decimater.set_observer(observer);
+    decimater.decimate_to_faces(0, target);
+    decimater.set_observer(nullptr);
+}
+
+/// The intermediate mesh decimated in blocks at once, towards `target` faces
+/// (BaseMeshOptions::block_decimation_faces): its faces in the Morton order of their centroids,
+/// cut into decimation_blocks runs of equal count (a fixed number: the result does not depend on
+/// the thread count). Each run is decimated on its own with the vertices it shares with another
+/// run locked: no collapse removes them or ends on them, so every collapse sees the whole
+/// one-ring it changes, as in the whole mesh, and the runs join again where they were cut. A run
+/// keeps its faces at the cuts as they are and takes the rest to its share of the target; the
+/// pass over the whole mesh that follows then coarsens the cuts' faces like the others. Returns
+/// the joined mesh (the intermediate mesh's vertices, the runs' faces), or nothing when a run is
+/// not a halfedge mesh of its own (a vertex whose faces in the run OpenMesh cannot link): the
+/// caller then decimates the whole mesh at once.
+std::optional<TriMesh> decimate_in_blocks(const TriMesh& intermediate, std::size_t target,
+                                          const BaseMeshStats& stats,
+                                          const BaseMeshOptions& options,
+                                          ProgressReporter& reporter)
+{
+    const std::size_t faces = intermediate.face_count();
+    const auto& x = intermediate.vertices.positions;
+    std::vector<Vec3f> centroids(faces);
+    parallel_blocks(faces, 0, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t f = begin; f < end; ++f)
+        {
+            const Triangle& t = intermediate.triangles[f];
+            centroids[f] = (x[t[0]] + x[t[1]] + x[t[2]]) / 3.0F;
+        }
+    });
+    const std::vector<std::uint32_t> order = spatial_order(centroids);
+    std::vector<Vec3f>().swap(centroids);
+    const auto run_begin = [&](std::size_t b) {
+        return b * faces / decimation_blocks;
+    };
+    // Each vertex's run, or `shared` when its faces lie in more than one.
+    constexpr std::uint32_t unseen = std::numeric_limits<std::uint32_t>::max();
+    constexpr std::uint32_t shared = unseen - 1;
+    std::vector<std::uint32_t> run_of(intermediate.vertex_count(), unseen);
+    for (std::size_t b = 0; b < decimation_blocks; ++b)
+        for (std::size_t k = run_begin(b); k < run_begin(b + 1); ++k)
+            for (const std::uint32_t v : intermediate.triangles[order[k]])
+                run_of[v] =
+                    run_of[v] == unseen || run_of[v] == b ? static_cast<std::uint32_t>(b) : shared;
+    const double ratio = static_cast<double>(target) / static_cast<double>(faces);
+    std::vector<std::vector<Triangle>> kept(decimation_blocks);
+    std::vector<std::uint8_t> linked(decimation_blocks, 1);
+    parallel_blocks(
+        decimation_blocks, 1,
+        [&](std::size_t first, std::size_t last) {
+            for (std::size_t b = first; b < last; ++b)
+            {
+                const std::span<const std::uint32_t> run(order.data() + run_begin(b),
+                                                         run_begin(b + 1) - run_begin(b));
+                std::vector<std::uint32_t> local; // the run's vertices, ascending
+                local.reserve(3 * run.size());
+                for (const std::uint32_t f : run)
+                    for (const std::uint32_t v : intermediate.triangles[f])
+                        local.push_back(v);
+                std::sort(local.begin(), local.end());
+                local.erase(std::unique(local.begin(), local.end()), local.end());
+                const auto handle = [&](std::uint32_t v) {
+                    return OmMesh::VertexHandle(static_cast<int>(
+                        std::lower_bound(local.begin(), local.end(), v) - local.begin()));
+                };
+                OmMesh mesh;
+                mesh.reserve(local.size(), 3 * run.size() / 2 + local.size(), run.size());
+                for (const std::uint32_t v : local)
+                {
+                    const auto h = mesh.add_vertex(to_om(intermediate.vertices.world(v)));
+                    if (run_of[v] == shared)
+                        mesh.status(h).set_locked(true);
+                }
+                std::size_t at_cuts = 0;
+                for (const std::uint32_t f : run)
+                {
+                    const Triangle& t = intermediate.triangles[f];
+                    at_cuts +=
+                        run_of[t[0]] == shared || run_of[t[1]] == shared || run_of[t[2]] == shared
+                            ? 1U
+                            : 0U;
+                    if (!mesh.add_face(handle(t[0]), handle(t[1]), handle(t[2])).is_valid())
+                    {
+                        linked[b] = 0;
+                        break;
+                    }
+                }
+                if (linked[b] == 0)
+                    continue;
+                mesh.keep_locked(true);
+                mesh.request_face_normals();
+                mesh.update_face_normals();
+                const auto inside = static_cast<double>(run.size() - at_cuts);
+                collapse_to(mesh, at_cuts + static_cast<std::size_t>(std::llround(ratio * inside)),
+                            stats, options, nullptr);
+                for (const auto f : mesh.faces()) // skips the deleted faces
+                {
+                    Triangle t{};
+                    std::size_t k = 0;
+                    for (const auto v : mesh.fv_range(f))
+                        t[k++] = local[static_cast<std::size_t>(v.idx())];
+                    kept[b].push_back(t);
+                }
+            }
+        },
+        &reporter);
+    if (std::find(linked.begin(), linked.end(), 0) != linked.end())
+        return std::nullopt;
+    TriMesh joined;
+    joined.vertices = intermediate.vertices;
+    for (const auto& run : kept)
+        joined.triangles.insert(joined.triangles.end(), run.begin(), run.end());
+    return joined;
+}
+
+} // namespace
 
 BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
                                const BaseMeshOptions& options)
@@ -1111,29 +1257,28 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
         stats.boundary_tolerance = 0.5 * *middle;
     }
 
-    // 1. Simplify by edge collapses.
-    OmMesh mesh = to_openmesh(intermediate);
+    // 1. Simplify by edge collapses: a large mesh first in blocks at once (decimate_in_blocks()),
+    //    then the whole.
+    std::optional<TriMesh> joined;
+    if (options.block_decimation_faces != 0 &&
+        stats.input_faces >= options.block_decimation_faces &&
+        stats.target_faces <= stats.input_faces / 4)
+    {
+        ProgressReporter reporter(options.progress, "base mesh: decimate in blocks");
+        joined = decimate_in_blocks(intermediate, stats.target_faces, stats, options, reporter);
+        stats.decimated_in_blocks = joined.has_value();
+        reporter.finish();
+    }
+    OmMesh mesh = to_openmesh(joined ? *joined : intermediate);
+    const std::size_t before_pass = mesh.n_faces();
+    joined.reset();
     mesh.request_face_normals();
     mesh.update_face_normals();
     {
-        OpenMesh::Decimater::DecimaterT<OmMesh> decimater(mesh);
-        OpenMesh::Decimater::ModQuadricT<OmMesh>::Handle quadric;
-        OpenMesh::Decimater::ModNormalFlippingT<OmMesh>::Handle normal_flipping;
-        ModBoundaryT<OmMesh>::Handle boundary;
-        decimater.add(quadric);
-        decimater.add(normal_flipping);
-        decimater.add(boundary);
-        decimater.module(boundary).set_tolerances(stats.boundary_tolerance,
-                                                  outward_factor * stats.boundary_tolerance);
-        decimater.module(quadric).unset_max_err();
-        decimater.module(normal_flipping)
-            .set_max_normal_deviation(options.max_normal_deviation_degrees);
-        decimater.initialize();
         ProgressReporter reporter(options.progress, "base mesh: decimate");
-        DecimateObserver observer(reporter, (stats.input_faces - stats.target_faces) / 2);
-        decimater.set_observer(&observer);
-        decimater.decimate_to_faces(0, stats.target_faces);
-        decimater.set_observer(nullptr);
+        DecimateObserver observer(reporter,
+                                  (before_pass - std::min(before_pass, stats.target_faces)) / 2);
+        collapse_to(mesh, stats.target_faces, stats, options, &observer);
         if (observer.cancelled())
         {
             throw Cancelled("base mesh: cancelled");

@@ -133,6 +133,7 @@ nlohmann::json report_json(const BaseMeshStats& stats)
     out["source"] = "automatic";
     out["input_faces"] = stats.input_faces;
     out["target_faces"] = stats.target_faces;
+    out["decimated_in_blocks"] = stats.decimated_in_blocks;
     out["faces"] = stats.faces;
     out["vertices"] = stats.vertices;
     out["min_angle_degrees"] = stats.min_angle_degrees;

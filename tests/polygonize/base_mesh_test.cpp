@@ -341,6 +341,68 @@ TEST(BaseMesh, SameMeshWhateverTheThreadCount)
     }
 }
 
+TEST(BaseMesh, DecimationInBlocksKeepsTheTorusAndItsShape)
+{
+    // The same torus decimated as a whole and first in blocks (forced on a small mesh): both
+    // keep the genus and the target, lie on the torus and have the same triangle shape.
+    const Scene scene =
+        sampled(Shape::Torus, 20000, 4.0 * std::numbers::pi * std::numbers::pi * 0.35);
+    ASSERT_GT(scene.mc.face_count(), 4U * 800U);
+    for (const std::size_t from : {std::size_t{0}, std::size_t{1}})
+    {
+        const BaseMeshResult result = build_base_mesh(
+            scene.mc, *scene.field, {.target_faces = 800, .block_decimation_faces = from});
+        EXPECT_EQ(result.stats.decimated_in_blocks, from != 0);
+        const MeshTopology topo = analyze_topology(result.mesh);
+        EXPECT_TRUE(topo.is_oriented_manifold());
+        EXPECT_TRUE(topo.is_closed());
+        EXPECT_EQ(topo.components, 1U);
+        EXPECT_EQ(topo.euler_characteristic, 0);
+        EXPECT_TRUE(result.stats.topology_kept) << result.stats.topology_change;
+        EXPECT_EQ(result.stats.faces, 800U);
+        EXPECT_LT(share_below_20(result.mesh), 0.02) << "blocks from " << from;
+        for (std::size_t v = 0; v < result.mesh.vertex_count(); ++v)
+        {
+            const Vec3d p = result.mesh.vertices.world(v);
+            const double ring = std::hypot(std::hypot(p.x(), p.y()) - 1.0, p.z());
+            ASSERT_NEAR(ring, 0.35, 0.25 * scene.spacing) << "blocks from " << from;
+        }
+    }
+}
+
+TEST(BaseMesh, DecimationInBlocksKeepsARimAndDoesNotDependOnThreads)
+{
+    // A sphere without its cap, in blocks: one boundary loop where the samples end, and the same
+    // mesh at 1, 2 and 3 threads (the blocks are fixed by the mesh, not by the threads).
+    const CutSphere cut = cut_sphere(20000, [](const Vec3d& p) { return p.z() > 0.8; });
+    ASSERT_EQ(analyze_topology(cut.mc).boundary_loops, 1U);
+    const auto runs = test::at_thread_counts([&] {
+        return build_base_mesh(cut.mc, *cut.field,
+                               {.target_faces = 1000, .block_decimation_faces = 1});
+    });
+    const BaseMeshResult& result = runs[0];
+    EXPECT_TRUE(result.stats.decimated_in_blocks);
+    const MeshTopology topo = analyze_topology(result.mesh);
+    EXPECT_TRUE(topo.is_oriented_manifold());
+    EXPECT_EQ(topo.boundary_loops, 1U);
+    EXPECT_EQ(topo.euler_characteristic, 1);
+    EXPECT_TRUE(result.stats.topology_kept) << result.stats.topology_change;
+    EXPECT_LE(result.stats.faces, 1000U);
+    const double reach = 0.8 + static_cast<double>(*std::max_element(cut.cloud.radii.begin(),
+                                                                     cut.cloud.radii.end()));
+    for (std::size_t v = 0; v < result.mesh.vertex_count(); ++v)
+    {
+        ASSERT_LT(result.mesh.vertices.world(v).z(), reach);
+        ASSERT_NEAR(result.mesh.vertices.world(v).norm(), 1.0, 0.01);
+    }
+    for (std::size_t i = 1; i < runs.size(); ++i)
+    {
+        EXPECT_EQ(runs[0].mesh.triangles, runs[i].mesh.triangles) << i + 1 << " threads";
+        EXPECT_EQ(runs[0].mesh.vertices.positions, runs[i].mesh.vertices.positions)
+            << i + 1 << " threads";
+    }
+}
+
 TEST(BaseMesh, RejectsBadTargetsAndMeshes)
 {
     const Scene scene = sampled(Shape::Sphere, 2000, sphere_area);

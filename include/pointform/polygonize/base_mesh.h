@@ -68,21 +68,28 @@ struct BaseMeshOptions
     /// Move every vertex onto f = 0 along the field gradient (§5.1 criterion 2); false keeps the
     /// decimated marching-cubes positions (and skips the relaxation, which needs projection).
     bool project = true;
-    /// Optional progress report (stages "base mesh: decimate", "base mesh: shape and
-    /// projection").
+    /// Intermediate meshes of at least this many faces (and at least four times the target)
+    /// are first decimated in decimation_blocks blocks at once, each block's shared vertices
+    /// locked, then as a whole (which coarsens the faces at the blocks' cuts); 0 = always as a
+    /// whole. The default leaves meshes of up to about 100k samples as they were and takes the
+    /// coarsened intermediate mesh of larger clouds (max_intermediate_faces) in blocks.
+    std::size_t block_decimation_faces = 262144;
+    /// Optional progress report (stages "base mesh: decimate in blocks", "base mesh: decimate",
+    /// "base mesh: shape and projection").
     ProgressCallback progress;
 };
 
 /// \brief What build_base_mesh() did.
 struct BaseMeshStats
 {
-    std::size_t input_faces = 0;     ///< faces of the intermediate mesh
-    std::size_t target_faces = 0;    ///< the target actually used (options or default)
-    std::size_t faces = 0;           ///< faces of the base mesh
-    std::size_t vertices = 0;        ///< vertices of the base mesh
-    int smoothing_rounds = 0;        ///< shape rounds done
-    std::size_t flips = 0;           ///< edge flips made to improve triangle shape
-    double boundary_tolerance = 0.0; ///< the boundary tolerance used (options or default)
+    std::size_t input_faces = 0;      ///< faces of the intermediate mesh
+    bool decimated_in_blocks = false; ///< BaseMeshOptions::block_decimation_faces applied
+    std::size_t target_faces = 0;     ///< the target actually used (options or default)
+    std::size_t faces = 0;            ///< faces of the base mesh
+    std::size_t vertices = 0;         ///< vertices of the base mesh
+    int smoothing_rounds = 0;         ///< shape rounds done
+    std::size_t flips = 0;            ///< edge flips made to improve triangle shape
+    double boundary_tolerance = 0.0;  ///< the boundary tolerance used (options or default)
     /// Vertices left off f = 0: no zero crossing within their mean edge length along the
     /// gradient (or the normal), the field undefined there, or a move that would fold a face.
     std::size_t unprojected = 0;
@@ -113,6 +120,10 @@ struct BaseMeshResult
     TriMesh mesh; ///< same origin as the intermediate mesh; no vertex attributes
     BaseMeshStats stats;
 };
+
+/// Blocks of a large intermediate mesh decimated at once (BaseMeshOptions::block_decimation_faces):
+/// a fixed number, so that the base mesh does not depend on the thread count.
+inline constexpr std::size_t decimation_blocks = 8;
 
 /// Intermediate faces per base face by default (default_base_faces()).
 inline constexpr std::size_t default_base_share = 16;
