@@ -1155,34 +1155,35 @@ std::optional<TriMesh> decimate_in_blocks(const TriMesh& intermediate, std::size
                         local.push_back(v);
                 std::sort(local.begin(), local.end());
                 local.erase(std::unique(local.begin(), local.end()), local.end());
-                const auto handle = [&](std::uint32_t v) {
-                    return OmMesh::VertexHandle(static_cast<int>(
-                        std::lower_bound(local.begin(), local.end(), v) - local.begin()));
-                };
-                OmMesh mesh;
-                mesh.reserve(local.size(), 3 * run.size() / 2 + local.size(), run.size());
+                // The run as a mesh of its own (its vertices in `local`'s order).
+                TriMesh part;
+                part.vertices.origin = intermediate.vertices.origin;
+                part.vertices.positions.reserve(local.size());
                 for (const std::uint32_t v : local)
-                {
-                    const auto h = mesh.add_vertex(to_om(intermediate.vertices.world(v)));
-                    if (run_of[v] == shared)
-                        mesh.status(h).set_locked(true);
-                }
+                    part.vertices.positions.push_back(x[v]);
+                part.triangles.reserve(run.size());
                 std::size_t at_cuts = 0;
                 for (const std::uint32_t f : run)
                 {
-                    const Triangle& t = intermediate.triangles[f];
+                    Triangle t = intermediate.triangles[f];
                     at_cuts +=
                         run_of[t[0]] == shared || run_of[t[1]] == shared || run_of[t[2]] == shared
                             ? 1U
                             : 0U;
-                    if (!mesh.add_face(handle(t[0]), handle(t[1]), handle(t[2])).is_valid())
-                    {
-                        linked[b] = 0;
-                        break;
-                    }
+                    for (std::uint32_t& v : t)
+                        v = static_cast<std::uint32_t>(
+                            std::lower_bound(local.begin(), local.end(), v) - local.begin());
+                    part.triangles.push_back(t);
                 }
-                if (linked[b] == 0)
+                OmMesh mesh;
+                if (!add_to_openmesh(part, mesh))
+                {
+                    linked[b] = 0;
                     continue;
+                }
+                for (std::size_t v = 0; v < local.size(); ++v)
+                    if (run_of[local[v]] == shared)
+                        mesh.status(OmMesh::VertexHandle(static_cast<int>(v))).set_locked(true);
                 mesh.keep_locked(true);
                 mesh.request_face_normals();
                 mesh.update_face_normals();

@@ -213,6 +213,25 @@ TEST(BaseMesh, TorusKeepsItsGenus)
     }
 }
 
+/// A base mesh of a sphere without its cap above z = 0.8: one rim, where the samples end
+/// (within one influence radius), and at most `max_faces` faces.
+void expect_one_rim_at_the_cap(const BaseMeshResult& result, const PointCloud& cloud,
+                               std::size_t max_faces)
+{
+    const MeshTopology topo = analyze_topology(result.mesh);
+    EXPECT_TRUE(topo.is_oriented_manifold());
+    EXPECT_EQ(topo.boundary_loops, 1U);
+    EXPECT_EQ(topo.euler_characteristic, 1);
+    EXPECT_TRUE(result.stats.topology_kept) << result.stats.topology_change;
+    EXPECT_LE(result.stats.faces, max_faces);
+    const double reach =
+        0.8 + static_cast<double>(*std::max_element(cloud.radii.begin(), cloud.radii.end()));
+    for (std::size_t v = 0; v < result.mesh.vertex_count(); ++v)
+    {
+        ASSERT_LT(result.mesh.vertices.world(v).z(), reach);
+    }
+}
+
 TEST(BaseMesh, SphereWithoutItsCapKeepsOneBoundaryLoop)
 {
     // A unit sphere sampled with exact normals, without the cap above z = 0.8.
@@ -223,21 +242,9 @@ TEST(BaseMesh, SphereWithoutItsCapKeepsOneBoundaryLoop)
     ASSERT_EQ(analyze_topology(mc).boundary_loops, 1U);
 
     const BaseMeshResult result = build_base_mesh(mc, field, {.target_faces = 250});
-    const MeshTopology topo = analyze_topology(result.mesh);
-    EXPECT_TRUE(topo.is_oriented_manifold());
-    EXPECT_EQ(topo.boundary_loops, 1U);
-    EXPECT_EQ(topo.euler_characteristic, 1);
-    EXPECT_TRUE(result.stats.topology_kept) << result.stats.topology_change;
-    EXPECT_LE(result.stats.faces, 250U);
+    expect_one_rim_at_the_cap(result, cloud, 250);
     EXPECT_EQ(result.stats.unprojected, 0U);
     EXPECT_LT(result.stats.share_below_20_degrees_off_boundary, 0.02);
-    // The rim stays where the samples end (within one influence radius).
-    const double reach =
-        0.8 + static_cast<double>(*std::max_element(cloud.radii.begin(), cloud.radii.end()));
-    for (std::size_t v = 0; v < result.mesh.vertex_count(); ++v)
-    {
-        ASSERT_LT(result.mesh.vertices.world(v).z(), reach);
-    }
 }
 
 TEST(BaseMesh, HolesDoNotGrow)
@@ -382,17 +389,9 @@ TEST(BaseMesh, DecimationInBlocksKeepsARimAndDoesNotDependOnThreads)
     });
     const BaseMeshResult& result = runs[0];
     EXPECT_TRUE(result.stats.decimated_in_blocks);
-    const MeshTopology topo = analyze_topology(result.mesh);
-    EXPECT_TRUE(topo.is_oriented_manifold());
-    EXPECT_EQ(topo.boundary_loops, 1U);
-    EXPECT_EQ(topo.euler_characteristic, 1);
-    EXPECT_TRUE(result.stats.topology_kept) << result.stats.topology_change;
-    EXPECT_LE(result.stats.faces, 1000U);
-    const double reach = 0.8 + static_cast<double>(*std::max_element(cut.cloud.radii.begin(),
-                                                                     cut.cloud.radii.end()));
+    expect_one_rim_at_the_cap(result, cut.cloud, 1000);
     for (std::size_t v = 0; v < result.mesh.vertex_count(); ++v)
     {
-        ASSERT_LT(result.mesh.vertices.world(v).z(), reach);
         ASSERT_NEAR(result.mesh.vertices.world(v).norm(), 1.0, 0.01);
     }
     for (std::size_t i = 1; i < runs.size(); ++i)
