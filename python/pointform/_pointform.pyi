@@ -91,7 +91,15 @@ def surfels_from_mesh(
 ) -> Tuple[PointCloud, dict[str, Any]]: ...
 
 class Field:
-    def __init__(self, surfels: PointCloud, *, fit: str = "quadric", far_grid: bool = True) -> None: ...
+    def __init__(
+        self,
+        surfels: PointCloud,
+        *,
+        fit: str = "quadric",
+        far_grid: bool = True,
+        rim_reach: float = 0.25,
+        crease_fit: bool = True,
+    ) -> None: ...
     @overload
     def evaluate(
         self, points: _Array

@@ -65,9 +65,11 @@ void bind_implicit(py::module_& m)
         "pointform.scene() makes one from the modeling language. Immutable and safe to "
         "evaluate from many threads.")
         .def(py::init([](const std::shared_ptr<Cloud>& surfels, const std::string& fit,
-                         bool far_grid, double rim_reach) {
-                 PointFieldOptions options{
-                     .fit = parse_plane_fit(fit), .rim_reach = rim_reach, .far_grid = far_grid};
+                         bool far_grid, double rim_reach, bool crease_fit) {
+                 PointFieldOptions options{.fit = parse_plane_fit(fit),
+                                           .crease_fit = crease_fit,
+                                           .rim_reach = rim_reach,
+                                           .far_grid = far_grid};
                  std::shared_ptr<const PointField> field;
                  {
                      py::gil_scoped_release release;
@@ -79,14 +81,20 @@ void bind_implicit(py::module_& m)
              }),
              py::arg("surfels"), py::kw_only(), py::arg("fit") = "quadric",
              py::arg("far_grid") = true, py::arg("rim_reach") = PointFieldOptions{}.rim_reach,
-             "Field(surfels, *, fit='quadric', far_grid=True, rim_reach=0.25)\n\n"
+             py::arg("crease_fit") = PointFieldOptions{}.crease_fit,
+             "Field(surfels, *, fit='quadric', far_grid=True, rim_reach=0.25, crease_fit=True)\n\n"
              "The signed point field of surfels with normals and radii (pointform.surfels()). "
              "fit: the local surfaces, 'quadric' (default), 'blend', 'centroid' or 'raw' (the "
              "paper's tangent planes). far_grid=False answers deep-inside queries by search "
              "instead of the far grid (exact distances there, slower). rim_reach: how far past a "
              "rim of the samples (a hole's edge, a scan's border) the field reaches, as a "
              "fraction of an automatic influence radius, in (0, 1]; 1 = a whole radius, the "
-             "paper's field. Raises InvalidInput for a cloud without normals or radii, or "
+             "paper's field. crease_fit (quadric only): each sample's surface fitted to its own "
+             "face "
+             "of a crease, and left out of the blend past the crease line, so that faces meet "
+             "there instead of being rounded off or running past it; False = the principal "
+             "normal's quadric everywhere. Raises InvalidInput for a cloud without normals or "
+             "radii, or "
              "non-finite or non-positive ones, or rim_reach out of range.")
         .def("evaluate", &evaluate, py::arg("points"), py::kw_only(), py::arg("defined") = false,
              "evaluate(points, *, defined=False) -> (values, gradients[, defined])\n\n"

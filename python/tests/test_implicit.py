@@ -61,6 +61,32 @@ def test_field_ends_past_a_rim_as_asked():
         pointform.Field(surfels, rim_reach=0.0)
 
 
+def cube_surface(n, seed):
+    """n points uniform on the surface of the cube [-0.5, 0.5]^3."""
+    rng = np.random.default_rng(seed)
+    points = rng.uniform(-0.5, 0.5, (n, 3))
+    axis = rng.integers(0, 3, n)
+    points[np.arange(n), axis] = rng.choice([-0.5, 0.5], n)
+    return points
+
+
+def test_crease_fits_meet_the_faces_of_a_cube():
+    # Raw points of a cube (normals estimated: tilted at the edges): with each sample's surface
+    # fitted to its own face (the default) the field on the true surface near the edges is
+    # closer to zero than with the principal normals' quadrics (crease_fit=False): 6-8% on
+    # average within 0.01-0.1 of an edge, at 20k and 50k samples.
+    surfels, _ = pointform.surfels(pointform.PointCloud(cube_surface(20000, 4)))
+    truth = cube_surface(5000, 9)
+    near_edges = truth[(np.abs(truth) > 0.45).sum(axis=1) >= 2]
+    errors = {}
+    for crease_fit in (True, False):
+        values, _, defined = pointform.Field(surfels, crease_fit=crease_fit).evaluate(
+            near_edges, defined=True)
+        assert defined.all()
+        errors[crease_fit] = np.abs(values).mean()
+    assert errors[True] < 0.97 * errors[False], errors
+
+
 def test_query_dtypes_and_orders_give_the_same_values(sphere_surfels):
     field = pointform.Field(sphere_surfels)
     points, _ = radial_queries([0.97, 1.02], n=50)

@@ -130,7 +130,7 @@ def test_texture_sources_and_bad_input(small, tmp_path):
     h, _ = small
     image = np.zeros((8, 8, 3), dtype=np.uint8)
     image[:, 4:] = 255
-    painted = h.texture(image=image, size=64)
+    painted = h.texture(image=image, size=128)
     assert painted.base_color[:, :16].mean() < painted.base_color[:, -16:].mean()
     light = h.texture(normal_map_level=1, size=128)
     assert light.normal_map.shape == (128, 128, 3) and light.report["normal_map"]
@@ -141,10 +141,13 @@ def test_texture_sources_and_bad_input(small, tmp_path):
     colored = pointform.PointCloud(scan.positions, colors=np.full((len(scan.positions), 3), 200, np.uint8),
                                    origin=scan.origin)
     # Every triangle gets its colour, even in an atlas so tight that most charts hold no texel
-    # centre (64 texels a side: the bake covers every texel a chart touches).
-    for size in (64, 256):
+    # centre (128 texels a side: the bake covers every texel a chart touches).
+    for size in (128, 256):
         baked = h.texture(bake_colors=colored, size=size)
         assert baked.report["bake"]["rms_color_error"] < 1.0
+    # Where the gutters alone fill the texture the charts would have no size: refused.
+    with pytest.raises(pointform.InvalidInput, match="do not fit"):
+        h.texture(size=32)
     with pytest.raises(pointform.InvalidInput, match="does not exist"):
         h.texture(level=7)
     with pytest.raises(pointform.InvalidInput):

@@ -269,16 +269,23 @@ Atlas make_atlas(const MultiresMesh& mesh, std::size_t level, const AtlasOptions
     std::vector<Placement> placed(faces.size());
     double lo = 0.0;
     double hi = (atlas.size - atlas.gutter) / largest;
+    const auto too_small = [&] {
+        return InvalidInput("atlas: " + std::to_string(faces.size()) + " charts with gutters of " +
+                            std::to_string(atlas.gutter) + " texels do not fit in " +
+                            std::to_string(atlas.size) + " x " + std::to_string(atlas.size) +
+                            " texels; choose a larger --size");
+    };
     if (!pack(shapes, order, 0.0, atlas.size, atlas.gutter, placed))
-        throw InvalidInput("atlas: " + std::to_string(faces.size()) + " charts with gutters of " +
-                           std::to_string(atlas.gutter) + " texels do not fit in " +
-                           std::to_string(atlas.size) + " x " + std::to_string(atlas.size) +
-                           " texels; choose a larger --size");
+        throw too_small();
     for (int step = 0; step < 40; ++step)
     {
         const double mid = 0.5 * (lo + hi);
         (pack(shapes, order, mid, atlas.size, atlas.gutter, placed) ? lo : hi) = mid;
     }
+    // Gutters alone filling the texture leave the charts no size: the longest under a texel
+    // (none at all where only points fit) would texture nothing.
+    if (!(lo * largest >= 1.0))
+        throw too_small();
     (void)pack(shapes, order, lo, atlas.size, atlas.gutter, placed);
     atlas.texels_per_unit = lo;
 

@@ -57,8 +57,10 @@ struct Atlas
 /// \brief Lays the base triangles out as charts (longest edge along u, shelf-packed, the largest
 /// scale that fits). `level` is the level that will be textured (for the automatic size).
 /// \throw InvalidInput for an empty hierarchy, a level that does not exist, a size outside
-///        min_atlas_size … max_atlas_size, a gutter outside 1 … 64, or a base face of zero
-///        area; also if the texture would not fit in memory (check_memory)
+///        min_atlas_size … max_atlas_size, a gutter outside 1 … 64, a base face of zero
+///        area, or charts whose gutters fill the texture (the longest chart under a texel at
+///        the largest scale that fits); also if the texture would not fit in memory
+///        (check_memory)
 [[nodiscard]] Atlas make_atlas(const MultiresMesh& mesh, std::size_t level,
                                const AtlasOptions& options = {});
 
