@@ -224,7 +224,7 @@ TEST(DeformCli, TheDocumentedExamplesRunOnTheQuickStartBunny)
     ASSERT_EQ(made.exit_code, 0) << made.out;
     const MultiresMesh bunny = read_hierarchy(hierarchy);
     for (const std::uint32_t v :
-         {1012U, 1014U, 1070U, 1096U, 1098U, 1152U, 1185U, 1186U, 1215U, 1269U, 1294U, 1314U})
+         {953U, 1072U, 1101U, 1102U, 1155U, 1190U, 1219U, 1271U, 1296U, 1297U, 1317U, 1318U})
         EXPECT_GT(bunny.world(v).y(), 0.17) << "vertex " << v << " is not at the ear tip";
     const std::filesystem::path examples = test::data_path("../docs/examples");
     const auto ear = run("deform " + quoted(hierarchy) + " -o " + quoted(dir / "ear.pfh") +
@@ -232,7 +232,7 @@ TEST(DeformCli, TheDocumentedExamplesRunOnTheQuickStartBunny)
     ASSERT_EQ(ear.exit_code, 0) << ear.out;
     const auto report = nlohmann::json::parse(ear.out);
     EXPECT_EQ(report["deformation"]["handle_vertices"].get<std::size_t>(), 12U);
-    EXPECT_GT(read_hierarchy(dir / "ear.pfh").world(1185).y(), bunny.world(1185).y() + 0.02);
+    EXPECT_GT(read_hierarchy(dir / "ear.pfh").world(1296).y(), bunny.world(1296).y() + 0.02);
     const auto bend = run("deform " + quoted(hierarchy) + " -o " + quoted(dir / "bend.pfh") +
                           " --lattice " + quoted(examples / "bunny_bend.json"));
     EXPECT_EQ(bend.exit_code, 0) << bend.out;
