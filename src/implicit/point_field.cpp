@@ -340,7 +340,8 @@ constexpr float crease_turn_cosine = 0.8660254F;
 /// Iterations of crease_normal()'s reweighting from each start.
 constexpr int crease_iterations = 4;
 
-/// A sample's neighbours (relative to the sample) as crease_normal() weighs them.
+/// A sample's neighbours (relative to the sample) as crease_normal() weighs them: the nearest
+/// `capacity` of them where PointFieldOptions::quadric_k asks for more.
 struct CreaseNeighbourhood
 {
     static constexpr std::size_t capacity = 256;
