@@ -68,9 +68,9 @@ struct PointFieldOptions
     /// or running past it. Measured on the 100k inputs of bench/peers, `reconstruct` at its
     /// defaults (Hausdorff / Chamfer in % of the diagonal, without → with; the Hausdorff
     /// distance of these evaluations varies by about 0.03 from run to run): clean plate
-    /// 0.98 / 0.0057 → 0.97 / 0.0051, clean blobby 0.25 / 0.0067 → 0.29 / 0.0064, clean part
-    /// 0.93 / 0.0107 → 0.71 / 0.0101; the clean sphere and torus the same mesh; the noisy
-    /// sphere, blobby, part and plate 0.2-0.8% lower in Chamfer and in Hausdorff.
+    /// 0.98 / 0.0057 → 0.93 / 0.0050, clean blobby 0.25 / 0.0067 → 0.25 / 0.0064, clean part
+    /// 0.93 / 0.0107 → 0.47 / 0.0099; the clean sphere and torus the same mesh; the noisy
+    /// sphere, blobby, part and plate 0.2-0.8% lower in Chamfer.
     bool crease_fit = true;
     /// Across a rim of the samples (a hole's edge, a partial scan's border: a sample whose
     /// neighbours, whichever way they face, have their centroid well off it over its tangent
