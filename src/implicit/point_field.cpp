@@ -408,6 +408,42 @@ struct CreaseNeighbourhood
         return sum;
     }
 
+    /// The principal axes (eigenvalues ascending) of the neighbours weighted by w(j) (those of
+    /// weight 0 left out), about their weighted centroid, written to `centroid` if given;
+    /// nullopt where no weight is positive.
+    template <typename Weight>
+    [[nodiscard]] std::optional<Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>> principal_axes(
+        Weight w, Vec3d* centroid = nullptr) const
+    {
+        double weight_sum = 0.0;
+        Vec3d mean = Vec3d::Zero();
+        for (std::size_t j = 0; j < count; ++j)
+        {
+            const double wj = w(j);
+            if (wj == 0.0)
+                continue;
+            weight_sum += wj;
+            mean += wj * x[j];
+        }
+        if (!(weight_sum > 0.0))
+            return std::nullopt;
+        mean /= weight_sum;
+        Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+        for (std::size_t j = 0; j < count; ++j)
+        {
+            const double wj = w(j);
+            if (wj == 0.0)
+                continue;
+            const Vec3d y = x[j] - mean;
+            covariance.noalias() += wj * y * y.transpose();
+        }
+        if (centroid != nullptr)
+            *centroid = mean;
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+        solver.computeDirect(covariance);
+        return solver;
+    }
+
     /// Iteratively reweighted least squares from `start` (signed like `sign`); nullopt where
     /// the weighted neighbours span no plane.
     [[nodiscard]] std::optional<Vec3d> refit(Vec3d n, const Vec3d& sign) const
@@ -415,31 +451,15 @@ struct CreaseNeighbourhood
         for (int iteration = 0; iteration < crease_iterations; ++iteration)
         {
             const double c = cut(n);
-            double weight_sum = 0.0;
-            Vec3d centroid = Vec3d::Zero();
             std::array<double, capacity> w;
             for (std::size_t j = 0; j < count; ++j)
-            {
                 w[j] = weight(j, n, c);
-                weight_sum += w[j];
-                centroid += w[j] * x[j];
-            }
-            if (!(weight_sum > 0.0))
-                return std::nullopt;
-            centroid /= weight_sum;
-            Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-            for (std::size_t j = 0; j < count; ++j)
-            {
-                const Vec3d y = x[j] - centroid;
-                covariance.noalias() += w[j] * y * y.transpose();
-            }
-            Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-            solver.computeDirect(covariance);
+            const auto axes = principal_axes([&](std::size_t j) { return w[j]; });
             // A line or a point (too few weighted neighbours off a line): no plane.
-            if (!(solver.eigenvalues()[1] > 1e-6 * solver.eigenvalues()[2]) ||
-                !solver.eigenvectors().allFinite())
+            if (!axes || !(axes->eigenvalues()[1] > 1e-6 * axes->eigenvalues()[2]) ||
+                !axes->eigenvectors().allFinite())
                 return std::nullopt;
-            const Vec3d next = solver.eigenvectors().col(0);
+            const Vec3d next = axes->eigenvectors().col(0);
             n = next.dot(sign) < 0.0 ? Vec3d(-next) : next;
         }
         return n;
@@ -463,8 +483,8 @@ struct CreaseFit
 /// face away (the other side of a thin wall lies under the whole neighbourhood and bounds
 /// nothing), and a one-sided neighbourhood (outliers of noise leave it centred); where the
 /// outliers span a plane of their own, the line where it meets the sample's bounds the cut
-/// too. Past the line
-/// the sample leaves the blend to the other face's samples, whose own lines end where its face
+/// too. `cut`: the biweight's cut of the plane. Past the line the sample leaves the blend to
+/// the other face's samples, whose own lines end where its face
 /// begins: the blend meets the two faces at the crease instead of rounding it, and neither
 /// face's surface reaches beyond it. The line itself is the limit: on the 100k clean part of
 /// bench/peers, with a margin of 0.25 / 0.1 / 0 of the farthest neighbour's distance beyond
@@ -472,12 +492,16 @@ struct CreaseFit
 /// 0.0102 / 0.0101 %; the plate 1.15 / 0.88 / 0.89 (0.98).
 Eigen::Vector3f crease_limit(const CreaseNeighbourhood& hood,
                              std::span<const std::uint32_t> neighbors,
-                             std::span<const Vec3f> normals, const Vec3f& normal)
+                             std::span<const Vec3f> normals, const Vec3f& normal, double cut)
 {
     const Vec3d n = normal.cast<double>();
     const Vec3d t1 = tangent_of(normal).cast<double>();
     const Vec3d t2 = n.cross(t1);
-    const double cut = hood.cut(n);
+    // Off the plane by more than `beyond` and not facing away: the other face's.
+    const auto other_face = [&](std::size_t j, double beyond) {
+        return std::abs(hood.x[j].dot(n)) > beyond &&
+               normals[neighbors[j]].cast<double>().dot(n) > -0.5;
+    };
     Eigen::Vector2d sum = Eigen::Vector2d::Zero();
     std::size_t inliers = 0;
     std::size_t outliers = 0;
@@ -490,7 +514,7 @@ Eigen::Vector3f crease_limit(const CreaseNeighbourhood& hood,
             inlier_far2 = std::max(inlier_far2, hood.x[j].squaredNorm());
             ++inliers;
         }
-        else if (normals[neighbors[j]].cast<double>().dot(n) > -0.5)
+        else if (other_face(j, cut))
         {
             ++outliers;
         }
@@ -511,36 +535,22 @@ Eigen::Vector3f crease_limit(const CreaseNeighbourhood& hood,
     // centroid back and the cut out: at the edge of the 100k clean part of bench/peers, a line
     // 0.0186 off where it is 0, and a lip 0.018 under the face (Hausdorff 0.71% of the
     // diagonal, 0.47% with the planes' line; Chamfer 0.0101% -> 0.0099%).
+    std::size_t others = 0;
+    for (std::size_t j = 0; j < hood.count; ++j)
+        others += other_face(j, 2.0 * cut) ? 1U : 0U;
+    Vec3d mean;
+    if (others >= 3)
     {
-        Vec3d mean = Vec3d::Zero();
-        std::size_t others = 0;
-        for (std::size_t j = 0; j < hood.count; ++j)
-            if (std::abs(hood.x[j].dot(n)) > 2.0 * cut &&
-                normals[neighbors[j]].cast<double>().dot(n) > -0.5)
-            {
-                mean += hood.x[j];
-                ++others;
-            }
-        if (others >= 3)
+        if (const auto solver = hood.principal_axes(
+                [&](std::size_t j) { return other_face(j, 2.0 * cut) ? 1.0 : 0.0; }, &mean))
         {
-            mean /= static_cast<double>(others);
-            Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-            for (std::size_t j = 0; j < hood.count; ++j)
-                if (std::abs(hood.x[j].dot(n)) > 2.0 * cut &&
-                    normals[neighbors[j]].cast<double>().dot(n) > -0.5)
-                {
-                    const Vec3d y = hood.x[j] - mean;
-                    covariance.noalias() += y * y.transpose();
-                }
-            Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-            solver.computeDirect(covariance);
-            const Vec3d m = solver.eigenvectors().col(0);
+            const Vec3d m = solver->eigenvectors().col(0);
             // Along d = toward over the sample's plane, the other plane (m · (x − mean) = 0)
             // is met at t with m · (t d − mean) = 0.
             const Vec3d d = toward.x() * t1 + toward.y() * t2;
             const double turn = std::abs(m.dot(n));
             const double along = m.dot(d);
-            if (solver.eigenvalues()[1] > 4.0 * solver.eigenvalues()[0] && turn < 0.866 &&
+            if (solver->eigenvalues()[1] > 4.0 * solver->eigenvalues()[0] && turn < 0.866 &&
                 std::abs(along) > 1e-9)
             {
                 const double t = m.dot(mean) / along;
@@ -582,12 +592,10 @@ CreaseFit crease_normal(std::span<const Vec3f> positions, std::span<const Vec3f>
     hood.count = std::min(neighbors.size(), CreaseNeighbourhood::capacity);
     const Vec3d s = positions[i].cast<double>();
     double far2 = 0.0;
-    Vec3d mean = Vec3d::Zero();
     for (std::size_t j = 0; j < hood.count; ++j)
     {
         hood.x[j] = positions[neighbors[j]].cast<double>() - s;
         far2 = std::max(far2, hood.x[j].squaredNorm());
-        mean += hood.x[j];
     }
     // A surface's k nearest spread as a disc (the farthest of 48 about 2.2 times as far as the
     // tenth); a stray point's reach a surface far off past its few fellows (a cluster of 10 to
@@ -613,19 +621,12 @@ CreaseFit crease_normal(std::span<const Vec3f> positions, std::span<const Vec3f>
     for (std::size_t j = 0; j < hood.count; ++j)
         hood.spatial[j] = std::exp(-hood.x[j].squaredNorm() / (0.25 * far2));
 
-    mean /= static_cast<double>(hood.count);
-    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-    for (std::size_t j = 0; j < hood.count; ++j)
-    {
-        const Vec3d y = hood.x[j] - mean;
-        covariance.noalias() += y * y.transpose();
-    }
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> principal;
-    principal.computeDirect(covariance);
-    const Vec3d e0 = principal.eigenvectors().col(0);
-    const Vec3d e1 = principal.eigenvectors().col(1);
+    const auto principal = hood.principal_axes([](std::size_t) { return 1.0; });
+    const Vec3d e0 = principal->eigenvectors().col(0);
+    const Vec3d e1 = principal->eigenvectors().col(1);
     std::array<Vec3d, 4> starts = {original, e1, (e0 + e1).normalized(), (e0 - e1).normalized()};
     std::array<std::optional<Vec3d>, 4> fits;
+    std::array<double, 4> cuts{};
     double tightest = std::numeric_limits<double>::infinity();
     for (std::size_t c = 0; c < starts.size(); ++c)
     {
@@ -635,30 +636,30 @@ CreaseFit crease_normal(std::span<const Vec3f> positions, std::span<const Vec3f>
         fits[c] = hood.refit(start, original);
         if (!fits[c])
             continue;
-        const double cut = hood.cut(*fits[c]);
-        tightest = std::min(tightest, cut);
+        cuts[c] = hood.cut(*fits[c]);
+        tightest = std::min(tightest, cuts[c]);
         // A plane from the normal that holds nearly the whole neighbourhood (curvature, not a
         // crease, set off the test): the other starts would not do better.
-        if (c == 0 && hood.support(*fits[c], cut) >= 0.9 * hood.total())
+        if (c == 0 && hood.support(*fits[c], cuts[c]) >= 0.9 * hood.total())
             break;
     }
-    std::optional<Vec3d> best;
+    std::optional<std::size_t> best;
     double best_support = 0.0;
-    for (const std::optional<Vec3d>& fit : fits)
+    for (std::size_t c = 0; c < fits.size(); ++c)
     {
-        if (!fit)
+        if (!fits[c])
             continue;
-        const double support = hood.support(*fit, tightest);
+        const double support = hood.support(*fits[c], tightest);
         if (support > best_support)
         {
-            best = fit;
+            best = c;
             best_support = support;
         }
     }
     if (!best)
         return {normal};
-    CreaseFit out{best->normalized().cast<float>()};
-    out.crease = crease_limit(hood, neighbors, normals, out.normal);
+    CreaseFit out{fits[*best]->normalized().cast<float>()};
+    out.crease = crease_limit(hood, neighbors, normals, out.normal, cuts[*best]);
     return out;
 }
 

@@ -304,12 +304,15 @@ TEST(PointField, CreaseFitsMeetTheFacesAtCreasesAndLeaveSmoothSurfacesAlone)
     // the true surface is closer to zero (measured: 10% and 14% at 40k samples). On a smooth
     // sphere a few samples find outliers (the tails of their residuals), and the field on the
     // truth is within 1%. And the same values at any thread count.
-    const auto field_error = [](Shape shape, bool crease_fit, std::size_t count = 40000) {
+    const auto raw_surfels = [](Shape shape, std::size_t count) {
         PointCloud raw = sample_shape(shape, {.count = count, .seed = 5});
         raw.normals.clear();
-        const PointCloud surfels = compute_surfels(raw).surfels;
+        return compute_surfels(raw).surfels;
+    };
+    const auto field_error = [&](Shape shape, bool crease_fit, std::size_t count = 40000) {
         const PointCloud truth = sample_shape(shape, {.count = 20000, .seed = 9});
-        return mean_on_truth(PointField(surfels, {.crease_fit = crease_fit}), truth);
+        return mean_on_truth(PointField(raw_surfels(shape, count), {.crease_fit = crease_fit}),
+                             truth);
     };
     for (const Shape shape : {Shape::Part, Shape::Blobby})
     {
@@ -320,9 +323,7 @@ TEST(PointField, CreaseFitsMeetTheFacesAtCreasesAndLeaveSmoothSurfacesAlone)
     EXPECT_LT(field_error(Shape::Sphere, true, 20000),
               1.01 * field_error(Shape::Sphere, false, 20000));
 
-    PointCloud raw = sample_shape(Shape::Part, {.count = 20000, .seed = 5});
-    raw.normals.clear();
-    const PointCloud surfels = compute_surfels(raw).surfels;
+    const PointCloud surfels = raw_surfels(Shape::Part, 20000);
     const PointCloud truth = sample_shape(Shape::Part, {.count = 2000, .seed = 9});
     const auto runs = test::at_thread_counts([&] {
         const PointField field(surfels);
