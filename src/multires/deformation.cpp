@@ -56,7 +56,19 @@ DeformHandle DeformHandle::translate(std::vector<std::uint32_t> vertices, const 
 DeformHandle DeformHandle::affine(std::vector<std::uint32_t> vertices,
                                   const Eigen::Matrix4d& transform)
 {
-    return {std::move(vertices), transform};
+    DeformHandle handle;
+    handle.vertices = std::move(vertices);
+    handle.transform = transform;
+    return handle;
+}
+
+DeformHandle DeformHandle::within(const RegionOfInterest& selection,
+                                  const Eigen::Matrix4d& transform)
+{
+    DeformHandle handle;
+    handle.selection = selection;
+    handle.transform = transform;
+    return handle;
 }
 
 namespace {
@@ -90,7 +102,8 @@ void check_transform(const Eigen::Matrix4d& m, std::size_t handle)
 
 /// Which of level j's n vertices the region holds.
 std::vector<std::uint8_t> region_members(const MultiresMesh& mesh, std::size_t n,
-                                         const RegionOfInterest& region)
+                                         const RegionOfInterest& region,
+                                         const std::string& whose = "the region's")
 {
     using Kind = RegionOfInterest::Kind;
     std::vector<std::uint8_t> in(n, region.kind == Kind::Whole ? 1 : 0);
@@ -110,18 +123,17 @@ std::vector<std::uint8_t> region_members(const MultiresMesh& mesh, std::size_t n
             break;
         case Kind::Ball:
             if (!region.center.allFinite() || !std::isfinite(region.radius) || region.radius <= 0.0)
-                throw InvalidInput(
-                    "deform: the region's ball needs a finite centre and a finite "
-                    "radius greater than 0");
+                throw InvalidInput("deform: " + whose +
+                                   " ball needs a finite centre and a finite radius greater "
+                                   "than 0");
             for (std::uint32_t v = 0; v < n; ++v)
                 in[v] = (mesh.world(v) - region.center).norm() <= region.radius ? 1 : 0;
             break;
         case Kind::Box:
             if (!region.min.allFinite() || !region.max.allFinite() ||
                 (region.min.array() > region.max.array()).any())
-                throw InvalidInput(
-                    "deform: the region's box needs finite corners with min <= max on "
-                    "every axis");
+                throw InvalidInput("deform: " + whose +
+                                   " box needs finite corners with min <= max on every axis");
             for (std::uint32_t v = 0; v < n; ++v)
             {
                 const Vec3d x = mesh.world(v);
@@ -153,8 +165,10 @@ struct MultiresDeformer::Impl
     MultiresDetails details;
     std::vector<std::uint32_t> handles;     ///< handle vertices, handle by handle
     std::vector<std::size_t> handle_starts; ///< first entry of each handle in `handles`, + end
-    std::vector<std::uint32_t> free;        ///< free vertices (ids of level j)
-    SparseMatrix coupling;                  ///< free × handles block of the system
+    /// Each handle's ball or box where it chose its vertices by place (else Kind::Vertices).
+    std::vector<RegionOfInterest> selections;
+    std::vector<std::uint32_t> free; ///< free vertices (ids of level j)
+    SparseMatrix coupling;           ///< free × handles block of the system
     Eigen::SimplicialLDLT<SparseMatrix> solver;
     DeformReport shape; ///< the report's fields fixed at construction
 
@@ -186,9 +200,24 @@ MultiresDeformer::MultiresDeformer(const MultiresMesh& rest, const MultiresEdit&
     {
         const DeformHandle& handle = edit.handles[h];
         check_transform(handle.transform, h);
-        if (handle.vertices.empty())
+        std::vector<std::uint32_t> chosen = handle.vertices;
+        if (chosen.empty() && (handle.selection.kind == RegionOfInterest::Kind::Ball ||
+                               handle.selection.kind == RegionOfInterest::Kind::Box))
+        {
+            const std::vector<std::uint8_t> inside =
+                region_members(rest, n, handle.selection, "handle " + std::to_string(h) + "'s");
+            for (std::uint32_t v = 0; v < n; ++v)
+                if (inside[v] != 0)
+                    chosen.push_back(v);
+            if (chosen.empty())
+                throw InvalidInput(
+                    "deform: handle " + std::to_string(h) + "'s " +
+                    (handle.selection.kind == RegionOfInterest::Kind::Ball ? "ball" : "box") +
+                    " holds no vertex of level " + std::to_string(j));
+        }
+        if (chosen.empty())
             throw InvalidInput("deform: handle " + std::to_string(h) + " has no vertices");
-        for (const std::uint32_t v : handle.vertices)
+        for (const std::uint32_t v : chosen)
         {
             if (v >= n)
                 throw InvalidInput("deform: handle " + std::to_string(h) + ": vertex " +
@@ -245,6 +274,9 @@ MultiresDeformer::MultiresDeformer(const MultiresMesh& rest, const MultiresEdit&
     Impl& m = *impl_;
     m.handles = std::move(handles);
     m.handle_starts = std::move(handle_starts);
+    for (const DeformHandle& handle : edit.handles)
+        m.selections.push_back(handle.vertices.empty() ? handle.selection
+                                                       : RegionOfInterest::of_vertices({}));
     std::vector<std::uint32_t> free_index(n, none);
     for (std::uint32_t v = 0; v < n; ++v)
         if (role[v] == Free)
@@ -426,8 +458,14 @@ DeformReport MultiresDeformer::apply(MultiresMesh& mesh,
         check_transform(handles[h].transform, h);
         const std::span<const std::uint32_t> expected(m.handles.data() + m.handle_starts[h],
                                                       m.handle_starts[h + 1] - m.handle_starts[h]);
-        if (!std::equal(expected.begin(), expected.end(), handles[h].vertices.begin(),
-                        handles[h].vertices.end()))
+        const RegionOfInterest& made = m.selections[h];
+        const RegionOfInterest& given = handles[h].selection;
+        const bool same_place = handles[h].vertices.empty() && made.kind == given.kind &&
+                                made.kind != RegionOfInterest::Kind::Vertices &&
+                                made.center == given.center && made.radius == given.radius &&
+                                made.min == given.min && made.max == given.max;
+        if (!same_place && !std::equal(expected.begin(), expected.end(),
+                                       handles[h].vertices.begin(), handles[h].vertices.end()))
             throw InvalidInput("deform: handle " + std::to_string(h) +
                                " names other vertices than the deformer was made with");
         for (const std::uint32_t v : expected)

@@ -182,6 +182,29 @@ std::string read_text(const std::filesystem::path& path, const char* what)
 
 } // namespace
 
+/// The vertices an object names (a region, a handle): its "vertices" ids, or its "ball" or
+/// "box" (the caller checks that exactly one is there); `where` names the object in errors.
+RegionOfInterest vertex_set(const json& object, const std::string& source, const std::string& where)
+{
+    if (object.contains("vertices"))
+        return RegionOfInterest::of_vertices(
+            vertex_ids(object["vertices"], source, where + ".vertices"));
+    if (object.contains("ball"))
+    {
+        const json& ball = object["ball"];
+        const std::string at = where + ".ball";
+        only_keys(ball, {"center", "radius"}, source, at);
+        return RegionOfInterest::ball(
+            vec3(required(ball, "center", source, at), source, at + ".center"),
+            number(required(ball, "radius", source, at), source, at + ".radius"));
+    }
+    const json& box = object["box"];
+    const std::string at = where + ".box";
+    only_keys(box, {"min", "max"}, source, at);
+    return RegionOfInterest::box(vec3(required(box, "min", source, at), source, at + ".min"),
+                                 vec3(required(box, "max", source, at), source, at + ".max"));
+}
+
 MultiresEdit parse_multires_edit(std::string_view text, const std::string& source)
 {
     const json document = parse_json(text, source);
@@ -197,27 +220,36 @@ MultiresEdit parse_multires_edit(std::string_view text, const std::string& sourc
         {
             const std::string where = "handles[" + std::to_string(h) + "]";
             const json& item = handles[h];
-            only_keys(item, {"vertices", "translate", "matrix"}, source, where);
+            only_keys(item, {"vertices", "ball", "box", "translate", "matrix"}, source, where);
             const bool translate = item.contains("translate");
             if (translate == item.contains("matrix"))
                 fail(source, where + " needs exactly one of \"translate\" and \"matrix\"");
-            std::vector<std::uint32_t> ids =
-                vertex_ids(required(item, "vertices", source, where), source, where + ".vertices");
+            if (static_cast<int>(item.contains("vertices")) +
+                    static_cast<int>(item.contains("ball")) +
+                    static_cast<int>(item.contains("box")) !=
+                1)
+                fail(source, where + " needs exactly one of \"vertices\", \"ball\" and \"box\"");
+            Eigen::Matrix4d matrix = Eigen::Matrix4d::Identity();
             if (translate)
             {
-                edit.handles.push_back(DeformHandle::translate(
-                    std::move(ids), vec3(item["translate"], source, where + ".translate")));
-                continue;
+                matrix.topRightCorner<3, 1>() =
+                    vec3(item["translate"], source, where + ".translate");
             }
-            const json& m = item["matrix"];
-            if (!m.is_array() || m.size() != 16)
-                fail(source, where + ".matrix must be an array of 16 numbers (row-major 4 x 4)");
-            Eigen::Matrix4d matrix;
-            for (int r = 0; r < 4; ++r)
-                for (int c = 0; c < 4; ++c)
-                    matrix(r, c) = number(m[static_cast<std::size_t>(4 * r + c)], source,
-                                          where + ".matrix[" + std::to_string(4 * r + c) + "]");
-            edit.handles.push_back(DeformHandle::affine(std::move(ids), matrix));
+            else
+            {
+                const json& m = item["matrix"];
+                if (!m.is_array() || m.size() != 16)
+                    fail(source,
+                         where + ".matrix must be an array of 16 numbers (row-major 4 x 4)");
+                for (int r = 0; r < 4; ++r)
+                    for (int c = 0; c < 4; ++c)
+                        matrix(r, c) = number(m[static_cast<std::size_t>(4 * r + c)], source,
+                                              where + ".matrix[" + std::to_string(4 * r + c) + "]");
+            }
+            const RegionOfInterest chosen = vertex_set(item, source, where);
+            edit.handles.push_back(chosen.kind == RegionOfInterest::Kind::Vertices
+                                       ? DeformHandle::affine(chosen.vertices, matrix)
+                                       : DeformHandle::within(chosen, matrix));
         }
     }
     if (document.contains("region"))
@@ -226,26 +258,7 @@ MultiresEdit parse_multires_edit(std::string_view text, const std::string& sourc
         only_keys(region, {"vertices", "ball", "box"}, source, "\"region\"");
         if (region.size() != 1)
             fail(source, "\"region\" needs exactly one of \"vertices\", \"ball\" and \"box\"");
-        if (region.contains("vertices"))
-            edit.region = RegionOfInterest::of_vertices(
-                vertex_ids(region["vertices"], source, "region.vertices"));
-        else if (region.contains("ball"))
-        {
-            const json& ball = region["ball"];
-            only_keys(ball, {"center", "radius"}, source, "region.ball");
-            edit.region = RegionOfInterest::ball(
-                vec3(required(ball, "center", source, "region.ball"), source, "region.ball.center"),
-                number(required(ball, "radius", source, "region.ball"), source,
-                       "region.ball.radius"));
-        }
-        else
-        {
-            const json& box = region["box"];
-            only_keys(box, {"min", "max"}, source, "region.box");
-            edit.region = RegionOfInterest::box(
-                vec3(required(box, "min", source, "region.box"), source, "region.box.min"),
-                vec3(required(box, "max", source, "region.box"), source, "region.box.max"));
-        }
+        edit.region = vertex_set(region, source, "region");
     }
     return edit;
 }

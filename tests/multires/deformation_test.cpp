@@ -227,6 +227,75 @@ TEST(Deformation, ADeformerSolvesAgainForNewTargets)
     EXPECT_TRUE(same_bytes(mesh, original));
 }
 
+TEST(Deformation, HandlesChosenByPlaceAreTheVerticesThere)
+{
+    const MultiresMesh original = test::relief_plate(3, Predictor::Butterfly);
+    const std::size_t n = original.vertex_count(1);
+    // Level 1's vertices in a ball and a box, listed by hand.
+    const Vec3d center(0.1, -0.2, 0.0);
+    const double radius = 0.3;
+    const Vec3d lo(-0.7, 0.25, -1.0);
+    const Vec3d hi(-0.15, 0.75, 1.0);
+    std::vector<std::uint32_t> in_ball;
+    std::vector<std::uint32_t> in_box;
+    for (std::uint32_t v = 0; v < n; ++v)
+    {
+        const Vec3d x = original.world(v);
+        if ((x - center).norm() <= radius)
+            in_ball.push_back(v);
+        if ((x.array() >= lo.array()).all() && (x.array() <= hi.array()).all())
+            in_box.push_back(v);
+    }
+    ASSERT_GE(in_ball.size(), 3U);
+    ASSERT_GE(in_box.size(), 3U);
+    const RegionOfInterest region =
+        RegionOfInterest::box(Vec3d(-0.8, -0.8, -1), Vec3d(0.8, 0.8, 1));
+    Eigen::Matrix4d up = Eigen::Matrix4d::Identity();
+    up(2, 3) = 0.2;
+    Eigen::Matrix4d down = Eigen::Matrix4d::Identity();
+    down(2, 3) = -0.1;
+    const MultiresEdit by_place{
+        .level = 1,
+        .handles = {DeformHandle::within(RegionOfInterest::ball(center, radius), up),
+                    DeformHandle::within(RegionOfInterest::box(lo, hi), down)},
+        .region = region};
+    const MultiresEdit by_id{
+        .level = 1,
+        .handles = {DeformHandle::affine(in_ball, up), DeformHandle::affine(in_box, down)},
+        .region = region};
+    const MultiresDeformer deformer(original, by_place);
+    std::vector<std::uint32_t> both = in_ball;
+    both.insert(both.end(), in_box.begin(), in_box.end());
+    EXPECT_EQ(std::vector<std::uint32_t>(deformer.handle_vertices().begin(),
+                                         deformer.handle_vertices().end()),
+              both);
+    MultiresMesh placed = original;
+    const DeformReport report = deformer.apply(placed, by_place.handles);
+    EXPECT_EQ(report.handle_vertices, both.size());
+    MultiresMesh listed = original;
+    (void)deform(listed, by_id);
+    EXPECT_TRUE(same_bytes(placed, listed));
+    EXPECT_NEAR(placed.world(in_ball[0]).z(), original.world(in_ball[0]).z() + 0.2, 1e-12);
+    // Another ball than the deformer was made with is refused; one holding no vertex too.
+    EXPECT_THROW(
+        (void)deformer.apply(placed,
+                             std::vector<DeformHandle>{
+                                 DeformHandle::within(RegionOfInterest::ball(center, 0.25), up),
+                                 by_place.handles[1]}),
+        InvalidInput);
+    MultiresMesh mesh = original;
+    const MultiresEdit empty{
+        .level = 1,
+        .handles = {DeformHandle::within(RegionOfInterest::ball(Vec3d(5, 5, 5), 0.1), up)},
+        .region = RegionOfInterest::whole()};
+    EXPECT_THROW((void)deform(mesh, empty), InvalidInput);
+    const MultiresEdit flat{
+        .level = 1,
+        .handles = {DeformHandle::within(RegionOfInterest::ball(center, -1.0), up)},
+        .region = RegionOfInterest::whole()};
+    EXPECT_THROW((void)deform(mesh, flat), InvalidInput);
+}
+
 TEST(Deformation, BadEditsAreRefused)
 {
     MultiresMesh mesh = test::relief_sphere(2);

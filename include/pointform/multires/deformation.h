@@ -47,15 +47,22 @@ struct RegionOfInterest
 };
 
 /// \brief Handle vertices of level j and where they go: the affine map `transform` (a 4 × 4
-/// matrix on world coordinates, last row 0 0 0 1) of their positions before the edit.
+/// matrix on world coordinates, last row 0 0 0 1) of their positions before the edit. The
+/// vertices are listed by id, or chosen by place: with `vertices` empty, level j's vertices in
+/// `selection` (a ball or a box), so that an edit written for one reconstruction still holds
+/// when the ids change.
 struct DeformHandle
 {
     std::vector<std::uint32_t> vertices;
     Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();
+    RegionOfInterest selection = RegionOfInterest::of_vertices({});
 
     [[nodiscard]] static DeformHandle translate(std::vector<std::uint32_t> vertices,
                                                 const Vec3d& by);
     [[nodiscard]] static DeformHandle affine(std::vector<std::uint32_t> vertices,
+                                             const Eigen::Matrix4d& transform);
+    /// The vertices in a ball or box (RegionOfInterest::ball(), box()), moved by `transform`.
+    [[nodiscard]] static DeformHandle within(const RegionOfInterest& selection,
                                              const Eigen::Matrix4d& transform);
 };
 

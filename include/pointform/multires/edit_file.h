@@ -24,14 +24,16 @@ namespace pointform {
 /// Edit: {"level": j, "handles": [{"vertices": [ids], "translate": [x, y, z]} or {"vertices":
 /// [ids], "matrix": [16 numbers, row-major 4 × 4]}, …], "region": {"vertices": [ids]} or
 /// {"ball": {"center": [x, y, z], "radius": r}} or {"box": {"min": [...], "max": [...]}}}; no
-/// region: the whole level. Lattice: {"min": [...], "max": [...], "degree": [l, m, n], "level":
-/// j, "control_points": [[x, y, z], …]} ((l + 1)(m + 1)(n + 1) points, x fastest, world
-/// coordinates); "level" may be left out (0).
+/// region: the whole level. A handle may give a "ball" or a "box" in place of "vertices": the
+/// level's vertices there (DeformHandle::within()). Lattice: {"min": [...], "max": [...],
+/// "degree": [l, m, n], "level": j, "control_points": [[x, y, z], …]} ((l + 1)(m + 1)(n + 1)
+/// points, x fastest, world coordinates); "level" may be left out (0).
 ///
 /// Every problem is an InvalidInput naming the source: text that is not JSON (with its line and
 /// column), nesting deeper than 16, a key that is not one of the above, a value of the wrong
 /// type, a vertex id that is not an integer in [0, 2³² − 1), a number that is not finite, a
-/// handle with both or neither of translate and matrix, a region with more than one kind. The
+/// handle with both or neither of translate and matrix, a region or handle with more than one
+/// kind of vertex set. The
 /// checks that need the hierarchy (ids of the level, handles inside the region, the lattice's
 /// size) are made by MultiresDeformer and validate_lattice().
 
