@@ -209,25 +209,9 @@ __attribute__((target("avx2"))) BlendSums blend_sums_avx2(const PackedSurfel* pa
 BlendSums blend_sums_reference(const PackedSurfel* packed, const std::uint32_t* slot,
                                const float* dist2, std::size_t used, const Vec3d& p, double inv_h)
 {
-    BlendSums sums;
-    for (std::size_t j = 0; j < used; ++j)
-    {
-        const PackedSurfel& sample = packed[slot[j]];
-        const Vec3d offset = p - sample.position.cast<double>();
-        const double t = std::sqrt(static_cast<double>(dist2[j])) * inv_h;
-        const double u = std::max(0.0, 1.0 - t);
-        const double u3 = u * u * u;
-        const double weight = u3 * u * (4.0 * t + 1.0);
-        const Vec3d weight_gradient = ((-20.0 * inv_h * inv_h) * u3) * offset;
-        Vec3d normal;
-        const double plane = sample.distance(p, &normal);
-        sums.weight += weight;
-        sums.value += weight * plane;
-        sums.normal += weight * normal;
-        sums.weighted_gradient += plane * weight_gradient;
-        sums.gradient += weight_gradient;
-    }
-    return sums;
+    return blend_sums_of(packed, slot, dist2, used, p, inv_h, [&](std::size_t j, Vec3d* gradient) {
+        return packed[slot[j]].distance(p, gradient);
+    });
 }
 
 bool blend_has_avx2()

@@ -9,6 +9,8 @@
 
 #include "pointform/core/types.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -87,6 +89,34 @@ enum class BlendPath
 [[nodiscard]] BlendSums blend_sums(const PackedSurfel* packed, const std::uint32_t* slot,
                                    const float* dist2, std::size_t used, const Vec3d& p,
                                    double inv_h, BlendPath path = BlendPath::automatic);
+
+/// The blend sums one sample at a time, with `distance(j, &gradient)` the signed distance to
+/// the surface of sample slot[j] at `p` and its gradient (blend_sums_reference(): the samples'
+/// own surfaces).
+template <typename Distance>
+[[nodiscard]] BlendSums blend_sums_of(const PackedSurfel* packed, const std::uint32_t* slot,
+                                      const float* dist2, std::size_t used, const Vec3d& p,
+                                      double inv_h, Distance distance)
+{
+    BlendSums sums;
+    for (std::size_t j = 0; j < used; ++j)
+    {
+        const Vec3d offset = p - packed[slot[j]].position.template cast<double>();
+        const double t = std::sqrt(static_cast<double>(dist2[j])) * inv_h;
+        const double u = std::max(0.0, 1.0 - t);
+        const double u3 = u * u * u;
+        const double weight = u3 * u * (4.0 * t + 1.0);
+        const Vec3d weight_gradient = ((-20.0 * inv_h * inv_h) * u3) * offset;
+        Vec3d normal;
+        const double value = distance(j, &normal);
+        sums.weight += weight;
+        sums.value += weight * value;
+        sums.normal += weight * normal;
+        sums.weighted_gradient += value * weight_gradient;
+        sums.gradient += weight_gradient;
+    }
+    return sums;
+}
 
 /// blend_sums() one sample at a time, as the formula reads (a compiler without GCC's vector
 /// extension runs this); the same sums up to rounding.
