@@ -338,7 +338,13 @@ double cut_of_disc_centroid(double c)
 constexpr float crease_turn_cosine = 0.8660254F;
 
 /// Iterations of crease_normal()'s reweighting from each start.
-constexpr int crease_iterations = 4;
+constexpr int crease_iterations = 16;
+
+/// The reweighting has converged when the normal turns by less than about 1e-4 radians in an
+/// iteration (cos 1e-4 ≈ 1 − 5e-9). Four iterations at most (from a principal normal 40° off
+/// a face at the edges of the 1M clean plate of bench/peers) left planes tilted 10°, which ran
+/// 0.004 past the edge.
+constexpr double crease_converged = 1.0 - 5e-9;
 
 /// A sample's neighbours (relative to the sample) as crease_normal() weighs them: the nearest
 /// `capacity` of them where PointFieldOptions::quadric_k asks for more.
@@ -460,7 +466,10 @@ struct CreaseNeighbourhood
                 !axes->eigenvectors().allFinite())
                 return std::nullopt;
             const Vec3d next = axes->eigenvectors().col(0);
+            const Vec3d previous = n;
             n = next.dot(sign) < 0.0 ? Vec3d(-next) : next;
+            if (std::abs(n.dot(previous)) > crease_converged)
+                break;
         }
         return n;
     }
@@ -567,6 +576,47 @@ Eigen::Vector4f crease_limit(const CreaseNeighbourhood& hood,
             static_cast<float>(limit), outlier_height < 0.0 ? 1.0F : -1.0F};
 }
 
+/// How far points are from a plane, from their covariance C (eigenvalues λ0 ≤ λ1 ≤ λ2):
+/// 3 det C / (I2 tr C), I2 the sum of C's principal 2 × 2 minors: 0 on a plane, 1 for an
+/// isotropic blob, about 3 λ0 / (λ1 + λ2) when thin (as the orientation's noise test measures).
+double flatness(std::span<const Vec3f> positions, std::span<const std::uint32_t> points)
+{
+    if (points.size() < 3)
+        return 0.0;
+    Vec3d mean = Vec3d::Zero();
+    for (const std::uint32_t j : points)
+        mean += positions[j].cast<double>();
+    mean /= static_cast<double>(points.size());
+    Eigen::Matrix3d c = Eigen::Matrix3d::Zero();
+    for (const std::uint32_t j : points)
+    {
+        const Vec3d y = positions[j].cast<double>() - mean;
+        c.noalias() += y * y.transpose();
+    }
+    const double minors = c(0, 0) * c(1, 1) - c(0, 1) * c(0, 1) + c(0, 0) * c(2, 2) -
+                          c(0, 2) * c(0, 2) + c(1, 1) * c(2, 2) - c(1, 2) * c(1, 2);
+    const double denominator = minors * c.trace();
+    return denominator > 0.0 ? 3.0 * c.determinant() / denominator : 0.0;
+}
+
+/// Median flatness() of the samples' fit neighbourhoods under which a cloud counts as clean for
+/// crease_normal(): the orientation's noise threshold (orient_normals_mst()), where a disc of
+/// radius ρ with position noise σ scores about 6 σ² / ρ², so noise under about ρ / 17.
+/// Curvature scores 4e-4 to 3e-3 on the clean shapes of bench/peers, the bunny scans about
+/// 0.01; its noisy clouds 0.1 to 0.9.
+constexpr double clean_flatness = 0.02;
+
+/// Whether the median of `flatness` (one a sample of a subsample; reordered) is under
+/// clean_flatness.
+bool clean_cloud(std::vector<double>& flatness)
+{
+    if (flatness.empty())
+        return true;
+    const auto middle = flatness.begin() + static_cast<std::ptrdiff_t>(flatness.size() / 2);
+    std::nth_element(flatness.begin(), middle, flatness.end());
+    return *middle < clean_flatness;
+}
+
 /// The normal of sample i refitted to the neighbours on its own side of a crease. A principal
 /// component normal averages over every face in the neighbourhood: at a crease it tilts toward
 /// the other face (up to 54° at the corners of the 100k plate of bench/peers, and in a concave
@@ -578,23 +628,27 @@ Eigen::Vector4f crease_limit(const CreaseNeighbourhood& hood,
 /// normal, the middle principal direction and the two diagonals between it and the smallest
 /// (the faces of a crease whose principal normal lies between them); the plane that holds most
 /// of the neighbourhood at the tightest of their scales wins, signed like the sample's normal.
-/// It replaces the normal where it, or the normal's plane, leaves some neighbours off by more
-/// than 3 robust standard deviations of the residuals (CreaseNeighbourhood::cut()). A first
-/// plane that holds 90% of the neighbourhood's weight at a cut under half the neighbourhood's
-/// reach is taken at once: on the 100k clean part of bench/peers the other starts then doubled
-/// the field's build time for 0.5% in Chamfer. At a box's corner three faces share the
+/// It replaces the normal where the normal's plane leaves some neighbours off by more than 3
+/// robust standard deviations of the residuals (CreaseNeighbourhood::cut()), or, in a `clean`
+/// cloud (clean_cloud()), where the fitted plane does. A first plane that holds 90% of the
+/// neighbourhood's weight (in a clean cloud: at a cut under half the neighbourhood's reach) is
+/// taken at once: on the 100k clean part of bench/peers the other starts then doubled the
+/// field's build time for 0.5% in Chamfer. At a box's corner three faces share the
 /// neighbourhood, the principal plane fits none of them, and its residuals spread too evenly
 /// to count as outliers; its cut then spans the neighbourhood and so holds all of it: with
 /// the outlier test on the normal's plane only and the early plane taken at any cut, the
 /// corners of the 100k clean plate kept their principal normals, whose surfaces put a lip
-/// 0.025 past the corner (Hausdorff 0.86% of the diagonal against 0.38%).
+/// 0.025 past the corner (Hausdorff 0.86% of the diagonal against 0.38%). Under noise as
+/// large as the sampling step (the 1M noisy part of bench/peers) the same rules fitted planes
+/// to the noise (a sample 3.6 deviations off a corner tilted 65° into the next face, a dent
+/// 0.03 deep; Chamfer 0.0584% -> 0.0591% of the diagonal).
 /// Measured with a numpy prototype of this fit on the 100k clean plate and blobby of
 /// bench/peers (estimated normals, samples within 0.15 of a corner and of a concave crease):
 /// error to the nearer true face normal over 30° on 61 and 22 samples with the principal
 /// normal, 43 and 13 with one start (the normal), 21 and 4 with the four.
 CreaseFit crease_normal(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
                         std::span<const std::uint32_t> neighbors, std::size_t i,
-                        const Vec3f& normal)
+                        const Vec3f& normal, bool clean)
 {
     if (neighbors.size() < 10)
         return {normal};
@@ -630,7 +684,11 @@ CreaseFit crease_normal(std::span<const Vec3f> positions, std::span<const Vec3f>
         return {normal};
     for (std::size_t j = 0; j < hood.count; ++j)
         hood.spatial[j] = std::exp(-hood.x[j].squaredNorm() / (0.25 * far2));
+    // Under noise a sample's plane leaves no outliers where the noise hides the crease, and
+    // the plane fitted instead is the noise's: only clean clouds go on without outliers.
     const bool outliers = hood.has_outliers(original);
+    if (!outliers && !clean)
+        return {normal};
 
     const auto principal = hood.principal_axes([](std::size_t) { return 1.0; });
     const Vec3d e0 = principal->eigenvectors().col(0);
@@ -651,7 +709,7 @@ CreaseFit crease_normal(std::span<const Vec3f> positions, std::span<const Vec3f>
         tightest = std::min(tightest, cuts[c]);
         // A plane from the normal that holds nearly the whole neighbourhood (curvature, not a
         // crease, set off the test): the other starts would not do better.
-        if (c == 0 && cuts[c] < 0.5 * std::sqrt(far2) &&
+        if (c == 0 && (!clean || cuts[c] < 0.5 * std::sqrt(far2)) &&
             hood.support(*fits[c], cuts[c]) >= 0.9 * hood.total())
             break;
     }
@@ -670,7 +728,8 @@ CreaseFit crease_normal(std::span<const Vec3f> positions, std::span<const Vec3f>
     }
     if (!best || (!outliers && !hood.has_outliers(*fits[*best])))
         return {normal};
-    CreaseFit out{fits[*best]->normalized().cast<float>()};
+    const Vec3d fitted = fits[*best]->normalized();
+    CreaseFit out{fitted.cast<float>()};
     out.crease = crease_limit(hood, neighbors, normals, out.normal, cuts[*best]);
     return out;
 }
@@ -1057,6 +1116,7 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
     const std::size_t subsample = (n + stride - 1) / stride;
     std::vector<float> query_reach(subsample);
     std::vector<float> fit_reach(subsample);
+    std::vector<double> fit_flatness(subsample);
     parallel_blocks(subsample, 256, [&](std::size_t begin, std::size_t end) {
         std::vector<std::uint32_t> index(reach_k);
         std::vector<float> d2(reach_k);
@@ -1065,8 +1125,10 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
             m.tree.knn(m.surfels.positions[r * stride], reach_k, index, d2);
             query_reach[r] = d2[query_k - 1];
             fit_reach[r] = d2[k - 1];
+            fit_flatness[r] = flatness(m.surfels.positions, std::span(index).first(k));
         }
     });
+    const bool clean = clean_cloud(fit_flatness);
     const auto grid_cell = [](std::vector<float>& reach) {
         auto middle = reach.begin() + static_cast<std::ptrdiff_t>(reach.size() / 2);
         std::nth_element(reach.begin(), middle, reach.end());
@@ -1140,7 +1202,7 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
             CreaseFit crease{m.surfels.normals[i]};
             if (options.fit == PlaneFit::Quadric && options.crease_fit)
                 crease = crease_normal(fit_positions, fit_normals, neighbors, samples[q],
-                                       m.surfels.normals[i]);
+                                       m.surfels.normals[i], clean);
             packed.normal = crease.normal;
             if (!m.crease.empty())
                 m.crease[m.grid->slot_of(i)] = crease.crease;
@@ -1329,14 +1391,11 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
         // bounded by the line (bounded_face_distance()) with weight λ = max(0, 1 − 2 W_in /
         // (W_in + W_past)): not at all where the others carry half the blend, fully where
         // every sample lies past its line (outside a convex corner, inside a concave one).
-        // The field then changes continuously where a sample's line is crossed. Measured on
-        // the 100k clean inputs of bench/peers (Hausdorff and Chamfer in % of the diagonal),
-        // against the samples past their lines left out wherever others remain: plate 0.38 /
-        // 0.00410 -> 0.40 / 0.00406, part 0.57 / 0.00879 -> 0.43 / 0.00871, blobby 0.32 /
-        // 0.00602 -> 0.26 / 0.00605; the noisy part 1.12 / 0.0818 -> 1.37 / 0.0808; the
-        // bunny 3.56 / 0.0717 -> 3.64 / 0.0708; and the quick start bunny's texture L2
-        // stretch at level 2 1.23 -> 1.02 (the jumps of the field at the lines had put needle
-        // triangles in the levels).
+        // Measured on the 100k clean inputs of bench/peers (Hausdorff and Chamfer in % of the
+        // diagonal), against the samples past their lines left out wherever others remain:
+        // part 0.71 / 0.00888 -> 0.46 / 0.00886, plate 0.40 / 0.00398 -> 0.40 / 0.00397,
+        // blobby 0.34 / 0.00594 -> 0.34 / 0.00592. A sample still changes group where p
+        // crosses its line, so the field is not continuous there.
         std::array<std::uint32_t, max_blend_k + 1> within_slot{};
         std::array<float, max_blend_k + 1> within_dist2{};
         std::array<std::uint32_t, max_blend_k + 1> past_slot{};
