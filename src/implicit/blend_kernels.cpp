@@ -209,9 +209,10 @@ __attribute__((target("avx2"))) BlendSums blend_sums_avx2(const PackedSurfel* pa
 BlendSums blend_sums_reference(const PackedSurfel* packed, const std::uint32_t* slot,
                                const float* dist2, std::size_t used, const Vec3d& p, double inv_h)
 {
-    return blend_sums_of(packed, slot, dist2, used, p, inv_h, [&](std::size_t j, Vec3d* gradient) {
-        return packed[slot[j]].distance(p, gradient);
-    });
+    return blend_sums_of(packed, slot, dist2, used, p, inv_h,
+                         [&](std::size_t j, Vec3d* gradient, double* /*factor*/) {
+                             return packed[slot[j]].distance(p, gradient);
+                         });
 }
 
 bool blend_has_avx2()

@@ -90,9 +90,9 @@ enum class BlendPath
                                    const float* dist2, std::size_t used, const Vec3d& p,
                                    double inv_h, BlendPath path = BlendPath::automatic);
 
-/// The blend sums one sample at a time, with `distance(j, &gradient)` the signed distance to
-/// the surface of sample slot[j] at `p` and its gradient (blend_sums_reference(): the samples'
-/// own surfaces).
+/// The blend sums one sample at a time, with `distance(j, &gradient, &factor)` the signed
+/// distance to the surface of sample slot[j] at `p` and its gradient, and optionally a factor
+/// on its weight (left at 1 by blend_sums_reference(): the samples' own surfaces).
 template <typename Distance>
 [[nodiscard]] BlendSums blend_sums_of(const PackedSurfel* packed, const std::uint32_t* slot,
                                       const float* dist2, std::size_t used, const Vec3d& p,
@@ -105,10 +105,13 @@ template <typename Distance>
         const double t = std::sqrt(static_cast<double>(dist2[j])) * inv_h;
         const double u = std::max(0.0, 1.0 - t);
         const double u3 = u * u * u;
-        const double weight = u3 * u * (4.0 * t + 1.0);
-        const Vec3d weight_gradient = ((-20.0 * inv_h * inv_h) * u3) * offset;
+        const double wendland = u3 * u * (4.0 * t + 1.0);
+        const Vec3d wendland_gradient = ((-20.0 * inv_h * inv_h) * u3) * offset;
         Vec3d normal;
-        const double value = distance(j, &normal);
+        double factor = 1.0;
+        const double value = distance(j, &normal, &factor);
+        const double weight = factor * wendland;
+        const Vec3d weight_gradient = factor * wendland_gradient;
         sums.weight += weight;
         sums.value += weight * value;
         sums.normal += weight * normal;
