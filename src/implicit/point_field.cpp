@@ -799,31 +799,20 @@ Eigen::Vector3f rim_limit(const NeighbourhoodOffset& offset, double radius, doub
             static_cast<float>(blended)};
 }
 
-/// Whether `p` (relative to the origin) lies within a sample's reach across its rim
-/// (rim_limit()): the part of p − s along the outward direction at most the limit.
-bool within_rim(const PackedSurfel& s, const Eigen::Vector3f& rim, const Vec3d& p)
+/// How far `p` (relative to the origin) lies past a sample's limit, a rim's (rim_limit()) or a
+/// crease line's (crease_limit()): the part of p − s along the limit's direction (x, y in the
+/// frame (t1, t2)) beyond its distance z; zero or less where the sample's surface holds at p,
+/// and zero where the limit has no direction (none).
+double past_limit(const PackedSurfel& s, const Eigen::Vector3f& limit, const Vec3d& p)
 {
-    if (rim.x() == 0.0F && rim.y() == 0.0F)
-        return true;
-    const Vec3d x = p - s.position.cast<double>();
-    const Vec3d t1 = s.tangent.cast<double>();
-    const Vec3d t2 = s.normal.cast<double>().cross(t1);
-    const double outward =
-        x.dot(t1) * static_cast<double>(rim.x()) + x.dot(t2) * static_cast<double>(rim.y());
-    return outward <= static_cast<double>(rim.z());
-}
-
-/// How far `p` (relative to the origin) lies past a sample's crease line (crease_limit()):
-/// zero or less where the sample's face holds there, or it has no crease.
-double past_crease(const PackedSurfel& s, const Eigen::Vector4f& crease, const Vec3d& p)
-{
-    if (crease.x() == 0.0F && crease.y() == 0.0F)
+    if (limit.x() == 0.0F && limit.y() == 0.0F)
         return 0.0;
     const Vec3d x = p - s.position.cast<double>();
     const Vec3d t1 = s.tangent.cast<double>();
     const Vec3d t2 = s.normal.cast<double>().cross(t1);
-    return x.dot(t1) * static_cast<double>(crease.x()) +
-           x.dot(t2) * static_cast<double>(crease.y()) - static_cast<double>(crease.z());
+    const double outward =
+        x.dot(t1) * static_cast<double>(limit.x()) + x.dot(t2) * static_cast<double>(limit.y());
+    return outward - static_cast<double>(limit.z());
 }
 
 /// sums += scale × more.
@@ -837,26 +826,20 @@ void add(BlendSums& sums, const BlendSums& more, double scale)
 }
 
 /// The signed distance from `p` (relative to the origin) to a sample's face bounded by its
-/// crease line (crease_limit()), for a point past the line, and its gradient: past a convex
-/// crease the face's nearest point is on the line, and p lies outside unless under the face's
-/// surface too (then the other face's wall is nearer: outside still); past a concave one p
-/// lies inside, under the other face. At an ideal crease of two planes this is the distance to
-/// the nearer face, exact on both sides (the other face's samples, past their own lines, give
-/// the same). The blend weighs it in where the samples whose surface holds at p carry little
-/// of the blend (PointField::Impl::evaluate_with()), as outside a convex corner, where each
-/// face is bounded by two lines and a sample's one line leaves some faces' surfaces running
-/// past the corner.
-double bounded_face_distance(const PackedSurfel& s, const Eigen::Vector4f& crease, const Vec3d& p,
-                             Vec3d* gradient)
+/// crease line (crease_limit()), for a point `past` the line by that much (past_limit()), and
+/// its gradient: past a convex crease the face's nearest point is on the line, and p lies
+/// outside unless under the face's surface too (then the other face's wall is nearer: outside
+/// still); past a concave one p lies inside, under the other face. At an ideal crease of two planes
+/// this is the distance to the nearer face, exact on both sides (the other face's samples, past
+/// their own lines, give the same). The blend weighs it in where the samples whose surface holds at
+/// p carry little of the blend (PointField::Impl::evaluate_with()), as outside a convex corner,
+/// where each face is bounded by two lines and a sample's one line leaves some faces' surfaces
+/// running past the corner.
+double bounded_face_distance(const PackedSurfel& s, const Eigen::Vector4f& crease, double past,
+                             const Vec3d& p, Vec3d* gradient)
 {
     Vec3d surface_gradient;
     const double height = s.distance(p, &surface_gradient);
-    const Vec3d t1 = s.tangent.cast<double>();
-    const Vec3d t2 = s.normal.cast<double>().cross(t1);
-    const Vec3d toward =
-        static_cast<double>(crease.x()) * t1 + static_cast<double>(crease.y()) * t2;
-    const double past = std::max(
-        0.0, (p - s.position.cast<double>()).dot(toward) - static_cast<double>(crease.z()));
     const double along = crease.w() > 0.0F ? std::max(height, 0.0) : std::min(height, 0.0);
     const double length = std::hypot(along, past);
     if (!(length > 0.0))
@@ -864,6 +847,10 @@ double bounded_face_distance(const PackedSurfel& s, const Eigen::Vector4f& creas
         *gradient = surface_gradient;
         return height;
     }
+    const Vec3d t1 = s.tangent.cast<double>();
+    const Vec3d t2 = s.normal.cast<double>().cross(t1);
+    const Vec3d toward =
+        static_cast<double>(crease.x()) * t1 + static_cast<double>(crease.y()) * t2;
     const double value = crease.w() > 0.0F ? length : -length;
     *gradient = (along * surface_gradient + past * toward) / value;
     return value;
@@ -1385,7 +1372,7 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
         const auto r = static_cast<double>(s.radius);
         out.defined = static_cast<double>(dist2[j]) <= r * r;
         if (out.defined && !m.rim.empty())
-            out.defined = within_rim(s, m.rim[slot[j]], p);
+            out.defined = past_limit(s, m.rim[slot[j]], p) <= 0.0;
     }
     if (!out.defined)
     {
@@ -1435,12 +1422,13 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
         std::array<float, max_blend_k + 1> within_dist2{};
         std::array<std::uint32_t, max_blend_k + 1> past_slot{};
         std::array<float, max_blend_k + 1> past_dist2{};
+        std::array<double, max_blend_k + 1> past_by{};
         std::array<double, max_blend_k + 1> share{};
         std::size_t within = 0;
         std::size_t past = 0;
         for (std::size_t j = 0; j < used; ++j)
         {
-            const double beyond = past_crease(m.packed[slot[j]], m.crease[slot[j]], p);
+            const double beyond = past_limit(m.packed[slot[j]], m.crease[slot[j]].head<3>(), p);
             if (!(beyond > 0.0))
             {
                 within_slot[within] = slot[j];
@@ -1451,6 +1439,7 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
             {
                 past_slot[past] = slot[j];
                 past_dist2[past] = dist2[j];
+                past_by[past] = beyond;
                 const double t = width > 0.0 ? std::min(1.0, beyond / width) : 1.0;
                 share[past] = (1.0 - t) * (1.0 - t);
                 ++past;
@@ -1470,8 +1459,8 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
                 m.packed.data(), past_slot.data(), past_dist2.data(), past, p, inv_h,
                 [&](std::size_t j, Vec3d* gradient, double* factor) {
                     *factor = 1.0 - share[j];
-                    return bounded_face_distance(m.packed[past_slot[j]], m.crease[past_slot[j]], p,
-                                                 gradient);
+                    return bounded_face_distance(m.packed[past_slot[j]], m.crease[past_slot[j]],
+                                                 past_by[j], p, gradient);
                 });
             add(sums, holding, 1.0);
             const double total = sums.weight + beyond.weight;
