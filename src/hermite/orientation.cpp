@@ -483,11 +483,14 @@ Guide guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> nor
 
 std::size_t count_flipped(std::span<const Vec3f> before, std::span<const Vec3f> after)
 {
-    std::size_t flipped = 0;
-    for (std::size_t i = 0; i < before.size(); ++i)
-        if (before[i].dot(after[i]) < 0.0F)
-            ++flipped;
-    return flipped;
+    std::atomic<std::size_t> flipped{0};
+    parallel_blocks(before.size(), 65536, [&](std::size_t begin, std::size_t end) {
+        std::size_t local = 0;
+        for (std::size_t i = begin; i < end; ++i)
+            local += before[i].dot(after[i]) < 0.0F ? 1U : 0U;
+        flipped.fetch_add(local, std::memory_order_relaxed);
+    });
+    return flipped.load();
 }
 
 } // namespace
@@ -822,11 +825,65 @@ RiemannianForest riemannian_spanning_forest(std::span<const Vec3f> positions,
 
 namespace {
 
-/// The last two steps of orient_normals_mst() for every component (`component`: one a sample,
-/// RiemannianForest::none to leave a sample out): turn it so that its root (`roots`, one a
+/// Samples a block of reduce_by_component().
+constexpr std::size_t reduce_block = 65536;
+
+/// Per component (`component_of(i)`: sample i's, RiemannianForest::none to leave it out), the
+/// samples 0 to n - 1 folded in index order: `add(acc, i)` folds sample i into its component's
+/// accumulator, `merge(total, part)` a block's part into the total. Blocks run in parallel and are
+/// merged in block order, so the result does not depend on the thread count.
+template <typename ComponentOf, typename Acc, typename Add, typename Merge>
+std::vector<Acc> reduce_by_component(std::size_t n, const ComponentOf& component_of,
+                                     std::size_t count, const Acc& zero, const Add& add,
+                                     const Merge& merge)
+{
+    const std::size_t blocks = (n + reduce_block - 1) / reduce_block;
+    // Each block's runs of one component: few where components are spatially coherent.
+    std::vector<std::vector<std::pair<std::uint32_t, Acc>>> parts(blocks);
+    parallel_blocks(blocks, 1, [&](std::size_t first, std::size_t last) {
+        for (std::size_t b = first; b < last; ++b)
+        {
+            auto& out = parts[b];
+            for (std::size_t i = b * reduce_block; i < std::min(n, (b + 1) * reduce_block); ++i)
+            {
+                const std::uint32_t c = component_of(i);
+                if (c == RiemannianForest::none)
+                    continue;
+                if (out.empty() || out.back().first != c)
+                    out.emplace_back(c, zero);
+                add(out.back().second, i);
+            }
+        }
+    });
+    std::vector<Acc> total(count, zero);
+    for (const auto& part : parts)
+        for (const auto& [c, acc] : part)
+            merge(total[c], acc);
+    return total;
+}
+
+/// Each component's highest sample (the first of them on a tie).
+template <typename ComponentOf>
+std::vector<std::uint32_t> highest_samples(std::span<const Vec3f> positions,
+                                           const ComponentOf& component_of, std::size_t count)
+{
+    const auto higher = [&](std::uint32_t& best, std::uint32_t i) {
+        if (i != RiemannianForest::none &&
+            (best == RiemannianForest::none || positions[i].z() > positions[best].z()))
+            best = i;
+    };
+    return reduce_by_component(
+        positions.size(), component_of, count, RiemannianForest::none,
+        [&](std::uint32_t& best, std::size_t i) { higher(best, static_cast<std::uint32_t>(i)); },
+        higher);
+}
+
+/// The last two steps of orient_normals_mst() for every component (`component_of(i)`: sample
+/// i's, RiemannianForest::none to leave it out): turn it so that its root (`roots`, one a
 /// component, or none) faces +z, then flip it if its area-weighted flux is clearly negative.
+template <typename ComponentOf>
 void face_components(std::span<const Vec3f> positions, const KnnTable& neighbors,
-                     std::span<const std::uint32_t> component, std::span<const std::uint32_t> roots,
+                     const ComponentOf& component_of, std::span<const std::uint32_t> roots,
                      std::span<Vec3f> normals)
 {
     const std::size_t n = positions.size();
@@ -834,36 +891,40 @@ void face_components(std::span<const Vec3f> positions, const KnnTable& neighbors
     std::vector<std::uint8_t> root_down(component_count, 0);
     for (std::size_t c = 0; c < component_count; ++c)
         root_down[c] = roots[c] != RiemannianForest::none && normals[roots[c]].z() < 0.0F;
-    for (std::size_t i = 0; i < n; ++i)
-        if (component[i] != RiemannianForest::none && root_down[component[i]] != 0)
-            normals[i] = -normals[i];
-    //    Σ a_i n_i·(p_i − c), a_i ≈ squared k-th neighbour distance.
-    std::vector<Vec3d> centroid(component_count, Vec3d::Zero());
-    std::vector<double> count(component_count, 0.0);
-    for (std::size_t i = 0; i < n; ++i)
-        if (component[i] != RiemannianForest::none)
-        {
-            centroid[component[i]] += positions[i].cast<double>();
-            count[component[i]] += 1.0;
-        }
+    //    Σ a_i n_i·(p_i − c), a_i ≈ squared k-th neighbour distance, with the normals as they
+    //    are (the root's turn negates it).
+    const std::vector<Eigen::Vector4d> sums = reduce_by_component(
+        n, component_of, component_count, Eigen::Vector4d::Zero().eval(),
+        [&](Eigen::Vector4d& acc, std::size_t i) {
+            acc.head<3>() += positions[i].cast<double>();
+            acc[3] += 1.0;
+        },
+        [](Eigen::Vector4d& total, const Eigen::Vector4d& part) { total += part; });
+    const std::vector<Eigen::Vector2d> fluxes = reduce_by_component(
+        n, component_of, component_count, Eigen::Vector2d::Zero().eval(),
+        [&](Eigen::Vector2d& acc, std::size_t i) {
+            const Eigen::Vector4d& sum = sums[component_of(i)];
+            const double area = neighbors.farthest2(i);
+            const Vec3d d = positions[i].cast<double>() - sum.head<3>() / sum[3];
+            acc[0] += area * normals[i].cast<double>().dot(d);
+            acc[1] += area * d.norm();
+        },
+        [](Eigen::Vector2d& total, const Eigen::Vector2d& part) { total += part; });
+    std::vector<std::uint8_t> flip(component_count, 0);
     for (std::size_t c = 0; c < component_count; ++c)
-        centroid[c] /= count[c];
-    std::vector<double> flux(component_count, 0.0);
-    std::vector<double> magnitude(component_count, 0.0);
-    for (std::size_t i = 0; i < n; ++i)
     {
-        const std::uint32_t c = component[i];
-        if (c == RiemannianForest::none)
-            continue;
-        const double area = neighbors.farthest2(i);
-        const Vec3d d = positions[i].cast<double>() - centroid[c];
-        flux[c] += area * normals[i].cast<double>().dot(d);
-        magnitude[c] += area * d.norm();
+        const double flux = root_down[c] != 0 ? -fluxes[c][0] : fluxes[c][0];
+        const bool inward = flux < -flux_decision_threshold * fluxes[c][1];
+        flip[c] = static_cast<std::uint8_t>((root_down[c] != 0) != inward);
     }
-    for (std::size_t i = 0; i < n; ++i)
-        if (component[i] != RiemannianForest::none &&
-            flux[component[i]] < -flux_decision_threshold * magnitude[component[i]])
-            normals[i] = -normals[i];
+    parallel_blocks(n, reduce_block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            const std::uint32_t c = component_of(i);
+            if (c != RiemannianForest::none && flip[c] != 0)
+                normals[i] = -normals[i];
+        }
+    });
 }
 
 /// A neighbour supports a sample's normal within 30° of it (cos² 30° = 0.75).
@@ -1207,7 +1268,9 @@ OrientedNormals orient_graph(std::span<const Vec3f> positions, std::span<const V
         *components_only = forest.component;
         return result;
     }
-    face_components(positions, neighbors, forest.component, forest.roots, result.normals);
+    face_components(
+        positions, neighbors, [&](std::size_t i) { return forest.component[i]; }, forest.roots,
+        result.normals);
     for (std::size_t i = 0; i < n; ++i)
         if (forest.parent[i] == RiemannianForest::none)
         {
@@ -1218,414 +1281,414 @@ OrientedNormals orient_graph(std::span<const Vec3f> positions, std::span<const V
     return result;
 }
 
-/// Clouds smaller than this are oriented over their whole graph (OrientationOptions::subsample).
-constexpr std::size_t min_subsampled = 2048;
-/// Rounds of the subsample's selection before the samples still undecided join it outright.
-constexpr std::size_t max_selection_rounds = 64;
-/// An edge of the subsample's graph passes no orientation when it leaves both ends' tangent
-/// planes more steeply (|n·ê|) than this plus the sine of half the angle between their normals:
-/// along one smooth sheet an edge tilts by about half the turn of the normals, while an edge
-/// across a thin part (the two sides of a bunny's ear, less than two members apart) joins
-/// parallel normals at a steep angle, and Hoppe's rule would hand one side's orientation to the
-/// other unchanged.
+/// Clouds smaller than this are oriented over their whole graph (OrientationOptions::patches).
+constexpr std::size_t min_patched = 2048;
+/// Samples in a block of orient_by_patches(), in index order: one thread finds a block's patches
+/// (spatially sorted samples, as compute_surfels() has them, make a block a compact piece of
+/// surface). Fixed, so that the result does not depend on the thread count.
+constexpr std::size_t patch_block = 4096;
+/// Agreement |n_a·n_b| from which an edge joins its ends' patches in a block's first pass (normals
+/// within about 18°); the other reliable edges (up to OrientationOptions::patch_cost) join after
+/// them, so that a patch grows over the smoothest steps first, as a spanning tree would.
+constexpr float firm_agreement = 0.95F;
+/// An edge passes no orientation when it leaves both ends' tangent planes more steeply (|n·ê|)
+/// than this plus the sine of half the angle between their normals: along one smooth sheet an
+/// edge tilts by about half the turn of the normals, while an edge across a thin part (the two
+/// sides of a bunny's ear, or of a plate a few sampling steps thick) joins parallel normals at a
+/// steep angle, and Hoppe's rule would hand one side's orientation to the other unchanged.
 constexpr float steep_edge = 0.3F;
-/// Sweeps of every sample's sign by its neighbours' after the subsample's signs are passed on.
-constexpr std::size_t fine_sweeps = 1;
-/// Paths between two cells counted towards their edge's verdict before it counts as settled
-/// (the rest are not checked), and the margin of consistent over inconsistent paths (or the
-/// other way) that an edge needs to pass orientation on (or reversed); with less it is blocked.
-constexpr int settled_balance = 4;
-constexpr int min_balance = 2;
 
-/// A fixed pseudo-random priority of each sample, distinct for distinct samples (the index is its
-/// low half): the subsample depends on nothing but the indices.
-std::uint64_t priority(std::uint32_t i)
+/// Whether the edge a–b leaves the sheet (see steep_edge).
+bool off_sheet(const Vec3f& pa, const Vec3f& na, const Vec3f& pb, const Vec3f& nb)
 {
-    std::uint64_t z = std::uint64_t{i} + 0x9E3779B97F4A7C15ULL;
-    z = (z ^ (z >> 30U)) * 0xBF58476D1CE4E5B9ULL;
-    z = (z ^ (z >> 27U)) * 0x94D049BB133111EBULL;
-    z ^= z >> 31U;
-    return (z << 32U) | i;
+    const Vec3f e = pb - pa;
+    const float len2 = e.squaredNorm();
+    const float da = na.dot(e);
+    const float db = nb.dot(e);
+    // Most edges lie in both tangent planes: no root needed to tell.
+    if (da * da <= steep_edge * steep_edge * len2 || db * db <= steep_edge * steep_edge * len2)
+        return false;
+    const float length = std::sqrt(len2);
+    const float half_turn = std::sqrt(std::max(0.0F, 0.5F * (1.0F - std::abs(na.dot(nb)))));
+    const float limit = (half_turn + steep_edge) * length;
+    return std::abs(da) > limit && std::abs(db) > limit;
 }
 
-/// orient_normals_mst() on a subsample, whose signs then pass to every other sample: for clean
-/// clouds under Hoppe's rule (noisy clouds keep the guided whole graph, orient_graph()).
+/// Disjoint sets whose members carry a sign relative to their set's representative: uniting a
+/// and b says whether a's sign is b's or the opposite.
+class SignedSets
+{
+public:
+    void reset(std::size_t n)
+    {
+        parent_.resize(n);
+        std::iota(parent_.begin(), parent_.end(), 0U);
+        odd_.assign(n, 0);
+        size_.assign(n, 1);
+    }
+
+    /// x's representative and whether x's sign is the opposite of it.
+    std::pair<std::uint32_t, std::uint8_t> find(std::uint32_t x)
+    {
+        std::uint32_t root = x;
+        std::uint8_t odd = 0;
+        while (parent_[root] != root)
+        {
+            odd ^= odd_[root];
+            root = parent_[root];
+        }
+        // Path compression: every member on the way points at the root with its own sign.
+        std::uint8_t left = odd;
+        while (parent_[x] != root)
+        {
+            const std::uint32_t next = parent_[x];
+            const std::uint8_t step = odd_[x];
+            parent_[x] = root;
+            odd_[x] = left;
+            left ^= step;
+            x = next;
+        }
+        return {root, odd};
+    }
+
+    /// Joins the sets of representatives ra and rb (of members a and b, whose signs against them
+    /// are oa and ob) so that b's sign is the opposite of a's when `opposite`. Returns the joined
+    /// set's representative and a's sign against it.
+    std::pair<std::uint32_t, std::uint8_t> link(std::uint32_t ra, std::uint8_t oa, std::uint32_t rb,
+                                                std::uint8_t ob, bool opposite)
+    {
+        const auto odd = static_cast<std::uint8_t>(oa ^ ob ^ (opposite ? 1U : 0U));
+        if (size_[ra] < size_[rb])
+        {
+            parent_[ra] = rb;
+            odd_[ra] = odd;
+            size_[rb] += size_[ra];
+            return {rb, static_cast<std::uint8_t>(oa ^ odd)};
+        }
+        parent_[rb] = ra;
+        odd_[rb] = odd;
+        size_[ra] += size_[rb];
+        return {ra, oa};
+    }
+
+private:
+    std::vector<std::uint32_t> parent_;
+    std::vector<std::uint8_t> odd_;
+    std::vector<std::uint32_t> size_;
+};
+
+/// orient_normals_mst() for clean clouds under Hoppe's rule (noisy clouds keep the guided whole
+/// graph, orient_graph()): patches of consistently oriented samples, found block by block, are
+/// oriented against each other, and the signs spread to every sample.
 ///
-/// 1. The subsample is a maximal independent set of the neighbour graph (its first
-///    graph_columns() columns), chosen by Luby's rounds with fixed pseudo-random priorities among
-///    the samples with a usable normal: every such sample is a member or has one among its
-///    neighbours (about one sample in six is a member with ten columns).
-/// 2. Every other sample belongs to the cell of its nearest member among its neighbours; two
-///    members are joined when a graph edge joins their cells. Every such edge i–j votes on the
-///    member edge s–t: whether the signs of the steps s–i, i–j and j–t, each reliable (as a tree
-///    step cheaper than patch_cost), compose to the sign the rule gives s–t directly. A clear
-///    majority for passes orientation on, one against reverses it (Guide::reversed), no clear
-///    verdict or an edge off the sheet (steep_edge) blocks it (Guide::blocked: it keeps the
-///    components whole but passes nothing). Each member keeps its nearest `columns` - 1.
-/// 3. orient_graph() orients the members (tree, patches, votes) on that graph; then every other
-///    sample takes the sign of the sum of the reliable agreements its decided neighbours
-///    predict, round by round from the members outwards, and one sweep lets every sample follow
-///    all its neighbours. Each component then faces +z at its highest sample and outwards by its
-///    flux, over all its samples as the whole graph's would; samples without a normal inherit
-///    one over the graph's edges either way.
+/// 1. Patches: in each block of patch_block samples (index order), the graph edges inside the
+///    block that are reliable (|n_a·n_b| at least 1 − patch_cost) and on the sheet (steep_edge)
+///    join their ends in signed disjoint sets, firm edges (firm_agreement) first: a patch's
+///    samples take their signs relative to its first sample from the edges that joined them.
+/// 2. Every graph edge between two patches votes on their relative orientation with its
+///    agreement (an edge off the sheet with none: it keeps the components whole but passes
+///    nothing), summed per pair of patches, and a maximum spanning forest of the patch graph (by
+///    the size of the vote) decides each patch's flip, as orient_graph() does with its patches.
+/// 3. Each component then faces +z at its highest sample and outwards by its flux; samples
+///    without a normal inherit one over the graph's edges. (A sweep in which every sample
+///    followed its neighbours changed no sign on the test shapes, the bunny scans or the 1M and
+///    10M blobby, so there is none.)
 ///
-/// Every round reads only the last round's state: the result does not depend on the thread
-/// count. On the clean test shapes, the 1M and 10M blobby and the bunny scans the signs are those
-/// of the whole graph (3 corner samples of 40,000 on a thin plate differ).
-OrientedNormals orient_by_subsample(std::span<const Vec3f> positions,
-                                    std::span<const Vec3f> normals, const KnnTable& neighbors,
-                                    const OrientationOptions& options)
+/// Blocks are fixed and every sum is taken in block order: the result does not depend on the
+/// thread count. On the clean test shapes and the bunny the signs are the whole graph's but for a
+/// few samples at a thin plate's corners.
+OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
+                                  const KnnTable& neighbors, const OrientationOptions& options)
 {
     const std::size_t n = positions.size();
     const std::size_t columns = graph_columns(options, neighbors);
     constexpr std::size_t block = 8192;
-
-    // 1. The subsample: Luby's maximal independent set over the rows.
-    enum State : std::uint8_t
-    {
-        undecided,
-        member,
-        covered,
-        unusable,
-    };
-    std::vector<std::uint8_t> state(n);
-    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i)
-            state[i] = usable(normals[i]) ? undecided : unusable;
-    });
-    std::vector<std::uint8_t> next(n);
-    for (std::size_t round = 0;; ++round)
-    {
-        std::atomic<bool> open{false};
-        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
-            bool local = false;
-            for (std::size_t i = begin; i < end; ++i)
-            {
-                next[i] = state[i];
-                if (state[i] != undecided)
-                    continue;
-                local = true;
-                const std::uint64_t mine = priority(static_cast<std::uint32_t>(i));
-                bool highest = true;
-                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
-                    highest &= j == i || state[j] != undecided || priority(j) < mine;
-                if (highest || round + 1 == max_selection_rounds)
-                    next[i] = member;
-            }
-            if (local)
-                open.store(true, std::memory_order_relaxed);
-        });
-        if (!open.load())
-            break;
-        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
-            for (std::size_t i = begin; i < end; ++i)
-            {
-                state[i] = next[i];
-                if (next[i] != undecided)
-                    continue;
-                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
-                    if (next[j] == member)
-                        state[i] = covered;
-            }
-        });
-    }
-    std::vector<std::uint8_t>().swap(next);
-    std::vector<std::uint32_t> members;
-    for (std::size_t i = 0; i < n; ++i)
-        if (state[i] == member)
-            members.push_back(static_cast<std::uint32_t>(i));
-    const std::size_t m = members.size();
-    //    Each sample's cell: the index of its nearest member among its neighbours (a member is
-    //    its own), and each cell's samples.
-    std::vector<std::uint32_t> cell(n, RiemannianForest::none);
-    parallel_blocks(m, block, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t q = begin; q < end; ++q)
-            cell[members[q]] = static_cast<std::uint32_t>(q);
-    });
-    //    A step's sign, 0 when it is not reliable (as a tree edge dearer than patch_cost); and
-    //    each sample's step from its member.
+    constexpr std::uint32_t none = RiemannianForest::none;
     const float reliable = 1.0F - static_cast<float>(options.patch_cost);
-    const auto step_sign = [&](std::uint32_t a, std::uint32_t b) -> std::int8_t {
-        if (a == b)
-            return 1;
-        const float agree = agreement(positions, normals, options.rule, a, b);
-        return std::abs(agree) >= reliable ? (agree < 0.0F ? -1 : 1) : 0;
-    };
-    std::vector<std::int8_t> from_member(n, 0);
-    std::vector<std::uint32_t> cell_start(m + 1, 0);
-    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i)
-        {
-            if (state[i] == covered)
-                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
-                    if (state[j] == member)
-                    {
-                        cell[i] = cell[j];
-                        from_member[i] = step_sign(j, static_cast<std::uint32_t>(i));
-                        break;
-                    }
-            if (state[i] == member)
-                from_member[i] = 1;
-            if (cell[i] != RiemannianForest::none)
-                std::atomic_ref<std::uint32_t>(cell_start[cell[i] + 1])
-                    .fetch_add(1, std::memory_order_relaxed);
-        }
-    });
-    for (std::size_t q = 0; q < m; ++q)
-        cell_start[q + 1] += cell_start[q];
-    std::vector<std::uint32_t> cell_samples(cell_start[m]);
-    {
-        std::vector<std::uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
-        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
-            for (std::size_t i = begin; i < end; ++i)
-                if (cell[i] != RiemannianForest::none)
-                    cell_samples[std::atomic_ref<std::uint32_t>(fill[cell[i]])
-                                     .fetch_add(1, std::memory_order_relaxed)] =
-                        static_cast<std::uint32_t>(i);
-        });
-    }
+    const float firm = std::max(reliable, firm_agreement);
 
-    // 2. The subsample's own graph: each member's nearest `columns` - 1 members among those whose
-    //    cells touch its own (column 0 is the member itself, as in a neighbour table; short rows
-    //    repeat it), mostly consistent edges first; steep and undecided edges are blocked.
-    std::vector<Vec3f> sub_positions(m);
-    std::vector<Vec3f> sub_fine(m);
-    Guide sub_guide;
-    KnnTable sub_table;
-    sub_table.k = columns;
-    sub_table.indices.resize(m * columns);
-    sub_table.squared_distances.resize(m * columns);
-    sub_guide.blocked.resize(m * columns);
-    sub_guide.reversed.resize(m * columns);
-    parallel_blocks(m, 1024, [&](std::size_t begin, std::size_t end) {
-        // The members whose cells touch this one: distinct, few (about six on a surface).
-        struct Candidate
+    // 1. Each block's patches: every sample's patch (numbered in the block first) and whether
+    //    its sign is the opposite of its patch's first sample's.
+    const std::size_t blocks = (n + patch_block - 1) / patch_block;
+    std::vector<std::uint32_t> patch(n, none);
+    std::vector<std::uint8_t> opposite(n, 0);
+    std::vector<std::uint32_t> block_start(blocks + 1, 0);
+    //    Each block also keeps the edges that may join two patches (those leaving the block,
+    //    the unreliable ones and those off the sheet), for the votes: edge i * columns + c of
+    //    the block is column c of its sample i.
+    std::vector<std::vector<std::uint32_t>> crossing(blocks);
+    parallel_blocks(blocks, 1, [&](std::size_t first, std::size_t last) {
+        SignedSets sets;
+        std::vector<std::uint32_t> later;
+        std::vector<std::uint32_t> local_id(patch_block);
+        for (std::size_t b = first; b < last; ++b)
         {
-            float len2;
-            std::uint32_t index;
-            bool steep;
-            bool flips;  // the orientation rule's sign across s–t
-            int balance; // consistent minus inconsistent edges between the cells
-        };
-        std::vector<Candidate> found;
-        for (std::size_t q = begin; q < end; ++q)
-        {
-            const std::uint32_t s = members[q];
-            sub_positions[q] = positions[s];
-            sub_fine[q] = normals[s];
-            found.clear();
-            // Every neighbour graph edge i–j from s's cell to another: it is consistent with
-            // the edge s–t to j's member t when the steps s–i, i–j and j–t compose to the sign
-            // the rule gives s–t directly.
-            const auto flips = [&](std::uint32_t a, std::uint32_t b) {
-                return a != b && agreement(positions, normals, options.rule, a, b) < 0.0F;
+            const std::size_t begin = b * patch_block;
+            const std::size_t end = std::min(n, begin + patch_block);
+            sets.reset(end - begin);
+            later.clear();
+            auto& open = crossing[b];
+            //    Joins i (whose set and sign are root and odd) and its column c, j.
+            const auto join = [&](std::size_t i, std::size_t c, std::uint32_t j,
+                                  std::pair<std::uint32_t, std::uint8_t>& own) {
+                const auto edge = static_cast<std::uint32_t>((i - begin) * columns + c);
+                const auto [rj, oj] = sets.find(static_cast<std::uint32_t>(j - begin));
+                if (rj == own.first)
+                    return;
+                if (off_sheet(positions[i], normals[i], positions[j], normals[j]))
+                    open.push_back(edge);
+                else
+                    own =
+                        sets.link(own.first, own.second, rj, oj, normals[i].dot(normals[j]) < 0.0F);
             };
-            for (std::uint32_t c = cell_start[q]; c < cell_start[q + 1]; ++c)
+            for (std::size_t i = begin; i < end; ++i)
             {
-                const std::uint32_t i = cell_samples[c];
-                const int first = from_member[i];
-                if (first == 0)
+                if (!usable(normals[i]))
                     continue;
-                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                auto own = sets.find(static_cast<std::uint32_t>(i - begin));
+                const auto row = neighbors.neighbors(i).first(columns);
+                for (std::size_t c = 0; c < columns; ++c)
                 {
-                    const std::uint32_t other = cell[j];
-                    if (other == RiemannianForest::none || other == q)
+                    const std::uint32_t j = row[c];
+                    if (j == i)
                         continue;
-                    const std::uint32_t t = members[other];
-                    auto at = std::find_if(found.begin(), found.end(),
-                                           [&](const Candidate& x) { return x.index == other; });
-                    if (at == found.end())
+                    const auto edge = static_cast<std::uint32_t>((i - begin) * columns + c);
+                    if (j < begin || j >= end)
                     {
-                        const Vec3f e = positions[t] - positions[s];
-                        const float len2 = e.squaredNorm();
-                        // Off the sheet: the edge leaves both tangent planes more steeply
-                        // than the turn of the normals explains (about half of it along one
-                        // smooth sheet; parallel normals across a thin part turn not at all).
-                        const float length = std::sqrt(len2);
-                        const float half_turn = std::sqrt(
-                            std::max(0.0F, 0.5F * (1.0F - std::abs(normals[s].dot(normals[t])))));
-                        const float limit = (half_turn + steep_edge) * length;
-                        const bool steep = options.rule == OrientationRule::Hoppe && len2 > 0.0F &&
-                                           std::abs(normals[s].dot(e)) > limit &&
-                                           std::abs(normals[t].dot(e)) > limit;
-                        found.push_back({len2, other, steep, flips(s, t), 0});
-                        at = found.end() - 1;
-                    }
-                    if (at->steep || std::abs(at->balance) >= settled_balance)
+                        open.push_back(edge);
                         continue;
-                    const int path = first * step_sign(i, j) * from_member[j];
-                    if (path != 0)
-                        at->balance += (path < 0) == at->flips ? 1 : -1;
+                    }
+                    if (!usable(normals[j]))
+                        continue;
+                    const float agree = std::abs(normals[i].dot(normals[j]));
+                    if (agree >= firm)
+                        join(i, c, j, own);
+                    else if (agree >= reliable)
+                        later.push_back(edge);
+                    else
+                        open.push_back(edge);
                 }
             }
-            // The nearest members across mostly consistent edges, then the nearest of the rest
-            // as blocked edges: they keep the graph's components whole but pass no orientation.
-            std::sort(found.begin(), found.end(), [](const Candidate& x, const Candidate& y) {
-                const bool x_bad = x.steep || std::abs(x.balance) < min_balance;
-                const bool y_bad = y.steep || std::abs(y.balance) < min_balance;
-                if (x_bad != y_bad)
-                    return y_bad;
-                return x.len2 != y.len2 ? x.len2 < y.len2 : x.index < y.index;
-            });
-            const std::size_t kept = std::min(found.size(), columns - 1);
-            std::uint32_t* row = sub_table.indices.data() + q * columns;
-            float* d2 = sub_table.squared_distances.data() + q * columns;
-            row[0] = static_cast<std::uint32_t>(q);
-            d2[0] = 0.0F;
-            // Nearest first, as in a neighbour table; short rows repeat the member itself.
-            std::sort(found.begin(), found.begin() + static_cast<std::ptrdiff_t>(kept),
-                      [](const Candidate& x, const Candidate& y) {
-                          return x.len2 != y.len2 ? x.len2 < y.len2 : x.index < y.index;
-                      });
-            std::uint8_t* blocked = sub_guide.blocked.data() + q * columns;
-            std::uint8_t* reversed = sub_guide.reversed.data() + q * columns;
-            blocked[0] = 0;
-            reversed[0] = 0;
-            for (std::size_t c = 1; c < columns; ++c)
+            for (const std::uint32_t edge : later)
             {
-                const bool real = c <= kept;
-                row[c] = real ? found[c - 1].index : static_cast<std::uint32_t>(q);
-                d2[c] = real ? found[c - 1].len2 : d2[c - 1];
-                blocked[c] =
-                    real && (found[c - 1].steep || std::abs(found[c - 1].balance) < min_balance)
-                        ? 1
-                        : 0;
-                reversed[c] = real && found[c - 1].balance <= -min_balance ? 1 : 0;
+                const std::size_t i = begin + edge / columns;
+                auto own = sets.find(static_cast<std::uint32_t>(i - begin));
+                join(i, edge % columns, neighbors.neighbors(i)[edge % columns], own);
+            }
+            std::uint32_t count = 0;
+            for (std::size_t i = begin; i < end; ++i)
+                if (usable(normals[i]) &&
+                    sets.find(static_cast<std::uint32_t>(i - begin)).first == i - begin)
+                    local_id[i - begin] = count++;
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                if (!usable(normals[i]))
+                    continue;
+                const auto [root, odd] = sets.find(static_cast<std::uint32_t>(i - begin));
+                patch[i] = local_id[root];
+                opposite[i] = odd;
+            }
+            block_start[b + 1] = count;
+        }
+    });
+    for (std::size_t b = 0; b < blocks; ++b)
+        block_start[b + 1] += block_start[b];
+    const std::size_t patch_count = block_start[blocks];
+    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+            if (patch[i] != none)
+                patch[i] += block_start[i / patch_block];
+    });
+    const auto signed_normal = [&](std::uint32_t i) {
+        return opposite[i] != 0 ? Vec3f(-normals[i]) : normals[i];
+    };
+
+    // 2. The votes of the edges between patches, summed per pair in each block in edge order,
+    //    then over the blocks in block order.
+    struct Vote
+    {
+        std::uint64_t pair; // lower patch << 32 | higher patch
+        double weight;
+    };
+    std::vector<std::vector<Vote>> block_votes(blocks);
+    parallel_blocks(blocks, 1, [&](std::size_t first, std::size_t last) {
+        // A block's first few pairs are summed in place (a compact block touches about ten);
+        // the pairs of a scattered one (samples not in spatial order) are sorted at the end.
+        constexpr std::size_t searched = 64;
+        std::vector<std::pair<std::uint64_t, float>> rest;
+        for (std::size_t b = first; b < last; ++b)
+        {
+            rest.clear();
+            auto& out = block_votes[b];
+            std::size_t hit = 0;
+            const std::size_t begin = b * patch_block;
+            for (const std::uint32_t edge : crossing[b])
+            {
+                const std::size_t i = begin + edge / columns;
+                const std::uint32_t j = neighbors.neighbors(i)[edge % columns];
+                const std::uint32_t pi = patch[i];
+                const std::uint32_t pj = patch[j];
+                if (pi == none || pj == none || pj == pi)
+                    continue;
+                const Vec3f ni = signed_normal(static_cast<std::uint32_t>(i));
+                const Vec3f nj = signed_normal(j);
+                const float weight =
+                    off_sheet(positions[i], ni, positions[j], nj) ? 0.0F : ni.dot(nj);
+                const std::uint64_t pair =
+                    (std::uint64_t{std::min(pi, pj)} << 32U) | std::max(pi, pj);
+                if (hit >= out.size() || out[hit].pair != pair)
+                    hit = static_cast<std::size_t>(
+                        std::find_if(out.begin(), out.end(),
+                                     [&](const Vote& v) { return v.pair == pair; }) -
+                        out.begin());
+                if (hit < out.size())
+                    out[hit].weight += static_cast<double>(weight);
+                else if (out.size() < searched)
+                    out.push_back({pair, static_cast<double>(weight)});
+                else
+                    rest.emplace_back(pair, weight);
+            }
+            std::vector<std::uint32_t>().swap(crossing[b]);
+            std::sort(rest.begin(), rest.end());
+            for (std::size_t v = 0; v < rest.size();)
+            {
+                Vote sum{rest[v].first, 0.0};
+                for (; v < rest.size() && rest[v].first == sum.pair; ++v)
+                    sum.weight += static_cast<double>(rest[v].second);
+                out.push_back(sum);
             }
         }
     });
-    OrientationOptions sub_options = options;
-    sub_options.k = 0;
-    std::vector<std::uint32_t> sub_component;
-    OrientedNormals sub =
-        orient_graph(sub_positions, sub_fine, sub_guide, sub_table, sub_options, &sub_component);
-    std::vector<Vec3f>().swap(sub_positions);
-    std::vector<Vec3f>().swap(sub_fine);
-    sub_table = KnnTable();
-
-    // 3. Every other sample takes its sign from its decided neighbours, members first: the round
-    //    in which a sample is decided is its stamp, and a round reads only earlier stamps.
-    OrientedNormals result;
-    result.components = sub.components;
-    result.normals.assign(n, Vec3f::Zero());
-    constexpr std::uint32_t not_yet = 0xFFFFFFFFU;
-    std::vector<std::uint32_t> stamp(n, not_yet);
-    parallel_blocks(m, block, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t q = begin; q < end; ++q)
-        {
-            result.normals[members[q]] = sub.normals[q];
-            stamp[members[q]] = 0;
-        }
+    std::vector<Vote> votes;
+    for (auto& own : block_votes)
+    {
+        votes.insert(votes.end(), own.begin(), own.end());
+        std::vector<Vote>().swap(own);
+    }
+    std::stable_sort(votes.begin(), votes.end(),
+                     [](const Vote& x, const Vote& y) { return x.pair < y.pair; });
+    std::vector<Vote> patch_edges;
+    for (std::size_t v = 0; v < votes.size();)
+    {
+        Vote sum{votes[v].pair, 0.0};
+        for (; v < votes.size() && votes[v].pair == sum.pair; ++v)
+            sum.weight += votes[v].weight;
+        patch_edges.push_back(sum);
+    }
+    std::vector<Vote>().swap(votes);
+    //    The maximum spanning forest of the patch graph by the size of the votes, walked from
+    //    each component's lowest patch.
+    std::stable_sort(patch_edges.begin(), patch_edges.end(), [](const Vote& x, const Vote& y) {
+        return std::abs(x.weight) > std::abs(y.weight);
     });
-    std::vector<std::uint32_t>().swap(members);
-    sub = OrientedNormals();
+    const auto ends = [](const Vote& e) {
+        return std::pair<std::uint32_t, std::uint32_t>(static_cast<std::uint32_t>(e.pair >> 32U),
+                                                       static_cast<std::uint32_t>(e.pair));
+    };
+    std::vector<std::uint32_t> degree(patch_count + 1, 0);
+    std::vector<Vote> tree;
+    {
+        DisjointSets sets(patch_count);
+        for (const Vote& e : patch_edges)
+        {
+            const auto [a, b] = ends(e);
+            if (sets.unite(a, b))
+            {
+                tree.push_back(e);
+                ++degree[a + 1];
+                ++degree[b + 1];
+            }
+        }
+    }
+    std::vector<Vote>().swap(patch_edges);
+    for (std::size_t p = 0; p < patch_count; ++p)
+        degree[p + 1] += degree[p];
+    std::vector<std::pair<std::uint32_t, bool>> adjacent(degree[patch_count]);
+    {
+        std::vector<std::uint32_t> fill(degree.begin(), degree.end() - 1);
+        for (const Vote& e : tree)
+        {
+            const auto [a, b] = ends(e);
+            adjacent[fill[a]++] = {b, e.weight < 0.0};
+            adjacent[fill[b]++] = {a, e.weight < 0.0};
+        }
+    }
+    std::vector<std::uint8_t> patch_flip(patch_count, 0);
+    std::vector<std::uint32_t> patch_component(patch_count, none);
+    std::size_t components = 0;
+    {
+        std::vector<std::uint32_t> queue;
+        for (std::uint32_t start = 0; start < patch_count; ++start)
+        {
+            if (patch_component[start] != none)
+                continue;
+            const auto c = static_cast<std::uint32_t>(components++);
+            patch_component[start] = c;
+            queue.assign(1, start);
+            for (std::size_t head = 0; head < queue.size(); ++head)
+            {
+                const std::uint32_t p = queue[head];
+                for (std::uint32_t e = degree[p]; e < degree[p + 1]; ++e)
+                {
+                    const auto [q, disagree] = adjacent[e];
+                    if (patch_component[q] != none)
+                        continue;
+                    patch_component[q] = c;
+                    patch_flip[q] = static_cast<std::uint8_t>(patch_flip[p] ^ (disagree ? 1U : 0U));
+                    queue.push_back(q);
+                }
+            }
+        }
+    }
+
+    OrientedNormals result;
+    result.components = components;
+    result.normals.resize(n); // every entry written below, in parallel
+    std::atomic<std::size_t> undecided{0};
+    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        std::size_t left = 0;
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            const std::uint32_t p = patch[i];
+            if (p == none)
+            {
+                result.normals[i] = Vec3f::Zero();
+                ++left;
+                continue;
+            }
+            result.normals[i] =
+                (opposite[i] ^ patch_flip[p]) != 0 ? Vec3f(-normals[i]) : normals[i];
+        }
+        undecided.fetch_add(left, std::memory_order_relaxed);
+    });
+    std::vector<std::uint8_t>().swap(patch_flip);
+    std::vector<std::uint8_t>().swap(opposite);
+
+    // 3. Each component faces +z at its highest sample, then outwards by its flux.
+    const auto component_of = [&](std::size_t i) {
+        return patch[i] == none ? none : patch_component[patch[i]];
+    };
+    face_components(positions, neighbors, component_of,
+                    highest_samples(positions, component_of, components), result.normals);
+    std::vector<std::uint32_t>().swap(patch_component);
+    result.flipped = count_flipped(normals, result.normals);
+    if (undecided.load() == 0)
+        return result;
+    //    Samples without a normal take their nearest decided neighbour's over the graph's edges
+    //    either way, round by round: a sample's own row first (nearest first), else the
+    //    lowest-numbered decided sample that lists it.
+    constexpr std::uint32_t not_yet = 0xFFFFFFFFU;
+    std::vector<std::uint32_t> stamp(n);
+    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+            stamp[i] = patch[i] == none ? not_yet : 0;
+    });
     const auto decided_before = [&](std::uint32_t j, std::uint32_t round) {
         return std::atomic_ref<std::uint32_t>(stamp[j]).load(std::memory_order_relaxed) < round;
     };
     const auto decide = [&](std::size_t i, std::uint32_t round) {
         std::atomic_ref<std::uint32_t>(stamp[i]).store(round, std::memory_order_relaxed);
     };
-    //    Samples with a normal: the sum of the agreements their decided neighbours predict.
-    bool last_resort = false;
-    for (std::uint32_t round = 1;; ++round)
-    {
-        std::atomic<bool> progressed{false};
-        std::atomic<bool> left{false};
-        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
-            bool local_progress = false;
-            bool local_left = false;
-            for (std::size_t i = begin; i < end; ++i)
-            {
-                if (state[i] == unusable || stamp[i] != not_yet)
-                    continue;
-                const auto a = static_cast<std::uint32_t>(i);
-                float sum = 0.0F;
-                bool voted = false;
-                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
-                {
-                    if (j == a || !decided_before(j, round) || !usable(result.normals[j]))
-                        continue;
-                    const float agree = agreement_of(positions[j], result.normals[j], positions[i],
-                                                     normals[i], options.rule);
-                    if (!(std::abs(agree) >= reliable) && !last_resort)
-                        continue;
-                    sum += agree;
-                    voted = true;
-                }
-                if (!voted)
-                {
-                    local_left = true;
-                    continue;
-                }
-                result.normals[i] = sum < 0.0F ? Vec3f(-normals[i]) : normals[i];
-                decide(i, round);
-                local_progress = true;
-            }
-            if (local_progress)
-                progressed.store(true, std::memory_order_relaxed);
-            if (local_left)
-                left.store(true, std::memory_order_relaxed);
-        });
-        if (!left.load() || (last_resort && !progressed.load()))
-            break;
-        last_resort = !progressed.load();
-    }
-    //    Then every sample re-decides by the sum of the agreements of all its neighbours
-    //    (Jacobi sweeps over a snapshot), so that a sample follows its own neighbourhood rather
-    //    than the one or two members among its neighbours.
-    for (std::size_t sweep = 0; sweep < fine_sweeps; ++sweep)
-    {
-        const std::vector<Vec3f> snapshot = result.normals;
-        parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
-            for (std::size_t i = begin; i < end; ++i)
-            {
-                if (state[i] == unusable || stamp[i] == not_yet)
-                    continue;
-                const auto a = static_cast<std::uint32_t>(i);
-                float sum = 0.0F;
-                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
-                {
-                    if (j == a || !usable(snapshot[j]))
-                        continue;
-                    const float agree = agreement_of(positions[j], snapshot[j], positions[i],
-                                                     snapshot[i], options.rule);
-                    if (std::abs(agree) >= reliable)
-                        sum += agree;
-                }
-                if (sum < 0.0F)
-                    result.normals[i] = -snapshot[i];
-            }
-        });
-    }
-    //    Samples with a normal that no decided sample reached (every edge jumps between sheets)
-    //    keep theirs; samples without one take their nearest decided neighbour's.
-    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i)
-            if (state[i] != unusable && stamp[i] == not_yet)
-            {
-                result.normals[i] = normals[i];
-                stamp[i] = 0;
-            }
-    });
-    //    Over the graph's edges either way: a sample's own row first (nearest first), else the
-    //    lowest-numbered decided sample that lists it.
-    //    Each component faces +z at its highest sample, then outwards by its flux, as the
-    //    whole graph's would (decided over all its samples, not its members).
-    {
-        std::vector<std::uint32_t> component(n, RiemannianForest::none);
-        std::vector<std::uint32_t> roots(result.components, RiemannianForest::none);
-        for (std::size_t i = 0; i < n; ++i)
-        {
-            if (state[i] == unusable || cell[i] == RiemannianForest::none)
-                continue;
-            const std::uint32_t c = sub_component[cell[i]];
-            component[i] = c;
-            std::uint32_t& root = roots[c];
-            if (root == RiemannianForest::none || positions[i].z() > positions[root].z())
-                root = static_cast<std::uint32_t>(i);
-        }
-        face_components(positions, neighbors, component, roots, result.normals);
-    }
     std::vector<std::uint8_t> inherited(n, 0);
     std::vector<std::uint32_t> offer(n, not_yet);
     for (std::uint32_t round = 1;; ++round)
@@ -1705,7 +1768,6 @@ OrientedNormals orient_by_subsample(std::span<const Vec3f> positions,
                     --count;
         result.components += count;
     }
-    result.flipped = count_flipped(normals, result.normals);
     return result;
 }
 
@@ -1726,9 +1788,9 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
     Guide guide;
     if (options.rule == OrientationRule::Hoppe && options.guide_rings > 0 && !positions.empty())
         guide = guide_normals(positions, fine_normals, neighbors, options.guide_rings);
-    if (options.subsample && options.rule == OrientationRule::Hoppe && guide.normals.empty() &&
-        positions.size() >= min_subsampled)
-        return orient_by_subsample(positions, fine_normals, neighbors, options);
+    if (options.patches && options.rule == OrientationRule::Hoppe && guide.normals.empty() &&
+        positions.size() >= min_patched)
+        return orient_by_patches(positions, fine_normals, neighbors, options);
     return orient_graph(positions, fine_normals, guide, neighbors, options);
 }
 

@@ -9,6 +9,7 @@
 #include <nanoflann.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -336,12 +337,19 @@ void check_knn_table(const KnnTable& table, std::size_t rows, std::size_t points
                      const char* function)
 {
     check_knn_table_shape(table, rows, function);
-    // Whether any is out of range first (a loop without branches), the offender only then.
+    // Whether any is out of range first (loops without branches, in parallel), the offender only
+    // then.
     const auto limit = static_cast<std::uint64_t>(points);
-    bool out_of_range = false;
-    for (const std::uint32_t index : table.indices)
-        out_of_range |= index >= limit;
-    if (!out_of_range)
+    std::atomic<bool> out_of_range{false};
+    parallel_blocks(table.indices.size(), std::size_t{1} << 20U,
+                    [&](std::size_t begin, std::size_t end) {
+                        bool local = false;
+                        for (std::size_t i = begin; i < end; ++i)
+                            local |= table.indices[i] >= limit;
+                        if (local)
+                            out_of_range.store(true, std::memory_order_relaxed);
+                    });
+    if (!out_of_range.load())
         return;
     const auto bad = static_cast<std::size_t>(
         std::find_if(table.indices.begin(), table.indices.end(),

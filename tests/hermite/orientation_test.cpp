@@ -497,13 +497,15 @@ TEST(SimpleOrientations, TowardsAlongAndFlip)
 namespace pointform {
 namespace {
 
-/// Clean clouds are oriented on a subsample (OrientationOptions::subsample) and must come out as
+/// Clean clouds are oriented by patches (OrientationOptions::patches) and must come out as
 /// the whole graph orients them: creases (blobby, part), a plate 2.8 sampling steps thick, two
-/// components, and the bunny's ears, thinner than two subsample spacings (before the test of
-/// edges off the sheet, one whole ear came out inside out: 294 of 8904 samples). At most one
+/// components, and the bunny's thin ears (before edges off the sheet passed no orientation, the
+/// earlier subsample scheme turned one whole ear inside out: 294 of 8904 samples). The samples
+/// are in random order here, so a block's patches are scattered (compute_surfels() sorts them
+/// first): the scheme must hold either way. At most one
 /// sample in 10,000 may take the other sign (the plate's corners, where the normal turns through
 /// 90° twice within a step, differ in 3 of 40,000), and never more of them against the truth.
-TEST(OrientNormalsMst, SubsampleOrientsCleanCloudsAsTheWholeGraph)
+TEST(OrientNormalsMst, PatchesOrientCleanCloudsAsTheWholeGraph)
 {
     std::vector<std::pair<std::string, PointCloud>> clouds;
     clouds.emplace_back("blobby", sample_shape(Shape::Blobby, {.count = 40000, .seed = 11}));
@@ -517,11 +519,11 @@ TEST(OrientNormalsMst, SubsampleOrientsCleanCloudsAsTheWholeGraph)
     {
         const Prepared p = prepare(cloud, 17);
         const OrientedNormals whole = orient_normals_mst(cloud.positions, p.normals.normals,
-                                                         p.table, {.k = 10, .subsample = false});
+                                                         p.table, {.k = 10, .patches = false});
         const auto runs = test::at_thread_counts(
             [&] {
                 return orient_normals_mst(cloud.positions, p.normals.normals, p.table,
-                                          {.k = 10, .subsample = true});
+                                          {.k = 10, .patches = true});
             },
             {.min_multi_block_loops = 4});
         for (const OrientedNormals& sub : runs)
