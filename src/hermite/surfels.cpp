@@ -51,23 +51,52 @@ void check_surfel_input(const PointCloudView& cloud, std::size_t k)
     if (k < 3)
         throw InvalidInput("k = " + std::to_string(k) +
                            " is too small: a tangent plane needs at least 3 neighbours");
-    if (cloud.size() <= k)
-        throw InvalidInput("only " + std::to_string(cloud.size()) + " points, fewer than k + 1 = " +
+    const std::size_t n = cloud.size();
+    if (n <= k)
+        throw InvalidInput("only " + std::to_string(n) + " points, fewer than k + 1 = " +
                            std::to_string(k + 1) + " (a point and its k neighbours)");
-    for (std::size_t i = 0; i < cloud.size(); ++i)
-        if (!cloud.positions[i].allFinite())
-            throw InvalidInput("point " + std::to_string(i) + " has a NaN or infinite coordinate");
 
-    Vec3d mean = Vec3d::Zero();
-    for (const auto& p : cloud.positions)
-        mean += p.cast<double>();
-    mean /= static_cast<double>(cloud.size());
-    Mat3d covariance = Mat3d::Zero();
-    for (const auto& p : cloud.positions)
+    // One pass, in parallel blocks whose sums are added in block order (the same bits at any
+    // thread count): the first non-finite point, and the moments about the first point (close
+    // to the cloud, so the covariance loses little to cancellation).
+    const std::size_t blocks = (n + gather_block - 1) / gather_block;
+    struct Moments
     {
-        const Vec3d d = p.cast<double>() - mean;
-        covariance.noalias() += d * d.transpose();
+        std::size_t first_bad = ~std::size_t{0};
+        Vec3d sum = Vec3d::Zero();
+        Mat3d products = Mat3d::Zero();
+    };
+    std::vector<Moments> parts(blocks);
+    const Vec3d pivot = cloud.positions[0].cast<double>();
+    parallel_blocks(blocks, 1, [&](std::size_t first, std::size_t last) {
+        for (std::size_t b = first; b < last; ++b)
+        {
+            Moments& part = parts[b];
+            for (std::size_t i = b * gather_block; i < std::min(n, (b + 1) * gather_block); ++i)
+            {
+                if (!cloud.positions[i].allFinite())
+                {
+                    part.first_bad = std::min(part.first_bad, i);
+                    continue;
+                }
+                const Vec3d d = cloud.positions[i].cast<double>() - pivot;
+                part.sum += d;
+                part.products.noalias() += d * d.transpose();
+            }
+        }
+    });
+    Vec3d sum = Vec3d::Zero();
+    Mat3d products = Mat3d::Zero();
+    for (const Moments& part : parts)
+    {
+        if (part.first_bad != ~std::size_t{0})
+            throw InvalidInput("point " + std::to_string(part.first_bad) +
+                               " has a NaN or infinite coordinate");
+        sum += part.sum;
+        products += part.products;
     }
+    const Vec3d mean = sum / static_cast<double>(n);
+    const Mat3d covariance = products - static_cast<double>(n) * mean * mean.transpose();
     const Eigen::SelfAdjointEigenSolver<Mat3d> solver(covariance, Eigen::EigenvaluesOnly);
     const Vec3d& lambda = solver.eigenvalues();
     if (!(lambda[2] > 0.0))
@@ -79,12 +108,12 @@ void check_surfel_input(const PointCloudView& cloud, std::size_t k)
 
 SurfelResult compute_surfels(const PointCloudView& cloud, const SurfelOptions& options)
 {
+    SurfelResult result;
+    StageTimer timer(result.stage_seconds);
     check_surfel_input(cloud, options.k);
     if (!(options.radius_scale > 0.0) || !std::isfinite(options.radius_scale))
         throw InvalidInput("radius scale must be positive and finite");
-
-    SurfelResult result;
-    StageTimer timer(result.stage_seconds);
+    timer.lap("check");
     const std::size_t n = cloud.size();
 
     // Work on the points in Morton order, so that neighbours are close in memory; map back at
@@ -150,22 +179,32 @@ SurfelResult compute_surfels(const PointCloudView& cloud, const SurfelOptions& o
 
     // Back to the input order.
     result.surfels.origin = cloud.origin;
-    result.surfels.positions.assign(cloud.positions.begin(), cloud.positions.end());
     result.surfels.colors.assign(cloud.colors.begin(), cloud.colors.end());
+    result.surfels.positions.resize(n); // every entry written below, in parallel
     result.surfels.normals.resize(n);
     result.surfels.radii.resize(n);
+    //    Each sample's place in the sorted order, so that the gathers below read at random and
+    //    write in order.
+    std::vector<std::uint32_t> rank(n);
     parallel_blocks(n, gather_block, [&](std::size_t begin, std::size_t end) {
         for (std::size_t j = begin; j < end; ++j)
+            rank[order[j]] = static_cast<std::uint32_t>(j);
+    });
+    parallel_blocks(n, gather_block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
         {
-            result.surfels.normals[order[j]] = oriented.normals[j];
-            result.surfels.radii[order[j]] = radii[j];
+            result.surfels.positions[i] = cloud.positions[i];
+            result.surfels.normals[i] = oriented.normals[rank[i]];
+            result.surfels.radii[i] = radii[rank[i]];
         }
     });
+    // The normals are the surfels'; the report keeps the rest.
     result.orientation = std::move(oriented);
-    result.orientation.normals = result.surfels.normals;
+    std::vector<Vec3f>().swap(result.orientation.normals);
     for (auto& index : result.orientation.unoriented)
         index = order[index];
     std::sort(result.orientation.unoriented.begin(), result.orientation.unoriented.end());
+    timer.lap("output order");
     return result;
 }
 

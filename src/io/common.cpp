@@ -57,11 +57,7 @@ bool CloudBuilder::add(const PointRecord& point, Location where)
     }
     cloud_.positions.emplace_back((point.position - cloud_.origin).cast<float>());
     if (attributes_.normals)
-    {
-        const float length = point.normal.norm();
-        cloud_.normals.push_back(
-            std::isfinite(length) && length > 0.0F ? Vec3f(point.normal / length) : Vec3f::Zero());
-    }
+        cloud_.normals.push_back(unit_or_zero(point.normal));
     if (attributes_.colors)
         cloud_.colors.push_back(point.color);
     if (attributes_.radii)
@@ -93,9 +89,14 @@ void OutputBuffer::flush()
 {
     if (buffer_.empty())
         return;
-    if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
-        fail(*path_, "write failed (disk full or I/O error)");
+    write_through(buffer_);
     buffer_.clear();
+}
+
+void OutputBuffer::write_through(std::string_view bytes)
+{
+    if (std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size())
+        fail(*path_, "write failed (disk full or I/O error)");
 }
 
 void OutputBuffer::write_number(float value)

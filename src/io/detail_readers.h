@@ -9,11 +9,15 @@
 // buffered output sink).
 
 #include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+#include "pointform/geometry/point_cloud.h"
 #include "pointform/io/io.h"
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -381,6 +385,18 @@ private:
 
 /// Collects points into a PointCloud: chooses the origin from the first kept point, stores
 /// positions as float relative to it, normalizes normals, and applies the non-finite policy.
+/// Points a block of CloudBuilder::add_all().
+inline constexpr std::size_t add_all_block = std::size_t{1} << 16U;
+/// No point, in CloudBuilder::add_all().
+inline constexpr std::size_t add_all_none = ~std::size_t{0};
+
+/// A file's normal scaled to unit length; zero where it has no length (or none that is finite).
+[[nodiscard]] inline Vec3f unit_or_zero(const Vec3f& normal)
+{
+    const float length = normal.norm();
+    return std::isfinite(length) && length > 0.0F ? Vec3f(normal / length) : Vec3f::Zero();
+}
+
 class CloudBuilder
 {
 public:
@@ -391,6 +407,12 @@ public:
     /// Adds a point. Returns false if it was dropped (non-finite coordinates under Drop).
     /// Throws IoError at `where` for non-finite coordinates under Error.
     bool add(const PointRecord& point, Location where);
+
+    /// Adds points 0 to count - 1, which `decode(i, point)` fills in (from any thread; it must
+    /// not depend on the order of calls), as add() called on each in turn would: the same cloud,
+    /// the same drops, the same error. Decodes in parallel, each point twice.
+    template <typename Decode, typename WhereOf>
+    void add_all(std::size_t count, const Decode& decode, const WhereOf& where_of);
 
     [[nodiscard]] std::size_t dropped() const { return dropped_; }
 
@@ -409,6 +431,103 @@ private:
     std::size_t dropped_ = 0;
     Location first_dropped_;
 };
+
+template <typename Decode, typename WhereOf>
+void CloudBuilder::add_all(std::size_t count, const Decode& decode, const WhereOf& where_of)
+{
+    const std::size_t block = add_all_block;
+    const std::size_t nowhere = add_all_none;
+    const std::size_t blocks = (count + block - 1) / block;
+    // 1. Each block's non-finite points: how many, and the first; and its first finite point.
+    struct Tally
+    {
+        std::size_t bad = 0;
+        std::size_t first_bad = add_all_none;
+        std::size_t first_good = add_all_none;
+    };
+    std::vector<Tally> tally(blocks);
+    parallel_blocks(blocks, 1, [&](std::size_t first, std::size_t last) {
+        PointRecord point;
+        for (std::size_t b = first; b < last; ++b)
+            for (std::size_t i = b * block; i < std::min(count, (b + 1) * block); ++i)
+            {
+                decode(i, point);
+                Tally& t = tally[b];
+                if (point.position.allFinite())
+                {
+                    if (t.first_good == nowhere)
+                        t.first_good = i;
+                }
+                else if (t.bad++ == 0)
+                    t.first_bad = i;
+            }
+    });
+    std::size_t bad = 0;
+    std::size_t first_bad = nowhere;
+    std::size_t first_good = nowhere;
+    std::vector<std::size_t> good_before(blocks + 1, 0);
+    for (std::size_t b = 0; b < blocks; ++b)
+    {
+        if (first_bad == nowhere)
+            first_bad = tally[b].first_bad;
+        if (first_good == nowhere)
+            first_good = tally[b].first_good;
+        bad += tally[b].bad;
+        const std::size_t size = std::min(count, (b + 1) * block) - b * block;
+        good_before[b + 1] = good_before[b] + size - tally[b].bad;
+    }
+    if (bad > 0)
+    {
+        if (policy_ != NonFinitePolicy::Drop)
+            fail(*path_,
+                 "non-finite coordinate in point " +
+                     std::to_string(cloud_.size() + dropped_ + first_bad),
+                 where_of(first_bad));
+        if (dropped_ == 0)
+            first_dropped_ = where_of(first_bad);
+        dropped_ += bad;
+    }
+    if (first_good == nowhere)
+        return;
+    PointRecord point;
+    if (!has_origin_)
+    {
+        decode(first_good, point);
+        cloud_.origin = choose_origin(point.position);
+        has_origin_ = true;
+    }
+    // 2. Every finite point in its place, after the points added before.
+    const std::size_t start = cloud_.size();
+    const std::size_t total = start + good_before[blocks];
+    cloud_.positions.resize(total);
+    if (attributes_.normals)
+        cloud_.normals.resize(total);
+    if (attributes_.colors)
+        cloud_.colors.resize(total);
+    if (attributes_.radii)
+        cloud_.radii.resize(total);
+    parallel_blocks(blocks, 1, [&](std::size_t first, std::size_t last) {
+        PointRecord record;
+        for (std::size_t b = first; b < last; ++b)
+        {
+            std::size_t at = start + good_before[b];
+            for (std::size_t i = b * block; i < std::min(count, (b + 1) * block); ++i)
+            {
+                decode(i, record);
+                if (!record.position.allFinite())
+                    continue;
+                cloud_.positions[at] = (record.position - cloud_.origin).cast<float>();
+                if (attributes_.normals)
+                    cloud_.normals[at] = unit_or_zero(record.normal);
+                if (attributes_.colors)
+                    cloud_.colors[at] = record.color;
+                if (attributes_.radii)
+                    cloud_.radii[at] = record.radius;
+                ++at;
+            }
+        }
+    });
+}
 
 /// How many elements to reserve when a header announces `declared` items of at least
 /// `min_bytes` each and `available` bytes remain: never more than the file can hold.
@@ -439,7 +558,10 @@ public:
     {
         if (buffer_.size() + bytes.size() > capacity)
             flush();
-        buffer_.append(bytes);
+        if (bytes.size() >= capacity)
+            write_through(bytes);
+        else
+            buffer_.append(bytes);
     }
 
     void put(char c)
@@ -469,7 +591,29 @@ public:
     /// Writes out everything buffered. Throws IoError on failure.
     void flush();
 
+    /// Encodes items 0 to count - 1 of `size` bytes each, `encode(i, p)` writing item i at p
+    /// (from any thread), in parallel, a few hundred thousand at a time.
+    template <typename Encode>
+    void write_items(std::size_t count, std::size_t size, const Encode& encode)
+    {
+        constexpr std::size_t round = std::size_t{1} << 18U;
+        std::vector<char> bytes;
+        for (std::size_t first = 0; first < count; first += round)
+        {
+            const std::size_t items = std::min(round, count - first);
+            bytes.resize(items * size);
+            parallel_blocks(items, 8192, [&](std::size_t begin, std::size_t end) {
+                for (std::size_t i = begin; i < end; ++i)
+                    encode(first + i, bytes.data() + i * size);
+            });
+            write(std::string_view(bytes.data(), bytes.size()));
+        }
+    }
+
 private:
+    /// Writes `bytes` to the file, past the buffer (which must be flushed first).
+    void write_through(std::string_view bytes);
+
     static constexpr std::size_t capacity = std::size_t{1} << 20;
 
     std::FILE* file_;

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 
 namespace pointform::detail {
@@ -327,6 +328,31 @@ std::uint8_t to_color(double value, PlyType type)
 }
 
 /// Values of a binary body, read through a ByteCursor in the file's byte order.
+/// A binary PLY scalar of `type` at p, as a double.
+double load_scalar(const char* p, PlyType type, ByteOrder order)
+{
+    switch (type)
+    {
+        case PlyType::Int8:
+            return load<std::int8_t>(p, order);
+        case PlyType::Uint8:
+            return load<std::uint8_t>(p, order);
+        case PlyType::Int16:
+            return load<std::int16_t>(p, order);
+        case PlyType::Uint16:
+            return load<std::uint16_t>(p, order);
+        case PlyType::Int32:
+            return load<std::int32_t>(p, order);
+        case PlyType::Uint32:
+            return load<std::uint32_t>(p, order);
+        case PlyType::Float32:
+            return static_cast<double>(load<float>(p, order));
+        case PlyType::Float64:
+            return load<double>(p, order);
+    }
+    return 0.0;
+}
+
 class BinarySource
 {
 public:
@@ -347,37 +373,45 @@ public:
     double scalar(PlyType type)
     {
         need(type_size(type));
-        const char* p = cursor_.data();
-        double value = 0.0;
-        switch (type)
-        {
-            case PlyType::Int8:
-                value = load<std::int8_t>(p, order_);
-                break;
-            case PlyType::Uint8:
-                value = load<std::uint8_t>(p, order_);
-                break;
-            case PlyType::Int16:
-                value = load<std::int16_t>(p, order_);
-                break;
-            case PlyType::Uint16:
-                value = load<std::uint16_t>(p, order_);
-                break;
-            case PlyType::Int32:
-                value = load<std::int32_t>(p, order_);
-                break;
-            case PlyType::Uint32:
-                value = load<std::uint32_t>(p, order_);
-                break;
-            case PlyType::Float32:
-                value = static_cast<double>(load<float>(p, order_));
-                break;
-            case PlyType::Float64:
-                value = load<double>(p, order_);
-                break;
-        }
+        const double value = load_scalar(cursor_.data(), type, order_);
         cursor_.seek(cursor_.offset() + type_size(type));
         return value;
+    }
+
+    /// Reads all of a vertex element whose instances have one size (no lists) at once, in
+    /// parallel; false (nothing read) when its instances do not have one size or the file ends
+    /// inside it (the reading one by one then says where).
+    bool read_fixed_size(const PlyElement& element, CloudBuilder& builder)
+    {
+        const std::size_t stride = element.fixed_stride();
+        if (stride == 0 || element.count > cursor_.remaining() / stride)
+            return false;
+        std::vector<std::size_t> offsets;
+        std::size_t offset = 0;
+        for (const auto& property : element.properties)
+        {
+            offsets.push_back(offset);
+            offset += type_size(property.type);
+        }
+        const char* base = cursor_.data();
+        const std::size_t start = cursor_.offset();
+        const auto count = static_cast<std::size_t>(element.count);
+        builder.add_all(
+            count,
+            [&](std::size_t i, PointRecord& point) {
+                point = PointRecord{};
+                const char* p = base + i * stride;
+                for (std::size_t k = 0; k < offsets.size(); ++k)
+                {
+                    const PlyProperty& property = element.properties[k];
+                    const double value = load_scalar(p + offsets[k], property.type, order_);
+                    set_field(point, property.field,
+                              is_color(property.field) ? to_color(value, property.type) : value);
+                }
+            },
+            [&](std::size_t i) { return Location::at_byte(start + i * stride); });
+        cursor_.seek(start + count * stride);
+        return true;
     }
 
     void skip_values(PlyType type, std::uint64_t n)
@@ -561,6 +595,9 @@ private:
 template <typename Source>
 void read_vertices(Source& source, const PlyElement& element, CloudBuilder& builder)
 {
+    if constexpr (std::is_same_v<Source, BinarySource>)
+        if (source.read_fixed_size(element, builder))
+            return;
     for (std::uint64_t i = 0; i < element.count; ++i)
     {
         source.begin(element, i);
@@ -681,6 +718,51 @@ void write_header(OutputBuffer& out, const PointCloudView& cloud, std::size_t fa
     out.write("end_header\n");
 }
 
+/// The vertex element of a binary PLY file, in parallel (see write_header() for the layout).
+void write_binary_vertices(OutputBuffer& out, const PointCloudView& cloud, bool world_double)
+{
+    const std::size_t size = (world_double ? 24U : 12U) + (cloud.has_normals() ? 12U : 0U) +
+                             (cloud.has_colors() ? 3U : 0U) + (cloud.has_radii() ? 4U : 0U);
+    const auto put = [](char*& p, auto value) {
+        if constexpr (native_byte_order != ByteOrder::Little)
+            value = byte_swap(value);
+        std::memcpy(p, &value, sizeof(value));
+        p += sizeof(value);
+    };
+    out.write_items(cloud.size(), size, [&](std::size_t i, char* p) {
+        if (world_double)
+        {
+            const Vec3d w = cloud.world(i);
+            put(p, w.x());
+            put(p, w.y());
+            put(p, w.z());
+        }
+        else
+        {
+            const Vec3f& v = cloud.positions[i];
+            put(p, v.x());
+            put(p, v.y());
+            put(p, v.z());
+        }
+        if (cloud.has_normals())
+        {
+            const Vec3f& n = cloud.normals[i];
+            put(p, n.x());
+            put(p, n.y());
+            put(p, n.z());
+        }
+        if (cloud.has_colors())
+        {
+            const Color c = cloud.colors[i];
+            put(p, c.r);
+            put(p, c.g);
+            put(p, c.b);
+        }
+        if (cloud.has_radii())
+            put(p, cloud.radii[i]);
+    });
+}
+
 } // namespace
 
 ReadResult read_ply(const std::filesystem::path& path, std::string_view bytes,
@@ -711,64 +793,32 @@ void write_ply(OutputBuffer& out, const PointCloudView& cloud, std::span<const T
 {
     write_header(out, cloud, triangles.size(), ascii);
     const bool world_double = !cloud.origin.isZero(0.0);
-    for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (!ascii)
+        write_binary_vertices(out, cloud, world_double);
+    for (std::size_t i = 0; ascii && i < cloud.size(); ++i)
     {
-        if (ascii)
-        {
-            write_world_text(out, cloud, i, precision);
-            if (cloud.has_normals())
-                for (int axis = 0; axis < 3; ++axis)
-                {
-                    out.put(' ');
-                    out.write_number(cloud.normals[i][axis]);
-                }
-            if (cloud.has_colors())
-            {
-                const Color c = cloud.colors[i];
-                for (const std::uint8_t channel : {c.r, c.g, c.b})
-                {
-                    out.put(' ');
-                    out.write_integer(channel);
-                }
-            }
-            if (cloud.has_radii())
+        write_world_text(out, cloud, i, precision);
+        if (cloud.has_normals())
+            for (int axis = 0; axis < 3; ++axis)
             {
                 out.put(' ');
-                out.write_number(cloud.radii[i]);
+                out.write_number(cloud.normals[i][axis]);
             }
-            out.put('\n');
-            continue;
-        }
-        if (world_double)
-        {
-            const Vec3d p = cloud.world(i);
-            out.write_le(p.x());
-            out.write_le(p.y());
-            out.write_le(p.z());
-        }
-        else
-        {
-            const Vec3f& p = cloud.positions[i];
-            out.write_le(p.x());
-            out.write_le(p.y());
-            out.write_le(p.z());
-        }
-        if (cloud.has_normals())
-        {
-            const Vec3f& n = cloud.normals[i];
-            out.write_le(n.x());
-            out.write_le(n.y());
-            out.write_le(n.z());
-        }
         if (cloud.has_colors())
         {
             const Color c = cloud.colors[i];
-            const char rgb[3] = {static_cast<char>(c.r), static_cast<char>(c.g),
-                                 static_cast<char>(c.b)};
-            out.write(std::string_view(rgb, 3));
+            for (const std::uint8_t channel : {c.r, c.g, c.b})
+            {
+                out.put(' ');
+                out.write_integer(channel);
+            }
         }
         if (cloud.has_radii())
-            out.write_le(cloud.radii[i]);
+        {
+            out.put(' ');
+            out.write_number(cloud.radii[i]);
+        }
+        out.put('\n');
     }
     for (const Triangle& t : triangles)
     {

@@ -3,10 +3,14 @@
 
 #include "io_test_util.h"
 #include "support/test_support.h"
+#include "support/thread_counts.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <limits>
+#include <set>
 
 namespace pointform::test {
 namespace {
@@ -357,6 +361,74 @@ TEST(PlyErrors, NonFiniteCoordinates)
     const std::size_t data = b.size();
     b.le(0.0F).le(0.0F).le(0.0F).le(1.0F).le(std::numeric_limits<float>::infinity()).le(1.0F);
     expect_file_error_at_offset(dir / "nan_binary.ply", b.str(), "non-finite", data + 12);
+}
+
+/// Binary vertices of one size are read in parallel blocks (CloudBuilder::add_all()): the cloud,
+/// the drops and the error must be those of reading them one by one, as the ascii reader does,
+/// at any thread count, with non-finite points in different blocks.
+TEST(PlyErrors, BinaryVerticesReadInParallelAsOneByOne)
+{
+    TempDir dir;
+    constexpr std::size_t count = 200000;
+    const std::set<std::size_t> bad = {70001, 150000};
+    const char* properties =
+        "property double x\nproperty double y\nproperty double z\nproperty float nx\n"
+        "property float ny\nproperty float nz\nproperty uchar red\nproperty uchar green\n"
+        "property uchar blue\nproperty int unused\nproperty float radius\nend_header\n";
+    Bytes b;
+    b.text("ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(count) + "\n")
+        .text(properties);
+    const std::size_t data = b.size();
+    std::string ascii = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(count) + "\n";
+    ascii += properties;
+    for (std::size_t i = 0; i < count; ++i)
+    {
+        const double t = static_cast<double>(i);
+        const double x =
+            bad.contains(i) ? std::numeric_limits<double>::quiet_NaN() : 500000.0 + std::sin(t);
+        const auto n = static_cast<float>(i % 7) - 3.0F;
+        b.le(x).le(std::cos(t)).le(0.001 * t).le(n).le(1.0F).le(0.0F);
+        b.le(static_cast<std::uint8_t>(i))
+            .le(std::uint8_t{7})
+            .le(static_cast<std::uint8_t>(i / 256));
+        b.le(static_cast<std::int32_t>(i)).le(static_cast<float>(t) * 0.5F);
+        char line[256];
+        std::snprintf(line, sizeof line, "%.17g %.17g %.17g %.9g 1 0 %u 7 %u %zu %.9g\n", x,
+                      std::cos(t), 0.001 * t, static_cast<double>(n),
+                      static_cast<unsigned>(i % 256), static_cast<unsigned>((i / 256) % 256), i,
+                      static_cast<double>(static_cast<float>(t) * 0.5F));
+        ascii += line;
+    }
+    const auto binary_path = dir / "binary.ply";
+    const auto ascii_path = dir / "ascii.ply";
+    write_file(binary_path, b.str());
+    write_file(ascii_path, ascii);
+
+    const ReadResult one_by_one = read_geometry(ascii_path, {.non_finite = NonFinitePolicy::Drop});
+    ASSERT_EQ(one_by_one.points.size(), count - bad.size());
+    EXPECT_EQ(one_by_one.dropped_points, bad.size());
+    const auto runs = test::at_thread_counts(
+        [&] { return read_geometry(binary_path, {.non_finite = NonFinitePolicy::Drop}); },
+        {.min_multi_block_loops = 2});
+    for (const ReadResult& read : runs)
+    {
+        EXPECT_EQ(read.dropped_points, bad.size());
+        EXPECT_EQ(read.points.origin, one_by_one.points.origin);
+        EXPECT_EQ(read.points.positions, one_by_one.points.positions);
+        EXPECT_EQ(read.points.normals, one_by_one.points.normals);
+        EXPECT_EQ(read.points.radii, one_by_one.points.radii);
+        ASSERT_EQ(read.points.colors.size(), one_by_one.points.colors.size());
+        for (std::size_t i = 0; i < read.points.colors.size(); ++i)
+        {
+            const Color c = read.points.colors[i];
+            const Color d = one_by_one.points.colors[i];
+            ASSERT_TRUE(c.r == d.r && c.g == d.g && c.b == d.b) << i;
+        }
+    }
+    // Without dropping: the first bad point, where it starts.
+    const std::size_t stride = 3 * 8 + 3 * 4 + 3 + 4 + 4;
+    (void)expect_file_error_at_offset(dir / "bad.ply", b.str(), "point 70001",
+                                      data + 70001 * stride);
 }
 
 TEST(PlyErrors, DroppingVerticesOfAMeshIsAnError)

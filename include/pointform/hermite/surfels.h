@@ -56,12 +56,13 @@ struct SurfelResult
 {
     /// The input points (same order, same origin) with oriented unit normals and radii.
     PointCloud surfels;
-    /// Orientation outcome (components, flipped, unoriented samples).
+    /// Orientation outcome (components, flipped, unoriented samples); its `normals` are left
+    /// empty (they are the surfels').
     OrientedNormals orientation;
     /// Samples whose neighbourhood was coincident or collinear (normal taken from a neighbour).
     std::size_t degenerate = 0;
-    /// Wall-clock seconds by stage, in order: "spatial sort", "kd-tree", "knn", "normals",
-    /// "orientation", "radius".
+    /// Wall-clock seconds by stage, in order: "check", "spatial sort", "kd-tree", "knn",
+    /// "normals", "orientation", "radius", "output order" (back to the input's order).
     std::vector<std::pair<std::string, double>> stage_seconds;
 };
 
