@@ -5,11 +5,13 @@
 
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
+#include "pointform/spatial/spatial_sort.h"
 
 #include <nanoflann.hpp>
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -156,6 +158,55 @@ Node* divide_tree(NanoTree& tree, std::span<const Vec3f> points, Node*& next, Of
 /// Points a subtree at least, below which it is built by one thread (divide_tree()).
 constexpr std::size_t min_subtree = 8192;
 
+/// The subtree of points [left, right) of points in Morton order (`keys`, non-decreasing), its
+/// nodes taken in turn from `next`: each node splits its points where their keys first differ,
+/// which is a plane between two halves of a grid cell (so every point of the first child lies
+/// below every point of the second along that axis), down to leaves of at most `leaf` points
+/// (or of points in one cell). No point moves: the leaves are ranges of the input. `bbox` is set
+/// to the points' box.
+Node* morton_subtree(std::span<const Vec3f> points, std::span<const std::uint64_t> keys,
+                     std::size_t leaf, Node*& next, Offset left, Offset right, BoundingBox& bbox)
+{
+    Node* node = next++;
+    const std::uint64_t differ = keys[left] ^ keys[right - 1];
+    if (right - left <= leaf || differ == 0)
+    {
+        node->child1 = node->child2 = nullptr;
+        node->node_type.lr.left = left;
+        node->node_type.lr.right = right;
+        for (int d = 0; d < 3; ++d)
+            bbox[d].low = bbox[d].high = points[left][d];
+        for (Offset k = left + 1; k < right; ++k)
+            for (int d = 0; d < 3; ++d)
+            {
+                bbox[d].low = std::min(bbox[d].low, points[k][d]);
+                bbox[d].high = std::max(bbox[d].high, points[k][d]);
+            }
+        return node;
+    }
+    const int bit = 63 - std::countl_zero(differ);
+    const std::uint64_t mask = std::uint64_t{1} << static_cast<unsigned>(bit);
+    const auto middle = static_cast<Offset>(
+        std::partition_point(keys.begin() + static_cast<std::ptrdiff_t>(left),
+                             keys.begin() + static_cast<std::ptrdiff_t>(right),
+                             [&](std::uint64_t key) { return (key & mask) == 0; }) -
+        keys.begin());
+    const int axis = bit % 3;
+    BoundingBox low;
+    BoundingBox high;
+    node->child1 = morton_subtree(points, keys, leaf, next, left, middle, low);
+    node->child2 = morton_subtree(points, keys, leaf, next, middle, right, high);
+    node->node_type.sub.divfeat = axis;
+    node->node_type.sub.divlow = low[axis].high;
+    node->node_type.sub.divhigh = high[axis].low;
+    for (int d = 0; d < 3; ++d)
+    {
+        bbox[d].low = std::min(low[d].low, high[d].low);
+        bbox[d].high = std::max(low[d].high, high[d].high);
+    }
+    return node;
+}
+
 } // namespace
 
 struct KdTree::Impl
@@ -179,14 +230,124 @@ struct KdTree::Impl
             build();
     }
 
+    /// Points in Morton order (spatial_order(), as compute_surfels() and the field sort them)
+    /// get a tree split where their Morton keys first differ (build_in_order()): no point
+    /// moves, so it is built in one pass over the points. Others get nanoflann's tree
+    /// (build_by_splits()). The k nearest neighbours do not depend on the tree (OrderedKnnResult).
+    void build();
+
     /// nanoflann's buildIndex(), giving the same tree, in parallel: the top nodes are split
     /// level by level, the nodes of a level at once, down to subtrees of about n / 64 points
     /// (at least min_subtree), which are then built at once; the top nodes' split bounds and
     /// boxes are filled in last, from their children's boxes, bottom up.
-    void build();
+    void build_by_splits();
+
+    /// The tree of morton_subtree() over points whose Morton `keys` do not decrease: the top
+    /// nodes one by one down to subtrees of about n / 64 points (at least min_subtree), which
+    /// are built at once; the top nodes' split bounds and boxes last, bottom up.
+    void build_in_order(std::span<const std::uint64_t> keys);
 };
 
 void KdTree::Impl::build()
+{
+    const std::vector<std::uint64_t> keys = morton_keys(data.points);
+    std::atomic<bool> sorted{true};
+    parallel_blocks(keys.size() - 1, 1U << 16U, [&](std::size_t begin, std::size_t end) {
+        bool local = true;
+        for (std::size_t i = begin; i < end; ++i)
+            local &= keys[i] <= keys[i + 1];
+        if (!local)
+            sorted.store(false, std::memory_order_relaxed);
+    });
+    if (sorted.load())
+        build_in_order(keys);
+    else
+        build_by_splits();
+}
+
+void KdTree::Impl::build_in_order(std::span<const std::uint64_t> keys)
+{
+    const std::span<const Vec3f> points = data.points;
+    const std::size_t n = points.size();
+    tree.m_size = n;
+    tree.m_size_at_index_build = n;
+    tree.vAcc.resize(n);
+    parallel_blocks(n, 1U << 16U, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+            tree.vAcc[i] = static_cast<std::uint32_t>(i);
+    });
+    const std::size_t leaf = tree.m_leaf_max_size;
+    struct Top
+    {
+        Offset left;
+        Offset right;
+        std::size_t child1 = 0;
+        std::size_t child2 = 0;
+        int axis = 0;
+        bool split = false;
+        BoundingBox bbox{};
+        Node* node = nullptr;
+    };
+    const std::size_t grain = std::max({min_subtree, n / 64, leaf});
+    std::vector<Top> top{{.left = 0, .right = n}};
+    std::vector<std::size_t> subtrees;
+    for (std::size_t t = 0; t < top.size(); ++t)
+    {
+        const Offset left = top[t].left;
+        const Offset right = top[t].right;
+        const std::uint64_t differ = keys[left] ^ keys[right - 1];
+        if (right - left <= grain || differ == 0)
+        {
+            subtrees.push_back(t);
+            continue;
+        }
+        const int bit = 63 - std::countl_zero(differ);
+        const std::uint64_t mask = std::uint64_t{1} << static_cast<unsigned>(bit);
+        const auto middle = static_cast<Offset>(
+            std::partition_point(keys.begin() + static_cast<std::ptrdiff_t>(left),
+                                 keys.begin() + static_cast<std::ptrdiff_t>(right),
+                                 [&](std::uint64_t key) { return (key & mask) == 0; }) -
+            keys.begin());
+        top[t].split = true;
+        top[t].axis = bit % 3;
+        top[t].child1 = top.size();
+        top[t].child2 = top.size() + 1;
+        top.push_back({.left = left, .right = middle});
+        top.push_back({.left = middle, .right = right});
+    }
+    nodes.reset(new Node[2 * n]); // NOLINT(cppcoreguidelines-owning-memory): not initialised
+    parallel_blocks(subtrees.size(), 1, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t s = begin; s < end; ++s)
+        {
+            Top& node = top[subtrees[s]];
+            Node* next = nodes.get() + 2 * node.left;
+            node.node = morton_subtree(points, keys, leaf, next, node.left, node.right, node.bbox);
+        }
+    });
+    for (std::size_t t = top.size(); t-- > 0;)
+    {
+        Top& node = top[t];
+        if (!node.split)
+            continue;
+        const Top& low = top[node.child1];
+        const Top& high = top[node.child2];
+        node.node = tree.pool.allocate<Node>();
+        node.node->node_type.sub.divfeat = node.axis;
+        node.node->child1 = low.node;
+        node.node->child2 = high.node;
+        node.node->node_type.sub.divlow = low.bbox[node.axis].high;
+        node.node->node_type.sub.divhigh = high.bbox[node.axis].low;
+        for (int d = 0; d < 3; ++d)
+        {
+            node.bbox[d].low = std::min(low.bbox[d].low, high.bbox[d].low);
+            node.bbox[d].high = std::max(low.bbox[d].high, high.bbox[d].high);
+        }
+    }
+    tree.root_bbox = top[0].bbox;
+    tree.root_node = top[0].node;
+}
+
+void KdTree::Impl::build_by_splits()
 {
     const std::span<const Vec3f> points = data.points;
     const std::size_t n = points.size();

@@ -175,22 +175,16 @@ std::unique_ptr<Keyed[]> bucket_sort(std::unique_ptr<Keyed[]> keyed, std::size_t
     return scattered;
 }
 
-} // namespace
-
-std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions)
+/// The Morton key of each point, on a grid of 2^21 cells an axis over
+/// the points' bounding box, passed to `use(i, key)` in parallel.
+template <typename Use>
+void for_each_key(std::span<const Vec3f> positions, const Use& use)
 {
     const Aabb box = parallel_bounding_box(positions);
-    // (Morton key, index) pairs: sorting them orders by key, ties by original index.
-    const std::size_t n = positions.size();
-    std::vector<std::uint32_t> order(n);
-    if (n == 0)
-        return order;
-    // NOLINTNEXTLINE(cppcoreguidelines-owning-memory): not initialised, every entry is written
-    std::unique_ptr<Keyed[]> keyed(new Keyed[n]);
     const Vec3d extent = box.size();
     const double largest = std::max({extent.x(), extent.y(), extent.z()});
     const double scale = largest > 0.0 ? static_cast<double>((1U << 21U) - 1U) / largest : 0.0;
-    parallel_blocks(n, 16384, [&](std::size_t begin, std::size_t end) {
+    parallel_blocks(positions.size(), 16384, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
         {
             const Vec3d q = (positions[i].cast<double>() - box.min) * scale;
@@ -200,10 +194,32 @@ std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions)
                                               std::clamp(v, 0.0, static_cast<double>(0x1FFFFF)))
                                         : std::uint64_t{0};
             };
-            keyed[i] = {spread_bits(cell(q.x())) | spread_bits(cell(q.y())) << 1U |
-                            spread_bits(cell(q.z())) << 2U,
-                        static_cast<std::uint32_t>(i)};
+            use(i, spread_bits(cell(q.x())) | spread_bits(cell(q.y())) << 1U |
+                       spread_bits(cell(q.z())) << 2U);
         }
+    });
+}
+
+} // namespace
+
+std::vector<std::uint64_t> morton_keys(std::span<const Vec3f> positions)
+{
+    std::vector<std::uint64_t> keys(positions.size());
+    for_each_key(positions, [&](std::size_t i, std::uint64_t key) { keys[i] = key; });
+    return keys;
+}
+
+std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions)
+{
+    // (Morton key, index) pairs: sorting them orders by key, ties by original index.
+    const std::size_t n = positions.size();
+    std::vector<std::uint32_t> order(n);
+    if (n == 0)
+        return order;
+    // NOLINTNEXTLINE(cppcoreguidelines-owning-memory): not initialised, every entry is written
+    std::unique_ptr<Keyed[]> keyed(new Keyed[n]);
+    for_each_key(positions, [&](std::size_t i, std::uint64_t key) {
+        keyed[i] = {key, static_cast<std::uint32_t>(i)};
     });
     keyed = bucket_sort(std::move(keyed), n); // keys paired with their index: a strict order
     parallel_blocks(n, 1U << 16U, [&](std::size_t begin, std::size_t end) {

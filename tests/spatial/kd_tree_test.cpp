@@ -6,6 +6,7 @@
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 #include "pointform/geometry/shapes.h"
+#include "pointform/spatial/spatial_sort.h"
 
 #include "support/thread_counts.h"
 
@@ -299,6 +300,57 @@ TEST(KdTree, TiesAtTheKthNeighbourGoToTheLowestIndices)
             }
             if (k > 1)
                 EXPECT_GT(tied, 10U) << "k " << k; // the case under test does occur
+        }
+    }
+}
+
+/// Points in Morton order (spatial_order()) get the tree split where their Morton keys differ
+/// (KdTree::Impl::build_in_order()): the same neighbours, ties included, as brute force: many
+/// coincident copies (cells holding more points than a leaf), a lattice (points on the split
+/// planes) and a flat plate (keys that never differ along one axis), at every leaf size and
+/// thread count (the subtrees are built at once).
+TEST(KdTree, PointsInMortonOrderGetTheirNeighbours)
+{
+    std::vector<Vec3f> lattice = random_points(30000, 51);
+    for (auto& p : lattice)
+        p = (p * 16.0F).array().round().matrix() / 16.0F;
+    std::vector<Vec3f> plate = random_points(30000, 52);
+    for (auto& p : plate)
+        p.z() = 0.25F;
+    for (std::vector<Vec3f> points : {clustered_points(61), lattice, plate})
+    {
+        const std::vector<std::uint32_t> order = spatial_order(points);
+        std::vector<Vec3f> sorted(points.size());
+        for (std::size_t j = 0; j < order.size(); ++j)
+            sorted[j] = points[order[j]];
+        std::vector<Vec3f> queries = random_points(60, 62);
+        for (std::size_t i = 0; i < sorted.size(); i += sorted.size() / 40)
+            queries.push_back(sorted[i]);
+        for (const std::size_t leaf : {1, 4, 16, 64})
+        {
+            const auto build_and_query = [&] {
+                const KdTree tree(sorted, {.leaf_size = leaf});
+                return knn_batch(tree, queries, 41);
+            };
+            // The clusters are too few points for parallel blocks.
+            const std::vector<KnnTable> runs =
+                sorted.size() < 10000
+                    ? std::vector<KnnTable>{build_and_query()}
+                    : test::at_thread_counts(build_and_query, {.min_multi_block_loops = 2}, {1, 3});
+            for (const KnnTable& table : runs)
+                for (std::size_t q = 0; q < queries.size(); ++q)
+                {
+                    std::vector<std::pair<float, std::uint32_t>> truth;
+                    for (std::uint32_t i = 0; i < sorted.size(); ++i)
+                        truth.emplace_back(squared_distance(sorted[i], queries[q]), i);
+                    std::partial_sort(truth.begin(), truth.begin() + 41, truth.end());
+                    for (std::size_t j = 0; j < 41; ++j)
+                    {
+                        ASSERT_EQ(table.neighbors(q)[j], truth[j].second)
+                            << "leaf " << leaf << " query " << q << " rank " << j;
+                        ASSERT_EQ(table.distances2(q)[j], truth[j].first);
+                    }
+                }
         }
     }
 }
