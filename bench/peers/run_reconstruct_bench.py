@@ -92,6 +92,7 @@ def thread_scaling(args) -> int:
         print("| command | samples | threads | wall s | peak MiB | bytes per sample | result | "
               "same bytes as 1 thread | stages s |")
         print("|---|---|---|---|---|---|---|---|---|")
+        ratios = []
         for command in args.commands.split(","):
             first = None
             for threads in counts:
@@ -112,6 +113,13 @@ def thread_scaling(args) -> int:
                       f"{per_sample:.0f} | {status if status != 'ok' else result} | "
                       f"{'yes' if digest and digest == first else 'NO'} | {stage_text} |",
                       flush=True)
+                if command == "normals" and isinstance(stages, dict) and stages.get("knn"):
+                    knn = stages["knn"]
+                    ratios.append(f"`normals` at {threads} thread(s): {stages['total'] / knn:.2f}x "
+                                  f"its kNN queries in process ({stages['total']:.1f} s against "
+                                  f"{knn:.1f}), {wall / knn:.2f}x as a whole process")
+        for line in ratios:
+            print(f"\n{line}", flush=True)
     return 0
 
 

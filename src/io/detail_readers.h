@@ -410,9 +410,11 @@ public:
 
     /// Adds points 0 to count - 1, which `decode(i, point)` fills in (from any thread; it must
     /// not depend on the order of calls), as add() called on each in turn would: the same cloud,
-    /// the same drops, the same error. Decodes in parallel, each point twice.
-    template <typename Decode, typename WhereOf>
-    void add_all(std::size_t count, const Decode& decode, const WhereOf& where_of);
+    /// the same drops, the same error. `position_of(i)` is point i's position alone (read
+    /// first, to place the points). Decodes in parallel.
+    template <typename PositionOf, typename Decode, typename WhereOf>
+    void add_all(std::size_t count, const PositionOf& position_of, const Decode& decode,
+                 const WhereOf& where_of);
 
     [[nodiscard]] std::size_t dropped() const { return dropped_; }
 
@@ -432,8 +434,9 @@ private:
     Location first_dropped_;
 };
 
-template <typename Decode, typename WhereOf>
-void CloudBuilder::add_all(std::size_t count, const Decode& decode, const WhereOf& where_of)
+template <typename PositionOf, typename Decode, typename WhereOf>
+void CloudBuilder::add_all(std::size_t count, const PositionOf& position_of, const Decode& decode,
+                           const WhereOf& where_of)
 {
     const std::size_t block = add_all_block;
     const std::size_t nowhere = add_all_none;
@@ -447,13 +450,11 @@ void CloudBuilder::add_all(std::size_t count, const Decode& decode, const WhereO
     };
     std::vector<Tally> tally(blocks);
     parallel_blocks(blocks, 1, [&](std::size_t first, std::size_t last) {
-        PointRecord point;
         for (std::size_t b = first; b < last; ++b)
             for (std::size_t i = b * block; i < std::min(count, (b + 1) * block); ++i)
             {
-                decode(i, point);
                 Tally& t = tally[b];
-                if (point.position.allFinite())
+                if (position_of(i).allFinite())
                 {
                     if (t.first_good == nowhere)
                         t.first_good = i;
@@ -489,11 +490,9 @@ void CloudBuilder::add_all(std::size_t count, const Decode& decode, const WhereO
     }
     if (first_good == nowhere)
         return;
-    PointRecord point;
     if (!has_origin_)
     {
-        decode(first_good, point);
-        cloud_.origin = choose_origin(point.position);
+        cloud_.origin = choose_origin(position_of(first_good));
         has_origin_ = true;
     }
     // 2. Every finite point in its place, after the points added before.

@@ -396,8 +396,25 @@ public:
         const char* base = cursor_.data();
         const std::size_t start = cursor_.offset();
         const auto count = static_cast<std::size_t>(element.count);
+        // Where x, y and z are (the last of each, as set_field() keeps).
+        std::array<std::optional<std::size_t>, 3> axis;
+        for (std::size_t k = 0; k < offsets.size(); ++k)
+        {
+            const Field field = element.properties[k].field;
+            if (field == Field::X || field == Field::Y || field == Field::Z)
+                axis[static_cast<std::size_t>(field) - static_cast<std::size_t>(Field::X)] = k;
+        }
         builder.add_all(
             count,
+            [&](std::size_t i) {
+                Vec3d position = Vec3d::Zero();
+                for (std::size_t a = 0; a < 3; ++a)
+                    if (axis[a])
+                        position[static_cast<Eigen::Index>(a)] =
+                            load_scalar(base + i * stride + offsets[*axis[a]],
+                                        element.properties[*axis[a]].type, order_);
+                return position;
+            },
             [&](std::size_t i, PointRecord& point) {
                 point = PointRecord{};
                 const char* p = base + i * stride;
