@@ -1410,8 +1410,10 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
     // 1. Each block's patches: every sample's patch (numbered in the block first) and whether
     //    its sign is the opposite of its patch's first sample's.
     const std::size_t blocks = (n + patch_block - 1) / patch_block;
-    std::vector<std::uint32_t> patch(n, none);
-    std::vector<std::uint8_t> opposite(n, 0);
+    //    Written in full by the blocks (in parallel, so the pages are touched where they are
+    //    used), hence not filled first.
+    const auto patch = std::make_unique_for_overwrite<std::uint32_t[]>(n);
+    auto opposite = std::make_unique_for_overwrite<std::uint8_t[]>(n);
     std::vector<std::uint32_t> block_start(blocks + 1, 0);
     //    Each block also keeps the edges that may join two patches (those leaving the block,
     //    the unreliable ones and those off the sheet), for the votes: edge i * columns + c of
@@ -1482,6 +1484,8 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
                     local_id[i - begin] = count++;
             for (std::size_t i = begin; i < end; ++i)
             {
+                patch[i] = none;
+                opposite[i] = 0;
                 if (!usable(normals[i]))
                     continue;
                 const auto [root, odd] = sets.find(static_cast<std::uint32_t>(i - begin));
@@ -1662,7 +1666,7 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
         undecided.fetch_add(left, std::memory_order_relaxed);
     });
     std::vector<std::uint8_t>().swap(patch_flip);
-    std::vector<std::uint8_t>().swap(opposite);
+    opposite.reset();
 
     // 3. Each component faces +z at its highest sample, then outwards by its flux.
     const auto component_of = [&](std::size_t i) {

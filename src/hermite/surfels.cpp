@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <string>
 
 namespace pointform {
@@ -185,7 +186,7 @@ SurfelResult compute_surfels(const PointCloudView& cloud, const SurfelOptions& o
     result.surfels.radii.resize(n);
     //    Each sample's place in the sorted order, so that the gathers below read at random and
     //    write in order.
-    std::vector<std::uint32_t> rank(n);
+    const auto rank = std::make_unique_for_overwrite<std::uint32_t[]>(n); // every entry written
     parallel_blocks(n, gather_block, [&](std::size_t begin, std::size_t end) {
         for (std::size_t j = begin; j < end; ++j)
             rank[order[j]] = static_cast<std::uint32_t>(j);

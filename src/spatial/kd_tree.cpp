@@ -250,9 +250,13 @@ struct KdTree::Impl
 
 void KdTree::Impl::build()
 {
-    const std::vector<std::uint64_t> keys = morton_keys(data.points);
+    const std::size_t n = data.points.size();
+    // Filled in parallel (so the pages are touched where they are used), hence not zeroed first.
+    const auto storage = std::make_unique_for_overwrite<std::uint64_t[]>(n);
+    const std::span<std::uint64_t> keys(storage.get(), n);
+    morton_keys(data.points, keys);
     std::atomic<bool> sorted{true};
-    parallel_blocks(keys.size() - 1, 1U << 16U, [&](std::size_t begin, std::size_t end) {
+    parallel_blocks(n - 1, 1U << 16U, [&](std::size_t begin, std::size_t end) {
         bool local = true;
         for (std::size_t i = begin; i < end; ++i)
             local &= keys[i] <= keys[i + 1];

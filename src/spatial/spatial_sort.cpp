@@ -3,6 +3,7 @@
 
 #include "pointform/spatial/spatial_sort.h"
 
+#include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 #include "pointform/geometry/aabb.h"
 
@@ -12,6 +13,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -202,11 +204,12 @@ void for_each_key(std::span<const Vec3f> positions, const Use& use)
 
 } // namespace
 
-std::vector<std::uint64_t> morton_keys(std::span<const Vec3f> positions)
+void morton_keys(std::span<const Vec3f> positions, std::span<std::uint64_t> keys)
 {
-    std::vector<std::uint64_t> keys(positions.size());
+    if (keys.size() != positions.size())
+        throw InvalidInput("morton_keys: " + std::to_string(positions.size()) + " points but " +
+                           std::to_string(keys.size()) + " keys");
     for_each_key(positions, [&](std::size_t i, std::uint64_t key) { keys[i] = key; });
-    return keys;
 }
 
 std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions)

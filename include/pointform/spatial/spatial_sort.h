@@ -23,7 +23,8 @@ namespace pointform {
 /// \brief The key spatial_order() sorts each point by: its cell of a grid of 2^21 cells an axis
 /// over the points' bounding box (cubic cells, the largest extent's), the cell's coordinates'
 /// bits interleaved from the top, z y x at each level (bit 3l + a is bit l of axis a). Points in
-/// spatial_order() have non-decreasing keys.
-[[nodiscard]] std::vector<std::uint64_t> morton_keys(std::span<const Vec3f> positions);
+/// spatial_order() have non-decreasing keys. Fills `keys` (one a point) in parallel.
+/// \throw InvalidInput if the sizes differ
+void morton_keys(std::span<const Vec3f> positions, std::span<std::uint64_t> keys);
 
 } // namespace pointform
