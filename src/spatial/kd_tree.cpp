@@ -110,6 +110,40 @@ using Node = NanoTree::Node;
 using Offset = NanoTree::Offset;
 using BoundingBox = NanoTree::BoundingBox;
 
+/// The box around two boxes.
+BoundingBox united(const BoundingBox& a, const BoundingBox& b)
+{
+    BoundingBox box;
+    for (int d = 0; d < 3; ++d)
+    {
+        box[d].low = std::min(a[d].low, b[d].low);
+        box[d].high = std::max(a[d].high, b[d].high);
+    }
+    return box;
+}
+
+/// Where points [left, right) in Morton order (their `keys` differing: `differ` is the first's
+/// key xor the last's) split: at the first key with the highest differing bit set, along that
+/// bit's axis.
+struct MortonSplit
+{
+    Offset middle;
+    int axis;
+};
+
+MortonSplit morton_split(std::span<const std::uint64_t> keys, Offset left, Offset right,
+                         std::uint64_t differ)
+{
+    const int bit = 63 - std::countl_zero(differ);
+    const std::uint64_t mask = std::uint64_t{1} << static_cast<unsigned>(bit);
+    const auto middle = static_cast<Offset>(
+        std::partition_point(keys.begin() + static_cast<std::ptrdiff_t>(left),
+                             keys.begin() + static_cast<std::ptrdiff_t>(right),
+                             [&](std::uint64_t key) { return (key & mask) == 0; }) -
+        keys.begin());
+    return {middle, bit % 3};
+}
+
 /// nanoflann's divideTree(), node for node (same splits, same leaves, same order of indices),
 /// with the nodes taken in turn from `next`: each subtree built at once has a range of its own.
 Node* divide_tree(NanoTree& tree, std::span<const Vec3f> points, Node*& next, Offset left,
@@ -147,11 +181,7 @@ Node* divide_tree(NanoTree& tree, std::span<const Vec3f> points, Node*& next, Of
     node->child2 = divide_tree(tree, points, next, left + index, right, right_bbox);
     node->node_type.sub.divlow = left_bbox[cutfeat].high;
     node->node_type.sub.divhigh = right_bbox[cutfeat].low;
-    for (int d = 0; d < 3; ++d)
-    {
-        bbox[d].low = std::min(left_bbox[d].low, right_bbox[d].low);
-        bbox[d].high = std::max(left_bbox[d].high, right_bbox[d].high);
-    }
+    bbox = united(left_bbox, right_bbox);
     return node;
 }
 
@@ -184,14 +214,7 @@ Node* morton_subtree(std::span<const Vec3f> points, std::span<const std::uint64_
             }
         return node;
     }
-    const int bit = 63 - std::countl_zero(differ);
-    const std::uint64_t mask = std::uint64_t{1} << static_cast<unsigned>(bit);
-    const auto middle = static_cast<Offset>(
-        std::partition_point(keys.begin() + static_cast<std::ptrdiff_t>(left),
-                             keys.begin() + static_cast<std::ptrdiff_t>(right),
-                             [&](std::uint64_t key) { return (key & mask) == 0; }) -
-        keys.begin());
-    const int axis = bit % 3;
+    const auto [middle, axis] = morton_split(keys, left, right, differ);
     BoundingBox low;
     BoundingBox high;
     node->child1 = morton_subtree(points, keys, leaf, next, left, middle, low);
@@ -199,12 +222,54 @@ Node* morton_subtree(std::span<const Vec3f> points, std::span<const std::uint64_
     node->node_type.sub.divfeat = axis;
     node->node_type.sub.divlow = low[axis].high;
     node->node_type.sub.divhigh = high[axis].low;
-    for (int d = 0; d < 3; ++d)
-    {
-        bbox[d].low = std::min(low[d].low, high[d].low);
-        bbox[d].high = std::max(low[d].high, high[d].high);
-    }
+    bbox = united(low, high);
     return node;
+}
+
+/// A node at the top of a tree built in parallel: split one by one, down to subtrees that are
+/// then built at once.
+struct Top
+{
+    Offset left;
+    Offset right;
+    BoundingBox bbox{}; // the box handed down (if any); the points' own box once built
+    std::size_t child1 = 0;
+    std::size_t child2 = 0;
+    NanoTree::Dimension cutfeat = 0;
+    float cutval = 0.0F;
+    Offset index = 0;
+    bool split = false;
+    Node* node = nullptr;
+};
+
+/// Builds the `subtrees` (indices into `top`) at once, `build_subtree(t)` setting t's node and
+/// box, then the split top nodes bottom up: their split bounds and boxes from their children's
+/// boxes. The tree's root is top[0].
+template <typename BuildSubtree>
+void finish_tree(NanoTree& tree, std::vector<Top>& top, std::span<const std::size_t> subtrees,
+                 const BuildSubtree& build_subtree)
+{
+    parallel_blocks(subtrees.size(), 1, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t s = begin; s < end; ++s)
+            build_subtree(top[subtrees[s]]);
+    });
+    for (std::size_t t = top.size(); t-- > 0;)
+    {
+        Top& node = top[t];
+        if (!node.split)
+            continue;
+        const Top& low = top[node.child1];
+        const Top& high = top[node.child2];
+        node.node = tree.pool.allocate<Node>();
+        node.node->node_type.sub.divfeat = node.cutfeat;
+        node.node->child1 = low.node;
+        node.node->child2 = high.node;
+        node.node->node_type.sub.divlow = low.bbox[node.cutfeat].high;
+        node.node->node_type.sub.divhigh = high.bbox[node.cutfeat].low;
+        node.bbox = united(low.bbox, high.bbox);
+    }
+    tree.root_bbox = top[0].bbox;
+    tree.root_node = top[0].node;
 }
 
 } // namespace
@@ -281,17 +346,6 @@ void KdTree::Impl::build_in_order(std::span<const std::uint64_t> keys)
             tree.vAcc[i] = static_cast<std::uint32_t>(i);
     });
     const std::size_t leaf = tree.m_leaf_max_size;
-    struct Top
-    {
-        Offset left;
-        Offset right;
-        std::size_t child1 = 0;
-        std::size_t child2 = 0;
-        int axis = 0;
-        bool split = false;
-        BoundingBox bbox{};
-        Node* node = nullptr;
-    };
     const std::size_t grain = std::max({min_subtree, n / 64, leaf});
     std::vector<Top> top{{.left = 0, .right = n}};
     std::vector<std::size_t> subtrees;
@@ -305,50 +359,19 @@ void KdTree::Impl::build_in_order(std::span<const std::uint64_t> keys)
             subtrees.push_back(t);
             continue;
         }
-        const int bit = 63 - std::countl_zero(differ);
-        const std::uint64_t mask = std::uint64_t{1} << static_cast<unsigned>(bit);
-        const auto middle = static_cast<Offset>(
-            std::partition_point(keys.begin() + static_cast<std::ptrdiff_t>(left),
-                                 keys.begin() + static_cast<std::ptrdiff_t>(right),
-                                 [&](std::uint64_t key) { return (key & mask) == 0; }) -
-            keys.begin());
+        const auto [middle, axis] = morton_split(keys, left, right, differ);
         top[t].split = true;
-        top[t].axis = bit % 3;
+        top[t].cutfeat = axis;
         top[t].child1 = top.size();
         top[t].child2 = top.size() + 1;
         top.push_back({.left = left, .right = middle});
         top.push_back({.left = middle, .right = right});
     }
     nodes.reset(new Node[2 * n]); // NOLINT(cppcoreguidelines-owning-memory): not initialised
-    parallel_blocks(subtrees.size(), 1, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t s = begin; s < end; ++s)
-        {
-            Top& node = top[subtrees[s]];
-            Node* next = nodes.get() + 2 * node.left;
-            node.node = morton_subtree(points, keys, leaf, next, node.left, node.right, node.bbox);
-        }
+    finish_tree(tree, top, subtrees, [&](Top& node) {
+        Node* next = nodes.get() + 2 * node.left;
+        node.node = morton_subtree(points, keys, leaf, next, node.left, node.right, node.bbox);
     });
-    for (std::size_t t = top.size(); t-- > 0;)
-    {
-        Top& node = top[t];
-        if (!node.split)
-            continue;
-        const Top& low = top[node.child1];
-        const Top& high = top[node.child2];
-        node.node = tree.pool.allocate<Node>();
-        node.node->node_type.sub.divfeat = node.axis;
-        node.node->child1 = low.node;
-        node.node->child2 = high.node;
-        node.node->node_type.sub.divlow = low.bbox[node.axis].high;
-        node.node->node_type.sub.divhigh = high.bbox[node.axis].low;
-        for (int d = 0; d < 3; ++d)
-        {
-            node.bbox[d].low = std::min(low.bbox[d].low, high.bbox[d].low);
-            node.bbox[d].high = std::max(low.bbox[d].high, high.bbox[d].high);
-        }
-    }
-    tree.root_bbox = top[0].bbox;
-    tree.root_node = top[0].node;
 }
 
 void KdTree::Impl::build_by_splits()
@@ -385,19 +408,6 @@ void KdTree::Impl::build_by_splits()
         }
 
     // The top of the tree: nodes in the order they are made, so a node's children come after it.
-    struct Top
-    {
-        Offset left;
-        Offset right;
-        BoundingBox bbox; // the box handed down; the points' own box once built
-        std::size_t child1 = 0;
-        std::size_t child2 = 0;
-        NanoTree::Dimension cutfeat = 0;
-        float cutval = 0.0F;
-        Offset index = 0;
-        bool split = false;
-        Node* node = nullptr;
-    };
     const std::size_t grain = std::max({min_subtree, n / 64, tree.m_leaf_max_size});
     std::vector<Top> top{{.left = 0, .right = n, .bbox = root_box}};
     std::vector<std::size_t> level{0};
@@ -436,35 +446,10 @@ void KdTree::Impl::build_by_splits()
         }
     }
     nodes.reset(new Node[2 * n]); // NOLINT(cppcoreguidelines-owning-memory): not initialised
-    parallel_blocks(subtrees.size(), 1, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t s = begin; s < end; ++s)
-        {
-            Top& node = top[subtrees[s]];
-            Node* next = nodes.get() + 2 * node.left;
-            node.node = divide_tree(tree, points, next, node.left, node.right, node.bbox);
-        }
+    finish_tree(tree, top, subtrees, [&](Top& node) {
+        Node* next = nodes.get() + 2 * node.left;
+        node.node = divide_tree(tree, points, next, node.left, node.right, node.bbox);
     });
-    for (std::size_t t = top.size(); t-- > 0;)
-    {
-        Top& node = top[t];
-        if (!node.split)
-            continue;
-        const Top& low = top[node.child1];
-        const Top& high = top[node.child2];
-        node.node = tree.pool.allocate<Node>();
-        node.node->node_type.sub.divfeat = node.cutfeat;
-        node.node->child1 = low.node;
-        node.node->child2 = high.node;
-        node.node->node_type.sub.divlow = low.bbox[node.cutfeat].high;
-        node.node->node_type.sub.divhigh = high.bbox[node.cutfeat].low;
-        for (int d = 0; d < 3; ++d)
-        {
-            node.bbox[d].low = std::min(low.bbox[d].low, high.bbox[d].low);
-            node.bbox[d].high = std::max(low.bbox[d].high, high.bbox[d].high);
-        }
-    }
-    tree.root_bbox = top[0].bbox;
-    tree.root_node = top[0].node;
 }
 
 KdTree::KdTree(std::span<const Vec3f> positions, const KdTreeOptions& options)
