@@ -126,14 +126,6 @@ struct Guide
     /// an isotropic blob (flatness()).
     std::vector<float> confidence;
 
-    /// Entries of the table (row-major) whose edges pass no orientation, whatever the guides
-    /// (the subsample's graph, orient_by_subsample()); empty = none.
-    std::vector<std::uint8_t> blocked;
-    /// Entries of the table (row-major) across which the orientation turns the other way than
-    /// the rule says from the two normals (the subsample's graph, where the samples between two
-    /// members say so); empty = none.
-    std::vector<std::uint8_t> reversed;
-
     /// Whether `to` lies off the band of `from`'s sheet (false without guides).
     [[nodiscard]] bool off_sheet(std::span<const Vec3f> positions, std::uint32_t from,
                                  std::uint32_t to) const
@@ -143,35 +135,13 @@ struct Guide
         const float height = (positions[to] - positions[from]).dot(normals[from]);
         return std::abs(height - centre[from]) > reach[from];
     }
-    /// -1 when the edge a–b is reversed (the entry of the lower-numbered row that lists the
-    /// other decides), else 1.
-    [[nodiscard]] float relation(const KnnTable& table, std::uint32_t a, std::uint32_t b) const
-    {
-        if (reversed.empty())
-            return 1.0F;
-        const std::uint32_t low = std::min(a, b);
-        const std::uint32_t high = std::max(a, b);
-        std::size_t at = entry(table, low, high);
-        if (at == no_entry)
-            at = entry(table, high, low);
-        return at != no_entry && reversed[at] != 0 ? -1.0F : 1.0F;
-    }
     /// Whether the edge a–b of the neighbour table jumps between sheets: b is one of a's
     /// neighbours and lies off a's sheet, or the other way round. Such edges would pass the
     /// orientation of one face of a thin plate to the opposite face unchanged, since their guides
-    /// are parallel. Blocked entries jump too.
+    /// are parallel.
     [[nodiscard]] bool jumps(std::span<const Vec3f> positions, const KnnTable& table,
                              std::uint32_t a, std::uint32_t b) const
     {
-        if (!blocked.empty())
-        {
-            const auto is_blocked = [&](std::uint32_t from, std::uint32_t to) {
-                const std::size_t at = entry(table, from, to);
-                return at != no_entry && blocked[at] != 0;
-            };
-            if (is_blocked(a, b) || is_blocked(b, a))
-                return true;
-        }
         // The row is searched only where off the band, which is rare.
         const auto off = [&](std::uint32_t from, std::uint32_t to) {
             return off_sheet(positions, from, to) && entry(table, from, to) != no_entry;
@@ -1011,8 +981,7 @@ void vote_normals(std::span<const Vec3f> positions, const KnnTable& neighbors, c
 /// patches, votes, sweeps, roots and flux. `guide` is empty for a clean cloud.
 OrientedNormals orient_graph(std::span<const Vec3f> positions, std::span<const Vec3f> fine_normals,
                              const Guide& guide, const KnnTable& neighbors,
-                             const OrientationOptions& options,
-                             std::vector<std::uint32_t>* components_only = nullptr)
+                             const OrientationOptions& options)
 {
     const bool guided = !guide.normals.empty();
     const std::span<const Vec3f> normals =
@@ -1048,8 +1017,7 @@ OrientedNormals orient_graph(std::span<const Vec3f> positions, std::span<const V
                                    static_cast<float>(options.patch_cost);
             if (!joins)
                 continue;
-            const float a = agreement(positions, normals, options.rule, parent, v) *
-                            guide.relation(neighbors, parent, v);
+            const float a = agreement(positions, normals, options.rule, parent, v);
             step[v] = a < 0.0F ? disagrees : a > 0.0F ? agrees : neutral;
         }
     });
@@ -1098,8 +1066,7 @@ OrientedNormals orient_graph(std::span<const Vec3f> positions, std::span<const V
                 guide.jumps(positions, neighbors, static_cast<std::uint32_t>(i), j))
                 continue;
             const float w = agreement(positions, result.normals, options.rule,
-                                      static_cast<std::uint32_t>(i), j) *
-                            guide.relation(neighbors, static_cast<std::uint32_t>(i), j);
+                                      static_cast<std::uint32_t>(i), j);
             votes.push_back({std::min(pi, pj), std::max(pi, pj), w});
         }
     }
@@ -1168,7 +1135,7 @@ OrientedNormals orient_graph(std::span<const Vec3f> positions, std::span<const V
             result.normals[i] = -result.normals[i];
     //    A patch that no vote reached (each of its edges jumps between sheets: an outlier of the
     //    noise in the gap of a thin plate) takes the sign of its neighbours in reached patches.
-    if (guided || !guide.blocked.empty())
+    if (guided)
     {
         const auto reached = [&](std::size_t i) {
             return patch[i] != RiemannianForest::none && patch_flip[patch[i]] != unvisited;
@@ -1180,9 +1147,7 @@ OrientedNormals orient_graph(std::span<const Vec3f> positions, std::span<const V
                     if (reached(j))
                         pull[patch[i]] +=
                             static_cast<double>(agreement(positions, result.normals, options.rule,
-                                                          static_cast<std::uint32_t>(i), j)) *
-                            static_cast<double>(
-                                guide.relation(neighbors, static_cast<std::uint32_t>(i), j));
+                                                          static_cast<std::uint32_t>(i), j));
         for (std::size_t i = 0; i < n; ++i)
             if (patch[i] != RiemannianForest::none && !reached(i) && pull[patch[i]] < 0.0)
                 result.normals[i] = -result.normals[i];
@@ -1197,7 +1162,7 @@ OrientedNormals orient_graph(std::span<const Vec3f> positions, std::span<const V
     //    comes from its guide below.
     //    After the first sweep only a sample with a neighbour flipped in the sweep before can
     //    flip: with the same neighbours, it would decide as it did then.
-    const std::size_t sweeps = guided || !guide.reversed.empty() ? 0 : options.smoothing_sweeps;
+    const std::size_t sweeps = guided ? 0 : options.smoothing_sweeps;
     std::vector<std::uint8_t> changed(sweeps > 1 ? n : 0, 0);
     std::vector<std::uint8_t> changed_before;
     std::vector<Vec3f> snapshot;
@@ -1261,12 +1226,6 @@ OrientedNormals orient_graph(std::span<const Vec3f> positions, std::span<const V
             result.normals[v] = result.normals[parent];
             ++result.inherited;
         }
-    }
-    if (components_only != nullptr)
-    {
-        // The caller turns the components (orient_by_subsample()).
-        *components_only = forest.component;
-        return result;
     }
     face_components(
         positions, neighbors, [&](std::size_t i) { return forest.component[i]; }, forest.roots,
