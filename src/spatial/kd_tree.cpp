@@ -60,8 +60,18 @@ public:
     using IndexType = std::uint32_t;
     using CountType = std::size_t;
 
-    OrderedKnnResult(std::size_t capacity, std::uint32_t* indices, float* distances)
-        : capacity_(capacity), indices_(indices), distances_(distances)
+    /// `coincident_in_order`: points at one place lie in one leaf in ascending index order (the
+    /// Morton tree's leaves, whose points never move); then a query whose k nearest are all
+    /// coincident with it stops at the next coincident point (a higher index, as is every
+    /// point left in that leaf; every other point is farther), instead of offering every copy:
+    /// a cloud with 50,000 copies of one point took 84 s with nanoflann's tree and 8 s with the
+    /// Morton tree before this.
+    OrderedKnnResult(std::size_t capacity, std::uint32_t* indices, float* distances,
+                     bool coincident_in_order)
+        : capacity_(capacity),
+          indices_(indices),
+          distances_(distances),
+          coincident_in_order_(coincident_in_order)
     {}
 
     [[nodiscard]] std::size_t size() const { return count_; }
@@ -74,7 +84,7 @@ public:
             return d1 < d2 || (d1 == d2 && i1 < i2);
         };
         if (full() && !before(dist, index, distances_[capacity_ - 1], indices_[capacity_ - 1]))
-            return true;
+            return !(coincident_in_order_ && dist == 0.0F && distances_[capacity_ - 1] == 0.0F);
         std::size_t i = full() ? capacity_ - 1 : count_++;
         for (; i > 0 && before(dist, index, distances_[i - 1], indices_[i - 1]); --i)
         {
@@ -104,6 +114,7 @@ private:
     std::size_t count_ = 0;
     static constexpr float infinity = std::numeric_limits<float>::infinity();
     float bound_ = infinity; ///< worstDist(): infinite until full
+    bool coincident_in_order_;
 };
 
 using Node = NanoTree::Node;
@@ -278,6 +289,8 @@ struct KdTree::Impl
 {
     PositionSpan data;
     NanoTree tree;
+    /// Built by build_in_order(): every leaf is a range of the points in index order.
+    bool in_order = false;
     /// The nodes of the subtrees built at once (the tree's own pool has the top ones): the
     /// subtree of points [left, right) has nodes [2 left, 2 right), more than its at most
     /// 2 (right - left) - 1. Left uninitialised, so only the pages used are ever resident; one
@@ -328,7 +341,8 @@ void KdTree::Impl::build()
         if (!local)
             sorted.store(false, std::memory_order_relaxed);
     });
-    if (sorted.load())
+    in_order = sorted.load();
+    if (in_order)
         build_in_order(keys);
     else
         build_by_splits();
@@ -523,7 +537,7 @@ std::size_t KdTree::knn(const Vec3f& query, std::size_t k, std::span<std::uint32
     check_buffer_size("KdTree::knn", "squared_distances", squared_distances.size(), k);
     if (k == 0)
         return 0;
-    OrderedKnnResult result(k, indices.data(), squared_distances.data());
+    OrderedKnnResult result(k, indices.data(), squared_distances.data(), impl_->in_order);
     impl_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
     return result.size();
 }

@@ -308,7 +308,8 @@ TEST(KdTree, TiesAtTheKthNeighbourGoToTheLowestIndices)
 /// (KdTree::Impl::build_in_order()): the same neighbours, ties included, as brute force: many
 /// coincident copies (cells holding more points than a leaf), a lattice (points on the split
 /// planes) and a flat plate (keys that never differ along one axis), at every leaf size and
-/// thread count (the subtrees are built at once).
+/// thread count (the subtrees are built at once), with k above and below the 40 copies of a
+/// cluster (below: a query on a cluster stops at its first copy past the k-th).
 TEST(KdTree, PointsInMortonOrderGetTheirNeighbours)
 {
     std::vector<Vec3f> lattice = random_points(30000, 51);
@@ -326,11 +327,12 @@ TEST(KdTree, PointsInMortonOrderGetTheirNeighbours)
         std::vector<Vec3f> queries = random_points(60, 62);
         for (std::size_t i = 0; i < sorted.size(); i += sorted.size() / 40)
             queries.push_back(sorted[i]);
-        for (const std::size_t leaf : {1, 4, 16, 64})
+        for (const auto& [leaf, k] :
+             {std::pair<std::size_t, std::size_t>{1, 41}, {4, 17}, {16, 41}, {16, 17}, {64, 5}})
         {
             const auto build_and_query = [&] {
                 const KdTree tree(sorted, {.leaf_size = leaf});
-                return knn_batch(tree, queries, 41);
+                return knn_batch(tree, queries, k);
             };
             // The clusters are too few points for parallel blocks.
             const std::vector<KnnTable> runs =
@@ -343,15 +345,51 @@ TEST(KdTree, PointsInMortonOrderGetTheirNeighbours)
                     std::vector<std::pair<float, std::uint32_t>> truth;
                     for (std::uint32_t i = 0; i < sorted.size(); ++i)
                         truth.emplace_back(squared_distance(sorted[i], queries[q]), i);
-                    std::partial_sort(truth.begin(), truth.begin() + 41, truth.end());
-                    for (std::size_t j = 0; j < 41; ++j)
+                    std::partial_sort(truth.begin(), truth.begin() + static_cast<std::ptrdiff_t>(k),
+                                      truth.end());
+                    for (std::size_t j = 0; j < k; ++j)
                     {
                         ASSERT_EQ(table.neighbors(q)[j], truth[j].second)
-                            << "leaf " << leaf << " query " << q << " rank " << j;
+                            << "leaf " << leaf << " k " << k << " query " << q << " rank " << j;
                         ASSERT_EQ(table.distances2(q)[j], truth[j].first);
                     }
                 }
         }
+    }
+}
+
+/// Tens of thousands of copies of one point (a scanner's zero returns) in Morton order: each
+/// copy's k nearest are the first k copies, found without offering every copy to every query
+/// (which made this quadratic).
+TEST(KdTree, ManyCopiesOfOnePointInMortonOrder)
+{
+    std::vector<Vec3f> points = random_points(20000, 71);
+    points.resize(80000, Vec3f(0.125F, -0.5F, 0.25F));
+    const std::vector<std::uint32_t> order = spatial_order(points);
+    std::vector<Vec3f> sorted(points.size());
+    for (std::size_t j = 0; j < order.size(); ++j)
+        sorted[j] = points[order[j]];
+    const KdTree tree(sorted);
+    const KnnTable table = knn_batch(tree, sorted, 17);
+    std::vector<std::uint32_t> copies;
+    for (std::uint32_t i = 0; i < sorted.size(); ++i)
+        if (sorted[i] == Vec3f(0.125F, -0.5F, 0.25F))
+            copies.push_back(i);
+    ASSERT_EQ(copies.size(), 60000U);
+    for (std::size_t c = 0; c < copies.size(); c += 997)
+        for (std::size_t j = 0; j < 17; ++j)
+        {
+            ASSERT_EQ(table.neighbors(copies[c])[j], copies[j]) << c;
+            ASSERT_EQ(table.distances2(copies[c])[j], 0.0F);
+        }
+    for (std::uint32_t q = 0; q < sorted.size(); q += 1999)
+    {
+        std::vector<std::pair<float, std::uint32_t>> truth;
+        for (std::uint32_t i = 0; i < sorted.size(); ++i)
+            truth.emplace_back(squared_distance(sorted[i], sorted[q]), i);
+        std::partial_sort(truth.begin(), truth.begin() + 17, truth.end());
+        for (std::size_t j = 0; j < 17; ++j)
+            ASSERT_EQ(table.neighbors(q)[j], truth[j].second) << q;
     }
 }
 
