@@ -439,7 +439,6 @@ void CloudBuilder::add_all(std::size_t count, const PositionOf& position_of, con
                            const WhereOf& where_of)
 {
     const std::size_t block = add_all_block;
-    const std::size_t nowhere = add_all_none;
     const std::size_t blocks = (count + block - 1) / block;
     // 1. Each block's non-finite points: how many, and the first; and its first finite point.
     struct Tally
@@ -456,7 +455,7 @@ void CloudBuilder::add_all(std::size_t count, const PositionOf& position_of, con
                 Tally& t = tally[b];
                 if (position_of(i).allFinite())
                 {
-                    if (t.first_good == nowhere)
+                    if (t.first_good == add_all_none)
                         t.first_good = i;
                 }
                 else if (t.bad++ == 0)
@@ -464,14 +463,14 @@ void CloudBuilder::add_all(std::size_t count, const PositionOf& position_of, con
             }
     });
     std::size_t bad = 0;
-    std::size_t first_bad = nowhere;
-    std::size_t first_good = nowhere;
+    std::size_t first_bad = add_all_none;
+    std::size_t first_good = add_all_none;
     std::vector<std::size_t> good_before(blocks + 1, 0);
     for (std::size_t b = 0; b < blocks; ++b)
     {
-        if (first_bad == nowhere)
+        if (first_bad == add_all_none)
             first_bad = tally[b].first_bad;
-        if (first_good == nowhere)
+        if (first_good == add_all_none)
             first_good = tally[b].first_good;
         bad += tally[b].bad;
         const std::size_t size = std::min(count, (b + 1) * block) - b * block;
@@ -488,7 +487,7 @@ void CloudBuilder::add_all(std::size_t count, const PositionOf& position_of, con
             first_dropped_ = where_of(first_bad);
         dropped_ += bad;
     }
-    if (first_good == nowhere)
+    if (first_good == add_all_none)
         return;
     if (!has_origin_)
     {

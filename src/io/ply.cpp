@@ -328,6 +328,13 @@ std::uint8_t to_color(double value, PlyType type)
 }
 
 /// Values of a binary body, read through a ByteCursor in the file's byte order.
+/// Stores a vertex property's value in its point (colours converted from their type).
+void set_property(PointRecord& point, const PlyProperty& property, double value)
+{
+    set_field(point, property.field,
+              is_color(property.field) ? to_color(value, property.type) : value);
+}
+
 /// A binary PLY scalar of `type` at p, as a double.
 double load_scalar(const char* p, PlyType type, ByteOrder order)
 {
@@ -421,9 +428,8 @@ public:
                 for (std::size_t k = 0; k < offsets.size(); ++k)
                 {
                     const PlyProperty& property = element.properties[k];
-                    const double value = load_scalar(p + offsets[k], property.type, order_);
-                    set_field(point, property.field,
-                              is_color(property.field) ? to_color(value, property.type) : value);
+                    set_property(point, property,
+                                 load_scalar(p + offsets[k], property.type, order_));
                 }
             },
             [&](std::size_t i) { return Location::at_byte(start + i * stride); });
@@ -627,9 +633,7 @@ void read_vertices(Source& source, const PlyElement& element, CloudBuilder& buil
                 source.skip_values(property.type, source.list_count(property));
                 continue;
             }
-            const double value = source.scalar(property.type);
-            set_field(point, property.field,
-                      is_color(property.field) ? to_color(value, property.type) : value);
+            set_property(point, property, source.scalar(property.type));
         }
         source.end();
         builder.add(point, where);
