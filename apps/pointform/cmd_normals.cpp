@@ -85,12 +85,7 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
     timings.lap("write");
     progress.clear();
 
-    // The smallest, the median (the element at n / 2 in order) and the largest radius.
-    std::vector<float> radii = result.surfels.radii;
-    const auto middle = radii.begin() + static_cast<std::ptrdiff_t>(radii.size() / 2);
-    std::nth_element(radii.begin(), middle, radii.end());
-    const float radius_median = *middle;
-    const auto [radius_min, radius_max] = std::minmax_element(radii.begin(), radii.end());
+    const RadiusSummary& radius = result.radius;
     const auto& orientation = result.orientation;
 
     if (options.json)
@@ -109,7 +104,7 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
             orientation.unoriented.begin(),
             orientation.unoriented.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(
                                                  orientation.unoriented.size(), 100)));
-        out["radius"] = {{"min", *radius_min}, {"median", radius_median}, {"max", *radius_max}};
+        out["radius"] = {{"min", radius.min}, {"median", radius.median}, {"max", radius.max}};
         add_run_report(out, timings);
         std::printf("%s\n", out.dump(2).c_str());
         return;
@@ -122,9 +117,9 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
     print_row("normals flipped", std::to_string(orientation.flipped));
     print_row("degenerate (inherited)", std::to_string(result.degenerate));
     print_row("unoriented", std::to_string(orientation.unoriented.size()));
-    print_row("radius min/median/max", format_number(*radius_min) + " / " +
-                                           format_number(radius_median) + " / " +
-                                           format_number(*radius_max));
+    print_row("radius min/median/max", format_number(radius.min) + " / " +
+                                           format_number(radius.median) + " / " +
+                                           format_number(radius.max));
     print_timings(timings);
     if (!orientation.unoriented.empty())
         std::fprintf(stderr,

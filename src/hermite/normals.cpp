@@ -9,6 +9,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
+#include <array>
 #include <string>
 
 namespace pointform {
@@ -76,31 +78,75 @@ LocalPlane solve_plane(const Moments& moments)
 /// where the least eigenvalue is close to the middle one and the rule for a line applies.
 constexpr double fast_min_spread = 1e-6;
 
-/// The unit eigenvector of the least eigenvalue λ0 of a covariance C, without trigonometry:
-/// λ0 by Newton's method on the characteristic polynomial p(λ) = λ³ − I1 λ² + I2 λ − I3 from 0,
-/// which climbs to it without overshooting (p is increasing and concave below its least root,
-/// since λ0 ≤ I1 / 3), then the longest column of adj(C − λ0 I), which spans the kernel of
-/// C − λ0 I when λ0 is simple. Zero when C is nearly a line or λ0 is not clearly simple (the
-/// columns all but vanish): solve_plane() then decides.
-Vec3d fast_normal(const Mat3d& c)
+/// The invariants of a covariance C, whose characteristic polynomial is
+/// p(λ) = λ³ − I1 λ² + I2 λ − I3, and whether fast_normal() takes it (else solve_plane() does).
+struct Cubic
 {
-    const double i1 = c.trace();
-    const double i2 = second_invariant(c);
-    if (!(i1 > 0.0) || !(i2 > fast_min_spread * i1 * i1))
-        return Vec3d::Zero();
-    const double i3 = c.determinant();
-    double lambda = 0.0;
+    double i1 = 0.0;
+    double i2 = 0.0;
+    double i3 = 0.0;
+    bool fast = false;
+};
+
+Cubic cubic_of(const Mat3d& c)
+{
+    Cubic cubic;
+    cubic.i1 = c.trace();
+    cubic.i2 = second_invariant(c);
+    cubic.fast = cubic.i1 > 0.0 && cubic.i2 > fast_min_spread * cubic.i1 * cubic.i1;
+    if (cubic.fast)
+        cubic.i3 = c.determinant();
+    return cubic;
+}
+
+/// Samples whose least eigenvalues least_roots() finds together.
+constexpr std::size_t root_group = 4;
+
+/// The least root λ0 of each fast cubic, by Newton's method from 0, which climbs to it without
+/// overshooting (p is increasing and concave below its least root, since λ0 ≤ I1 / 3). The
+/// cubics are solved in lockstep, each by the same steps as alone: its chain of divisions
+/// overlaps the others' instead of waiting on itself.
+std::array<double, root_group> least_roots(const std::array<Cubic, root_group>& cubics,
+                                           std::size_t count)
+{
+    std::array<double, root_group> lambda{};
+    std::array<bool, root_group> active{};
+    for (std::size_t g = 0; g < count; ++g)
+        active[g] = cubics[g].fast;
     for (int step = 0; step < 64; ++step)
     {
-        const double value = ((lambda - i1) * lambda + i2) * lambda - i3;
-        const double slope = (3.0 * lambda - 2.0 * i1) * lambda + i2;
-        const double move = -value / slope;
-        if (!(move > 0.0) || !std::isfinite(move))
-            break; // at the root to rounding (or past it by rounding)
-        lambda += move;
-        if (move <= 1e-15 * i1)
+        bool any = false;
+        for (std::size_t g = 0; g < count; ++g)
+        {
+            if (!active[g])
+                continue;
+            const Cubic& c = cubics[g];
+            const double value = ((lambda[g] - c.i1) * lambda[g] + c.i2) * lambda[g] - c.i3;
+            const double slope = (3.0 * lambda[g] - 2.0 * c.i1) * lambda[g] + c.i2;
+            const double move = -value / slope;
+            if (!(move > 0.0) || !std::isfinite(move))
+            {
+                active[g] = false; // at the root to rounding (or past it by rounding)
+                continue;
+            }
+            lambda[g] += move;
+            active[g] = move > 1e-15 * c.i1;
+            any = any || active[g];
+        }
+        if (!any)
             break;
     }
+    return lambda;
+}
+
+/// The unit eigenvector of the least eigenvalue λ0 of a covariance C, without trigonometry: the
+/// longest column of adj(C − λ0 I), which spans the kernel of C − λ0 I when λ0 is simple. Zero
+/// when C is nearly a line (not `fast`) or λ0 is not clearly simple (the columns all but vanish):
+/// solve_plane() then decides.
+Vec3d fast_normal(const Mat3d& c, const Cubic& cubic, double lambda)
+{
+    if (!cubic.fast)
+        return Vec3d::Zero();
     const Mat3d m = c - lambda * Mat3d::Identity();
     const Vec3d a = m.row(1).cross(m.row(2)).transpose();
     const Vec3d b = m.row(0).cross(m.row(2)).transpose();
@@ -111,7 +157,7 @@ Vec3d fast_normal(const Mat3d& c)
     const Vec3d& longest = na >= nb && na >= nd ? a : (nb >= nd ? b : d);
     const double length2 = std::max({na, nb, nd});
     // The columns' length is about (λ1 − λ0)(λ2 − λ0): tiny against I2 when λ0 is (nearly) double.
-    if (!(length2 > (fast_min_spread * i2) * (fast_min_spread * i2)))
+    if (!(length2 > (fast_min_spread * cubic.i2) * (fast_min_spread * cubic.i2)))
         return Vec3d::Zero();
     return longest / std::sqrt(length2);
 }
@@ -142,26 +188,39 @@ Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neigh
     parallel_blocks(
         positions.size(), 4096,
         [&](std::size_t begin, std::size_t end) {
-            for (std::size_t i = begin; i < end; ++i)
+            std::array<Moments, root_group> moments;
+            std::array<Cubic, root_group> cubics;
+            for (std::size_t first = begin; first < end; first += root_group)
             {
-                const std::span<const std::uint32_t> row = neighbors.neighbors(i);
-                for (const std::uint32_t index : row)
-                    if (index >= positions.size())
-                        throw InvalidInput("estimate_normals: neighbour " + std::to_string(index) +
-                                           " of row " + std::to_string(i) +
-                                           " is out of range for " +
-                                           std::to_string(positions.size()) + " points");
-                const Moments moments = moments_of(positions, row);
-                const Vec3d fast = fast_normal(moments.covariance);
-                if (fast.squaredNorm() > 0.0)
+                const std::size_t count = std::min(root_group, end - first);
+                for (std::size_t g = 0; g < count; ++g)
                 {
-                    result.normals[i] = fast.cast<float>();
-                    degenerate[i] = 0;
-                    continue;
+                    const std::size_t i = first + g;
+                    const std::span<const std::uint32_t> row = neighbors.neighbors(i);
+                    for (const std::uint32_t index : row)
+                        if (index >= positions.size())
+                            throw InvalidInput("estimate_normals: neighbour " +
+                                               std::to_string(index) + " of row " +
+                                               std::to_string(i) + " is out of range for " +
+                                               std::to_string(positions.size()) + " points");
+                    moments[g] = moments_of(positions, row);
+                    cubics[g] = cubic_of(moments[g].covariance);
                 }
-                const LocalPlane fit = solve_plane(moments);
-                result.normals[i] = fit.normal.cast<float>();
-                degenerate[i] = fit.degenerate ? 1 : 0;
+                const std::array<double, root_group> lambda = least_roots(cubics, count);
+                for (std::size_t g = 0; g < count; ++g)
+                {
+                    const std::size_t i = first + g;
+                    const Vec3d fast = fast_normal(moments[g].covariance, cubics[g], lambda[g]);
+                    if (fast.squaredNorm() > 0.0)
+                    {
+                        result.normals[i] = fast.cast<float>();
+                        degenerate[i] = 0;
+                        continue;
+                    }
+                    const LocalPlane fit = solve_plane(moments[g]);
+                    result.normals[i] = fit.normal.cast<float>();
+                    degenerate[i] = fit.degenerate ? 1 : 0;
+                }
             }
         },
         &reporter);

@@ -8,8 +8,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace pointform {
@@ -100,10 +104,92 @@ std::vector<float> influence_radii(const KnnTable& neighbors, double scale)
                            std::to_string(scale));
     check_knn_table_shape(neighbors, neighbors.rows(), "influence_radii");
     std::vector<float> radii(neighbors.rows());
-    for (std::size_t i = 0; i < radii.size(); ++i)
-        radii[i] =
-            static_cast<float>(scale * std::sqrt(static_cast<double>(neighbors.farthest2(i))));
+    parallel_blocks(radii.size(), 65536, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+            radii[i] =
+                static_cast<float>(scale * std::sqrt(static_cast<double>(neighbors.farthest2(i))));
+    });
     return radii;
+}
+
+RadiusSummary summarize_radii(std::span<const float> radii)
+{
+    const std::size_t n = radii.size();
+    if (n == 0)
+        throw InvalidInput("summarize_radii: no radii");
+    // Unsigned keys in the order of the values: the sign bit set on positive values, every bit
+    // flipped on negative ones.
+    const auto key_of = [](float value) {
+        const auto bits = std::bit_cast<std::uint32_t>(value);
+        return (bits & 0x80000000U) != 0 ? ~bits : bits | 0x80000000U;
+    };
+    const auto value_of = [](std::uint32_t key) {
+        return std::bit_cast<float>((key & 0x80000000U) != 0 ? key & 0x7FFFFFFFU : ~key);
+    };
+    constexpr unsigned low_bits = 16;
+    constexpr std::size_t buckets = std::size_t{1} << (32 - low_bits);
+    // Blocks of at least a million values, at most 64 of them (their counts are 256 kB each).
+    const std::size_t block = std::max<std::size_t>(std::size_t{1} << 20, (n + 63) / 64);
+    const std::size_t blocks = (n + block - 1) / block;
+    std::vector<std::uint32_t> counts(blocks * buckets, 0);
+    std::vector<std::uint32_t> lowest(blocks);
+    std::vector<std::uint32_t> highest(blocks);
+    std::vector<std::uint8_t> has_nan(blocks, 0);
+    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        const std::size_t b = begin / block;
+        std::uint32_t* count = counts.data() + b * buckets;
+        std::uint32_t lo = std::numeric_limits<std::uint32_t>::max();
+        std::uint32_t hi = 0;
+        bool nan = false;
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            nan = nan || std::isnan(radii[i]);
+            const std::uint32_t key = key_of(radii[i]);
+            ++count[key >> low_bits];
+            lo = std::min(lo, key);
+            hi = std::max(hi, key);
+        }
+        lowest[b] = lo;
+        highest[b] = hi;
+        has_nan[b] = nan ? 1 : 0;
+    });
+    if (std::find(has_nan.begin(), has_nan.end(), 1) != has_nan.end())
+        throw InvalidInput("summarize_radii: a radius is NaN");
+    // The bucket that holds the value at n / 2, and that value's place in it.
+    const std::size_t rank = n / 2;
+    std::size_t below = 0;
+    std::uint32_t middle = 0;
+    for (std::size_t bucket = 0; bucket < buckets; ++bucket)
+    {
+        std::size_t count = 0;
+        for (std::size_t b = 0; b < blocks; ++b)
+            count += counts[b * buckets + bucket];
+        if (below + count > rank)
+        {
+            middle = static_cast<std::uint32_t>(bucket);
+            break;
+        }
+        below += count;
+    }
+    std::vector<std::vector<std::uint32_t>> inside(blocks);
+    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        auto& keys = inside[begin / block];
+        keys.reserve(counts[(begin / block) * buckets + middle]);
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            const std::uint32_t key = key_of(radii[i]);
+            if (key >> low_bits == middle)
+                keys.push_back(key);
+        }
+    });
+    std::vector<std::uint32_t> keys;
+    for (const auto& part : inside)
+        keys.insert(keys.end(), part.begin(), part.end());
+    const auto at = keys.begin() + static_cast<std::ptrdiff_t>(rank - below);
+    std::nth_element(keys.begin(), at, keys.end());
+    return {.min = value_of(*std::min_element(lowest.begin(), lowest.end())),
+            .median = value_of(*at),
+            .max = value_of(*std::max_element(highest.begin(), highest.end()))};
 }
 
 std::vector<RadiusRegion> parse_radius_regions(const std::string& text,

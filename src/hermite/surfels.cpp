@@ -176,6 +176,7 @@ SurfelResult compute_surfels(const PointCloudView& cloud, const SurfelOptions& o
 
     std::vector<float> radii = influence_radii(table, options.radius_scale);
     radii = apply_radius_regions(positions, cloud.origin, std::move(radii), options.radius_regions);
+    result.radius = summarize_radii(radii);
     timer.lap("radius");
 
     // Back to the input order.

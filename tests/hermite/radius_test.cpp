@@ -7,10 +7,14 @@
 #include "pointform/spatial/kd_tree.h"
 
 #include "support/test_support.h"
+#include "support/thread_counts.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <random>
 
 namespace pointform {
 namespace {
@@ -39,6 +43,58 @@ TEST(InfluenceRadii, DistanceToKthNeighbourTimesScale)
               radii);
     EXPECT_THROW((void)influence_radii(table, 0.0), InvalidInput);
     EXPECT_THROW((void)influence_radii(table, std::nan("")), InvalidInput);
+}
+
+/// The smallest, the value at n / 2 in order (by std::nth_element) and the largest.
+RadiusSummary summary_by_sorting(std::vector<float> values)
+{
+    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+    return {.min = *lo, .median = *middle, .max = *hi};
+}
+
+TEST(SummarizeRadii, SameAsSortingWhateverTheThreadCount)
+{
+    std::mt19937 random(7);
+    std::lognormal_distribution<float> spread(-4.0F, 0.3F);
+    std::vector<std::vector<float>> cases;
+    // Radii of a scan: 3 million, so that each pass runs in several blocks.
+    cases.emplace_back(3'000'000);
+    for (auto& r : cases.back())
+        r = spread(random);
+    // Every radius the same (a grid): the median's bucket holds them all.
+    cases.emplace_back(2'500'000, 0.125F);
+    // Signed values, zeros of both signs and many ties, an even count.
+    std::uniform_int_distribution<int> small(-50, 50);
+    cases.emplace_back(2'200'000);
+    for (auto& r : cases.back())
+        r = static_cast<float>(small(random)) * 0.37F;
+    cases.back()[17] = -0.0F;
+    cases.back()[18] = std::numeric_limits<float>::infinity();
+    // Few values: one block.
+    cases.push_back({3.0F});
+    cases.push_back({2.0F, 1.0F});
+    cases.push_back({5.0F, -1.0F, 4.0F, 4.0F, 0.5F});
+    for (const auto& values : cases)
+    {
+        const RadiusSummary expected = summary_by_sorting(values);
+        // Small inputs run in one block, on one thread.
+        const auto runs = values.size() > 2'000'000
+                              ? test::at_thread_counts([&] { return summarize_radii(values); },
+                                                       {.min_multi_block_loops = 2})
+                              : std::vector<RadiusSummary>{summarize_radii(values)};
+        for (const RadiusSummary& got : runs)
+        {
+            EXPECT_EQ(got.min, expected.min) << values.size();
+            EXPECT_EQ(got.median, expected.median) << values.size();
+            EXPECT_EQ(got.max, expected.max) << values.size();
+        }
+    }
+    EXPECT_THROW((void)summarize_radii({}), InvalidInput);
+    std::vector<float> with_nan(1'500'000, 1.0F);
+    with_nan[1'234'567] = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_THROW((void)summarize_radii(with_nan), InvalidInput);
 }
 
 TEST(RadiusRegions, BallSetsAndBoxScales)

@@ -33,6 +33,21 @@ inline constexpr double default_field_radius_scale = 1.5;
 [[nodiscard]] std::vector<float> influence_radii(const KnnTable& neighbors,
                                                  double scale = default_radius_scale);
 
+/// \brief The smallest, the median and the largest of a set of radii.
+struct RadiusSummary
+{
+    float min = 0.0F;
+    /// The value at position N / 2 in ascending order (as std::nth_element leaves it).
+    float median = 0.0F;
+    float max = 0.0F;
+};
+
+/// \brief The smallest, median and largest of `radii`, in parallel passes over them (a radix
+/// select: the values' counts by their leading bits, then the one bucket that holds the median),
+/// the same whatever the thread count. Values are ordered as numbers, with -0 below +0.
+/// \throw InvalidInput if radii is empty or holds a NaN
+[[nodiscard]] RadiusSummary summarize_radii(std::span<const float> radii);
+
 /// \brief A user region that sets the influence radius of the samples inside it (§4.1,
 /// interactive). Coordinates are world coordinates in the input's units.
 struct RadiusRegion

@@ -61,6 +61,8 @@ struct SurfelResult
     OrientedNormals orientation;
     /// Samples whose neighbourhood was coincident or collinear (normal taken from a neighbour).
     std::size_t degenerate = 0;
+    /// The smallest, median and largest of the surfels' radii.
+    RadiusSummary radius;
     /// Wall-clock seconds by stage, in order: "check", "spatial sort", "kd-tree", "knn",
     /// "normals", "orientation", "radius", "output order" (back to the input's order).
     std::vector<std::pair<std::string, double>> stage_seconds;
