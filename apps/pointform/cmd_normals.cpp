@@ -76,7 +76,7 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
     cloud.normals.clear(); // estimated afresh; input normals play no part
     timings.lap("read");
 
-    const SurfelResult result = compute_surfels(cloud, surfel_options);
+    const SurfelResult result = compute_surfels(std::move(cloud), surfel_options);
     for (const auto& [stage, seconds] : result.stage_seconds)
         timings.add(stage, seconds);
     write_output(options.output, [&](const std::filesystem::path& path) {

@@ -107,7 +107,12 @@ void check_surfel_input(const PointCloudView& cloud, std::size_t k)
         throw InvalidInput("all points lie on one line: no surface normal is defined");
 }
 
-SurfelResult compute_surfels(const PointCloudView& cloud, const SurfelOptions& options)
+namespace {
+
+/// compute_surfels() of `cloud`; when `owner` is given (the cloud that `cloud` views, no longer
+/// needed by the caller), its positions and colours are moved into the result, not copied.
+SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& options,
+                        PointCloud* owner)
 {
     SurfelResult result;
     StageTimer timer(result.stage_seconds);
@@ -179,15 +184,27 @@ SurfelResult compute_surfels(const PointCloudView& cloud, const SurfelOptions& o
     result.radius = summarize_radii(radii);
     timer.lap("radius");
 
-    // Back to the input order.
+    // Back to the input order. The PCA normals' array (its pages already mapped) takes the
+    // oriented normals.
     result.surfels.origin = cloud.origin;
-    result.surfels.colors.assign(cloud.colors.begin(), cloud.colors.end());
-    result.surfels.positions.resize(n); // every entry written below, in parallel
-    result.surfels.normals.resize(n);
     result.surfels.radii.resize(n);
     //    Each sample's place in the sorted order, so that the gathers below read at random and
     //    write in order.
     const auto rank = std::make_unique_for_overwrite<std::uint32_t[]>(n); // every entry written
+    //    Nothing throws from here on, so the owner's cloud is unchanged if anything did.
+    const bool moved = owner != nullptr;
+    if (moved)
+    {
+        result.surfels.positions = std::move(owner->positions);
+        result.surfels.colors = std::move(owner->colors);
+        *owner = PointCloud{};
+    }
+    else
+    {
+        result.surfels.colors.assign(cloud.colors.begin(), cloud.colors.end());
+        result.surfels.positions.resize(n); // every entry written below, in parallel
+    }
+    result.surfels.normals = std::move(normals.normals);
     parallel_blocks(n, gather_block, [&](std::size_t begin, std::size_t end) {
         for (std::size_t j = begin; j < end; ++j)
             rank[order[j]] = static_cast<std::uint32_t>(j);
@@ -195,7 +212,8 @@ SurfelResult compute_surfels(const PointCloudView& cloud, const SurfelOptions& o
     parallel_blocks(n, gather_block, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
         {
-            result.surfels.positions[i] = cloud.positions[i];
+            if (!moved)
+                result.surfels.positions[i] = cloud.positions[i];
             result.surfels.normals[i] = oriented.normals[rank[i]];
             result.surfels.radii[i] = radii[rank[i]];
         }
@@ -208,6 +226,18 @@ SurfelResult compute_surfels(const PointCloudView& cloud, const SurfelOptions& o
     std::sort(result.orientation.unoriented.begin(), result.orientation.unoriented.end());
     timer.lap("output order");
     return result;
+}
+
+} // namespace
+
+SurfelResult compute_surfels(const PointCloudView& cloud, const SurfelOptions& options)
+{
+    return surfels_of(cloud, options, nullptr);
+}
+
+SurfelResult compute_surfels(PointCloud&& cloud, const SurfelOptions& options)
+{
+    return surfels_of(cloud, options, &cloud);
 }
 
 } // namespace pointform

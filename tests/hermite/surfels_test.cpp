@@ -108,6 +108,31 @@ TEST(ComputeSurfels, LargeCloudsAreTheSameWhateverTheThreadCount)
     }
 }
 
+// A cloud handed over (as `pointform normals` does) gives the same surfels as one viewed, with
+// its positions and colours moved in; a cloud that fails the checks is left as it was.
+TEST(ComputeSurfels, CloudHandedOverGivesTheSameSurfels)
+{
+    PointCloud cloud = sample_shape(Shape::Torus, {.count = 30000, .seed = 5, .noise = 0.001});
+    cloud.colors.assign(cloud.size(), Color{10, 20, 30});
+    const SurfelResult viewed = compute_surfels(cloud);
+    PointCloud handed = cloud;
+    const Vec3f* const positions = handed.positions.data();
+    const SurfelResult moved = compute_surfels(std::move(handed));
+    EXPECT_EQ(moved.surfels.positions, viewed.surfels.positions);
+    EXPECT_EQ(moved.surfels.positions.data(), positions); // moved, not copied
+    EXPECT_EQ(moved.surfels.colors, viewed.surfels.colors);
+    EXPECT_EQ(moved.surfels.normals, viewed.surfels.normals);
+    EXPECT_EQ(moved.surfels.radii, viewed.surfels.radii);
+    EXPECT_EQ(moved.radius.median, viewed.radius.median);
+    EXPECT_EQ(moved.orientation.flipped, viewed.orientation.flipped);
+    EXPECT_EQ(handed.size(), 0U); // NOLINT(bugprone-use-after-move): documented as left empty
+    PointCloud few = cloud;
+    few.positions.resize(10);
+    few.colors.resize(10);
+    EXPECT_THROW((void)compute_surfels(std::move(few), {.k = 16}), InvalidInput);
+    EXPECT_EQ(few.size(), 10U); // NOLINT(bugprone-use-after-move): unchanged when it throws
+}
+
 TEST(ComputeSurfels, RejectsBadInput)
 {
     PointCloud cloud = sample_shape(Shape::Sphere, {.count = 100, .seed = 13});

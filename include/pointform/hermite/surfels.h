@@ -79,6 +79,11 @@ void check_surfel_input(const PointCloudView& cloud, std::size_t k);
 [[nodiscard]] SurfelResult compute_surfels(const PointCloudView& cloud,
                                            const SurfelOptions& options = {});
 
+/// \brief compute_surfels() of a cloud the caller no longer needs: its positions and colours
+/// move into the result instead of being copied, and `cloud` is left empty. If it throws,
+/// `cloud` is unchanged.
+[[nodiscard]] SurfelResult compute_surfels(PointCloud&& cloud, const SurfelOptions& options = {});
+
 /// \brief Options of surfels_from_samples(): samples of any kind to the surfels of a field.
 struct SurfelsFromSamplesOptions
 {
