@@ -22,6 +22,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -31,9 +32,30 @@
 
 namespace pointform::detail {
 
-/// \brief The whole file as bytes. \throw IoError naming the file if it is missing, a
-/// directory, empty or unreadable
-[[nodiscard]] std::string read_whole_file(const std::filesystem::path& path);
+/// \brief A file's bytes, read by read_whole_file().
+class FileBytes
+{
+public:
+    explicit FileBytes(std::size_t size)
+        : bytes_(std::make_unique_for_overwrite<char[]>(size)), size_(size)
+    {
+    }
+
+    [[nodiscard]] char* data() { return bytes_.get(); }
+    [[nodiscard]] const char* data() const { return bytes_.get(); }
+    [[nodiscard]] std::size_t size() const { return size_; }
+    // NOLINTNEXTLINE(google-explicit-constructor): read as a string_view everywhere
+    operator std::string_view() const { return {bytes_.get(), size_}; }
+
+private:
+    std::unique_ptr<char[]> bytes_;
+    std::size_t size_;
+};
+
+/// \brief The whole file as bytes (large files read in parallel pieces, into memory that is not
+/// cleared first), as long as it was when read began. \throw IoError naming the file if it is
+/// missing, a directory, empty or unreadable, or shorter by the time it is read
+[[nodiscard]] FileBytes read_whole_file(const std::filesystem::path& path);
 
 /// Where in a file a problem was found: a 1-based line (text) or a byte offset (binary).
 struct Location

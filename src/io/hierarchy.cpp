@@ -222,7 +222,7 @@ void write_hierarchy(const std::filesystem::path& path, const MultiresMesh& mesh
 
 MultiresMesh read_hierarchy(const std::filesystem::path& path)
 {
-    const std::string bytes = detail::read_whole_file(path);
+    const detail::FileBytes bytes = detail::read_whole_file(path);
     return decode(path, bytes);
 }
 

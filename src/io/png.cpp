@@ -166,7 +166,7 @@ TextureImage decode_png(std::span<const std::uint8_t> bytes,
 
 TextureImage read_png(const std::filesystem::path& path, const PngLimits& limits)
 {
-    const std::string bytes = detail::read_whole_file(path);
+    const detail::FileBytes bytes = detail::read_whole_file(path);
     return decode_png(std::span<const std::uint8_t>(
                           reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()),
                       path, limits);
