@@ -38,8 +38,7 @@ class FileBytes
 public:
     explicit FileBytes(std::size_t size)
         : bytes_(std::make_unique_for_overwrite<char[]>(size)), size_(size)
-    {
-    }
+    {}
 
     [[nodiscard]] char* data() { return bytes_.get(); }
     [[nodiscard]] const char* data() const { return bytes_.get(); }

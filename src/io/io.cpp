@@ -5,6 +5,8 @@
 
 #include "detail_readers.h"
 
+#include <unistd.h>
+
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
@@ -13,8 +15,6 @@
 #include <string>
 #include <system_error>
 #include <utility>
-
-#include <unistd.h>
 
 namespace pointform {
 namespace {
@@ -281,8 +281,7 @@ FileBytes read_whole_file(const std::filesystem::path& path)
                     error.store(errno);
                 std::size_t expected = short_at.load();
                 while (at < expected && !short_at.compare_exchange_weak(expected, at))
-                {
-                }
+                {}
                 return;
             }
             at += static_cast<std::size_t>(got);
