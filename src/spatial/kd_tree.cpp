@@ -16,7 +16,9 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <utility>
+#include <vector>
 
 namespace pointform {
 namespace {
@@ -61,7 +63,8 @@ public:
     using CountType = std::size_t;
 
     /// `coincident_in_order`: points at one place lie in one leaf in ascending index order (the
-    /// Morton tree's leaves, whose points never move); then a query whose k nearest are all
+    /// Morton tree's leaves, whose order is the points' or, in a refined cell, sorted by key and
+    /// then index); then a query whose k nearest are all
     /// coincident with it stops at the next coincident point (a higher index, as is every
     /// point left in that leaf; every other point is farther), instead of offering every copy:
     /// a cloud with 50,000 copies of one point took 84 s with nanoflann's tree and 8 s with the
@@ -199,37 +202,69 @@ Node* divide_tree(NanoTree& tree, std::span<const Vec3f> points, Node*& next, Of
 /// Points a subtree at least, below which it is built by one thread (divide_tree()).
 constexpr std::size_t min_subtree = 8192;
 
-/// The subtree of points [left, right) of points in Morton order (`keys`, non-decreasing), its
-/// nodes taken in turn from `next`: each node splits its points where their keys first differ,
-/// which is a plane between two halves of a grid cell (so every point of the first child lies
-/// below every point of the second along that axis), down to leaves of at most `leaf` points
-/// (or of points in one cell). No point moves: the leaves are ranges of the input. `bbox` is set
-/// to the points' box.
-Node* morton_subtree(std::span<const Vec3f> points, std::span<const std::uint64_t> keys,
-                     std::size_t leaf, Node*& next, Offset left, Offset right, BoundingBox& bbox)
+/// Points [left, right) of the tree's order (`vacc`) whose `keys` are all the same (one grid
+/// cell) but which do not all lie at one place (a far outlier makes the cells of the rest large):
+/// their keys again, over their own bounding box, and `vacc` and `keys` of the range sorted by
+/// them, ties by index (so that coincident points stay together in index order). False, and
+/// nothing changed, when they do all lie at one place.
+bool refine_cell(std::span<const Vec3f> points, std::span<std::uint32_t> vacc,
+                 std::span<std::uint64_t> keys, Offset left, Offset right)
+{
+    Vec3f low = points[vacc[left]];
+    Vec3f high = low;
+    for (Offset k = left + 1; k < right; ++k)
+    {
+        low = low.cwiseMin(points[vacc[k]]);
+        high = high.cwiseMax(points[vacc[k]]);
+    }
+    if (low == high)
+        return false;
+    const Vec3d corner = low.cast<double>();
+    const double scale = morton_scale(high.cast<double>() - corner);
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(right - left);
+    for (Offset k = left; k < right; ++k)
+        keyed[k - left] = {morton_key(points[vacc[k]], corner, scale), vacc[k]};
+    std::sort(keyed.begin(), keyed.end());
+    for (Offset k = left; k < right; ++k)
+        std::tie(keys[k], vacc[k]) = keyed[k - left];
+    return true;
+}
+
+/// The subtree of points [left, right) of the tree's order `vacc`, whose Morton `keys` do not
+/// decrease, its nodes taken in turn from `next`: each node splits its points where their keys
+/// first differ, which is a plane between two halves of a grid cell (so every point of the first
+/// child lies below every point of the second along that axis), down to leaves of at most `leaf`
+/// points, or of copies of one point, in index order. A cell of more points than a leaf that do
+/// not all lie at one place is keyed again over its own box (refine_cell()). `bbox` is set to the
+/// points' box.
+Node* morton_subtree(std::span<const Vec3f> points, std::span<std::uint32_t> vacc,
+                     std::span<std::uint64_t> keys, std::size_t leaf, Node*& next, Offset left,
+                     Offset right, BoundingBox& bbox)
 {
     Node* node = next++;
-    const std::uint64_t differ = keys[left] ^ keys[right - 1];
+    std::uint64_t differ = keys[left] ^ keys[right - 1];
+    if (differ == 0 && right - left > leaf && refine_cell(points, vacc, keys, left, right))
+        differ = keys[left] ^ keys[right - 1];
     if (right - left <= leaf || differ == 0)
     {
         node->child1 = node->child2 = nullptr;
         node->node_type.lr.left = left;
         node->node_type.lr.right = right;
         for (int d = 0; d < 3; ++d)
-            bbox[d].low = bbox[d].high = points[left][d];
+            bbox[d].low = bbox[d].high = points[vacc[left]][d];
         for (Offset k = left + 1; k < right; ++k)
             for (int d = 0; d < 3; ++d)
             {
-                bbox[d].low = std::min(bbox[d].low, points[k][d]);
-                bbox[d].high = std::max(bbox[d].high, points[k][d]);
+                bbox[d].low = std::min(bbox[d].low, points[vacc[k]][d]);
+                bbox[d].high = std::max(bbox[d].high, points[vacc[k]][d]);
             }
         return node;
     }
     const auto [middle, axis] = morton_split(keys, left, right, differ);
     BoundingBox low;
     BoundingBox high;
-    node->child1 = morton_subtree(points, keys, leaf, next, left, middle, low);
-    node->child2 = morton_subtree(points, keys, leaf, next, middle, right, high);
+    node->child1 = morton_subtree(points, vacc, keys, leaf, next, left, middle, low);
+    node->child2 = morton_subtree(points, vacc, keys, leaf, next, middle, right, high);
     node->node_type.sub.divfeat = axis;
     node->node_type.sub.divlow = low[axis].high;
     node->node_type.sub.divhigh = high[axis].low;
@@ -289,7 +324,7 @@ struct KdTree::Impl
 {
     PositionSpan data;
     NanoTree tree;
-    /// Built by build_in_order(): every leaf is a range of the points in index order.
+    /// Built by build_in_order(): all copies of a point lie in one leaf, in index order.
     bool in_order = false;
     /// The nodes of the subtrees built at once (the tree's own pool has the top ones): the
     /// subtree of points [left, right) has nodes [2 left, 2 right), more than its at most
@@ -309,8 +344,9 @@ struct KdTree::Impl
     }
 
     /// Points in Morton order (spatial_order(), as compute_surfels() and the field sort them)
-    /// get a tree split where their Morton keys first differ (build_in_order()): no point
-    /// moves, so it is built in one pass over the points. Others get nanoflann's tree
+    /// get a tree split where their Morton keys first differ (build_in_order()): in one pass
+    /// over the points, in their order (but in cells that a far outlier made too large, which
+    /// are keyed again over their own box). Others get nanoflann's tree
     /// (build_by_splits()). The k nearest neighbours do not depend on the tree (OrderedKnnResult).
     void build();
 
@@ -323,7 +359,7 @@ struct KdTree::Impl
     /// The tree of morton_subtree() over points whose Morton `keys` do not decrease: the top
     /// nodes one by one down to subtrees of about n / 64 points (at least min_subtree), which
     /// are built at once; the top nodes' split bounds and boxes last, bottom up.
-    void build_in_order(std::span<const std::uint64_t> keys);
+    void build_in_order(std::span<std::uint64_t> keys);
 };
 
 void KdTree::Impl::build()
@@ -348,7 +384,7 @@ void KdTree::Impl::build()
         build_by_splits();
 }
 
-void KdTree::Impl::build_in_order(std::span<const std::uint64_t> keys)
+void KdTree::Impl::build_in_order(std::span<std::uint64_t> keys)
 {
     const std::span<const Vec3f> points = data.points;
     const std::size_t n = points.size();
@@ -384,7 +420,8 @@ void KdTree::Impl::build_in_order(std::span<const std::uint64_t> keys)
     nodes.reset(new Node[2 * n]); // NOLINT(cppcoreguidelines-owning-memory): not initialised
     finish_tree(tree, top, subtrees, [&](Top& node) {
         Node* next = nodes.get() + 2 * node.left;
-        node.node = morton_subtree(points, keys, leaf, next, node.left, node.right, node.bbox);
+        node.node =
+            morton_subtree(points, tree.vAcc, keys, leaf, next, node.left, node.right, node.bbox);
     });
 }
 

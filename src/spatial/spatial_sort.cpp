@@ -183,26 +183,89 @@ template <typename Use>
 void for_each_key(std::span<const Vec3f> positions, const Use& use)
 {
     const Aabb box = parallel_bounding_box(positions);
-    const Vec3d extent = box.size();
-    const double largest = std::max({extent.x(), extent.y(), extent.z()});
-    const double scale = largest > 0.0 ? static_cast<double>((1U << 21U) - 1U) / largest : 0.0;
+    const double scale = morton_scale(box.size());
     parallel_blocks(positions.size(), 16384, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
-        {
-            const Vec3d q = (positions[i].cast<double>() - box.min) * scale;
-            // Non-finite coordinates (rejected elsewhere) must not poison the casts.
-            const auto cell = [](double v) {
-                return std::isfinite(v) ? static_cast<std::uint64_t>(
-                                              std::clamp(v, 0.0, static_cast<double>(0x1FFFFF)))
-                                        : std::uint64_t{0};
-            };
-            use(i, spread_bits(cell(q.x())) | spread_bits(cell(q.y())) << 1U |
-                       spread_bits(cell(q.z())) << 2U);
-        }
+            use(i, morton_key(positions[i], box.min, scale));
+    });
+}
+
+/// Runs of more equal keys than this whose points do not all lie at one place are ordered again
+/// by keys over their own box (refine_run()).
+constexpr std::size_t refine_above = 16;
+
+/// Orders a run of points that share a key (a grid cell) by their keys over their own bounding
+/// box, ties by index, and so on inside those keys' own runs: where a far outlier made the grid's
+/// cells large, points close in space are close in the order again. Nothing changes when the
+/// run's points all lie at one place. Each round shrinks the box by at least 2^21, so float's
+/// range allows about a dozen.
+void refine_run(std::span<const Vec3f> positions, std::span<Keyed> run)
+{
+    Vec3f low = positions[run[0].index];
+    Vec3f high = low;
+    for (const Keyed& k : run)
+    {
+        low = low.cwiseMin(positions[k.index]);
+        high = high.cwiseMax(positions[k.index]);
+    }
+    if (!(low != high) || !low.allFinite() || !high.allFinite())
+        return;
+    const Vec3d corner = low.cast<double>();
+    const double scale = morton_scale(high.cast<double>() - corner);
+    for (Keyed& k : run)
+        k.key = morton_key(positions[k.index], corner, scale);
+    std::sort(run.begin(), run.end());
+    for (std::size_t begin = 0; begin < run.size();)
+    {
+        std::size_t end = begin + 1;
+        while (end < run.size() && run[end].key == run[begin].key)
+            ++end;
+        if (end - begin > refine_above)
+            refine_run(positions, run.subspan(begin, end - begin));
+        begin = end;
+    }
+}
+
+/// refine_run() on every run of more than refine_above equal keys of `sorted`, in parallel. The
+/// keys of those runs are overwritten (only the order is kept).
+void refine_cells(std::span<const Vec3f> positions, std::span<Keyed> sorted)
+{
+    std::vector<std::pair<std::size_t, std::size_t>> runs;
+    for (std::size_t begin = 0; begin < sorted.size();)
+    {
+        std::size_t end = begin + 1;
+        while (end < sorted.size() && sorted[end].key == sorted[begin].key)
+            ++end;
+        if (end - begin > refine_above)
+            runs.emplace_back(begin, end);
+        begin = end;
+    }
+    parallel_blocks(runs.size(), 1, [&](std::size_t first, std::size_t last) {
+        for (std::size_t r = first; r < last; ++r)
+            refine_run(positions, sorted.subspan(runs[r].first, runs[r].second - runs[r].first));
     });
 }
 
 } // namespace
+
+double morton_scale(const Vec3d& extent)
+{
+    const double largest = std::max({extent.x(), extent.y(), extent.z()});
+    return largest > 0.0 ? static_cast<double>((1U << 21U) - 1U) / largest : 0.0;
+}
+
+std::uint64_t morton_key(const Vec3f& point, const Vec3d& low, double scale)
+{
+    const Vec3d q = (point.cast<double>() - low) * scale;
+    // Non-finite coordinates (rejected elsewhere) must not poison the casts.
+    const auto cell = [](double v) {
+        return std::isfinite(v)
+                   ? static_cast<std::uint64_t>(std::clamp(v, 0.0, static_cast<double>(0x1FFFFF)))
+                   : std::uint64_t{0};
+    };
+    return spread_bits(cell(q.x())) | spread_bits(cell(q.y())) << 1U |
+           spread_bits(cell(q.z())) << 2U;
+}
 
 void morton_keys(std::span<const Vec3f> positions, std::span<std::uint64_t> keys)
 {
@@ -225,6 +288,7 @@ std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions)
         keyed[i] = {key, static_cast<std::uint32_t>(i)};
     });
     keyed = bucket_sort(std::move(keyed), n); // keys paired with their index: a strict order
+    refine_cells(positions, {keyed.get(), n});
     parallel_blocks(n, 1U << 16U, [&](std::size_t begin, std::size_t end) {
         for (std::size_t j = begin; j < end; ++j)
             order[j] = keyed[j].index;

@@ -393,6 +393,49 @@ TEST(KdTree, ManyCopiesOfOnePointInMortonOrder)
     }
 }
 
+/// Points in Morton order of a grid whose cells a far outlier made large (a sphere in a few
+/// cells, in the input's order inside each): the tree keys such a cell's points again over their
+/// own box instead of leaving thousands in one leaf, and the neighbours, ties and copies
+/// included, are brute force's at every leaf size.
+TEST(KdTree, CellsMadeLargeByAFarOutlier)
+{
+    PointCloud cloud = sample_shape(Shape::Sphere, {.count = 20000, .seed = 81});
+    std::vector<Vec3f> points = cloud.positions;
+    points.insert(points.end(), 40, points[777]);
+    points.emplace_back(1e7F, 0.0F, 0.0F);
+    std::vector<std::uint64_t> keys(points.size());
+    morton_keys(points, keys);
+    std::vector<std::uint32_t> order(points.size());
+    std::iota(order.begin(), order.end(), 0U);
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return keys[a] < keys[b]; });
+    std::vector<Vec3f> sorted(points.size());
+    for (std::size_t j = 0; j < order.size(); ++j)
+        sorted[j] = points[order[j]];
+    std::vector<Vec3f> queries;
+    for (std::size_t i = 0; i < sorted.size(); i += 97)
+        queries.push_back(sorted[i]);
+    queries.push_back(points[777]);
+    for (const std::size_t leaf : {1U, 16U, 64U})
+    {
+        const KdTree tree(sorted, {.leaf_size = leaf});
+        const KnnTable table = knn_batch(tree, queries, 45);
+        for (std::size_t q = 0; q < queries.size(); ++q)
+        {
+            std::vector<std::pair<float, std::uint32_t>> truth;
+            for (std::uint32_t i = 0; i < sorted.size(); ++i)
+                truth.emplace_back(squared_distance(sorted[i], queries[q]), i);
+            std::partial_sort(truth.begin(), truth.begin() + 45, truth.end());
+            for (std::size_t j = 0; j < 45; ++j)
+            {
+                ASSERT_EQ(table.neighbors(q)[j], truth[j].second)
+                    << "leaf " << leaf << " query " << q << " rank " << j;
+                ASSERT_EQ(table.distances2(q)[j], truth[j].first);
+            }
+        }
+    }
+}
+
 TEST(KdTree, TiedResultsIndependentOfThreadCountAndLayout)
 {
     const std::vector<Vec3f> points = clustered_points(41);

@@ -19,7 +19,7 @@ namespace {
 
 /// The Morton key of a point's cell: 21 bits a coordinate, interleaved x, y, z from the lowest
 /// bit, over a cube of `size` from `lo` (the order spatial_order() documents), bit by bit.
-std::uint64_t morton_key(const Vec3f& p, const Vec3d& lo, double size)
+std::uint64_t reference_key(const Vec3f& p, const Vec3d& lo, double size)
 {
     std::uint64_t key = 0;
     for (int axis = 0; axis < 3; ++axis)
@@ -63,11 +63,62 @@ TEST(SpatialOrder, MortonOrderTiesByIndexWhateverTheThreadCount)
         EXPECT_EQ(seen[order[j]]++, 0) << "index " << order[j] << " twice";
         if (j == 0)
             continue;
-        const std::uint64_t before = morton_key(points[order[j - 1]], lo, size);
-        const std::uint64_t key = morton_key(points[order[j]], lo, size);
+        const std::uint64_t before = reference_key(points[order[j - 1]], lo, size);
+        const std::uint64_t key = reference_key(points[order[j]], lo, size);
         out_of_order += before > key || (before == key && order[j - 1] > order[j]) ? 1U : 0U;
     }
     EXPECT_EQ(out_of_order, 0U);
+}
+
+/// The mean distance between points that follow each other in `order`, over those whose both
+/// points are `near` the origin.
+double mean_step(const std::vector<Vec3f>& points, const std::vector<std::uint32_t>& order,
+                 float near)
+{
+    double sum = 0.0;
+    std::size_t steps = 0;
+    for (std::size_t j = 1; j < order.size(); ++j)
+    {
+        const Vec3f& a = points[order[j - 1]];
+        const Vec3f& b = points[order[j]];
+        if (a.norm() < near && b.norm() < near)
+        {
+            sum += (a - b).norm();
+            ++steps;
+        }
+    }
+    return sum / static_cast<double>(steps);
+}
+
+// One point far away (a stray return) makes the grid's cells so large that a whole sphere falls
+// into a few of them; the points of such a cell are ordered again over their own box, so those
+// that follow each other stay as close as without the outlier (in their input order they would
+// be a sphere's size apart). Copies of one point stay in index order.
+TEST(SpatialOrder, AFarOutlierLeavesNeighboursClose)
+{
+    PointCloud cloud = sample_shape(Shape::Sphere, {.count = 200000, .seed = 8});
+    std::vector<Vec3f> points = cloud.positions;
+    std::mt19937 rng(9);
+    std::shuffle(points.begin(), points.end(), rng);
+    const double without = mean_step(points, spatial_order(points), 10.0F);
+    points.insert(points.end(), 300, points[12345]);
+    points.emplace_back(1e7F, 0.0F, 0.0F);
+    const auto orders = test::at_thread_counts([&] { return spatial_order(points); });
+    EXPECT_EQ(orders[0], orders[1]);
+    EXPECT_EQ(orders[0], orders[2]);
+    const std::vector<std::uint32_t>& order = orders[0];
+    std::vector<std::uint32_t> sorted = order;
+    std::sort(sorted.begin(), sorted.end());
+    for (std::uint32_t i = 0; i < sorted.size(); ++i)
+        ASSERT_EQ(sorted[i], i);
+    const double with = mean_step(points, order, 10.0F);
+    EXPECT_LT(with, 1.5 * without) << "without the outlier " << without;
+    std::vector<std::uint32_t> copies;
+    for (const std::uint32_t i : order)
+        if (points[i] == points[12345])
+            copies.push_back(i);
+    ASSERT_EQ(copies.size(), 301U);
+    EXPECT_TRUE(std::is_sorted(copies.begin(), copies.end()));
 }
 
 } // namespace

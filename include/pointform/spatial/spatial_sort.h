@@ -16,8 +16,10 @@ namespace pointform {
 /// order makes neighbour queries, PCA and graph traversals cache-friendly (several times faster
 /// on large scans stored in acquisition or random order).
 /// \param positions  N points
-/// \return N indices: result[j] is the original index of the j-th point along the curve; ties
-///         (points in one grid cell) keep their original order, so the result is deterministic
+/// \return N indices: result[j] is the original index of the j-th point along the curve. More
+///         than 16 points in one grid cell (where a far outlier made the cells large) are
+///         ordered again along a curve over their own box, and so on; points at one place keep
+///         their original order, so the result is deterministic
 [[nodiscard]] std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions);
 
 /// \brief The key spatial_order() sorts each point by: its cell of a grid of 2^21 cells an axis
@@ -26,5 +28,13 @@ namespace pointform {
 /// spatial_order() have non-decreasing keys. Fills `keys` (one a point) in parallel.
 /// \throw InvalidInput if the sizes differ
 void morton_keys(std::span<const Vec3f> positions, std::span<std::uint64_t> keys);
+
+/// \brief The Morton key morton_keys() gives `point` when the points' box has its low corner
+/// at `low` and `scale` = (2^21 - 1) / (the box's largest extent), or 0 if that extent is 0.
+/// Non-finite coordinates take cell 0.
+[[nodiscard]] std::uint64_t morton_key(const Vec3f& point, const Vec3d& low, double scale);
+
+/// \brief The `scale` of morton_key() for a box of these extents.
+[[nodiscard]] double morton_scale(const Vec3d& extent);
 
 } // namespace pointform
