@@ -100,6 +100,7 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
         out["degenerate"] = result.degenerate;
         out["inherited"] = orientation.inherited;
         out["unoriented"] = orientation.unoriented.size();
+        out["isolated"] = result.isolated.size();
         out["unoriented_indices"] = std::vector<std::uint32_t>(
             orientation.unoriented.begin(),
             orientation.unoriented.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(
@@ -117,6 +118,8 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
     print_row("normals flipped", std::to_string(orientation.flipped));
     print_row("degenerate (inherited)", std::to_string(result.degenerate));
     print_row("unoriented", std::to_string(orientation.unoriented.size()));
+    print_row("isolated", std::to_string(result.isolated.size()) +
+                              (result.isolated.empty() ? "" : " (alone far from the rest; kept)"));
     print_row("radius min/median/max", format_number(radius.min) + " / " +
                                            format_number(radius.median) + " / " +
                                            format_number(radius.max));

@@ -34,4 +34,15 @@ void warn_unoriented(const std::string& path, std::size_t unoriented)
     }
 }
 
+void warn_isolated(const std::string& path, std::size_t isolated)
+{
+    if (isolated > 0)
+    {
+        std::fprintf(stderr,
+                     "pointform: warning: %s: %zu samples alone far from the rest (stray points) "
+                     "were left out\n",
+                     path.c_str(), isolated);
+    }
+}
+
 } // namespace pointform::cli

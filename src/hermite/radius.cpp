@@ -5,6 +5,7 @@
 
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
+#include "pointform/spatial/kd_tree.h"
 
 #include <nlohmann/json.hpp>
 
@@ -110,6 +111,35 @@ std::vector<float> influence_radii(const KnnTable& neighbors, double scale)
                 static_cast<float>(scale * std::sqrt(static_cast<double>(neighbors.farthest2(i))));
     });
     return radii;
+}
+
+std::vector<std::uint32_t> isolated_samples(std::span<const Vec3f> positions,
+                                            const KnnTable& neighbors)
+{
+    check_knn_table(neighbors, positions.size(), positions.size(), "isolated_samples");
+    const std::size_t n = positions.size();
+    constexpr std::size_t block = 65536;
+    std::vector<std::vector<std::uint32_t>> found((n + block - 1) / block);
+    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        auto& out = found[begin / block];
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            // The nearest other sample: the row's first entry that is not i itself.
+            const auto row = neighbors.neighbors(i);
+            const auto other =
+                std::find_if(row.begin(), row.end(), [&](std::uint32_t j) { return j != i; });
+            if (other == row.end())
+                continue;
+            const float gap2 = (positions[*other] - positions[i]).squaredNorm();
+            const float reach2 = neighbors.farthest2(*other);
+            if (gap2 > isolation_factor * isolation_factor * reach2)
+                out.push_back(static_cast<std::uint32_t>(i));
+        }
+    });
+    std::vector<std::uint32_t> isolated;
+    for (const auto& part : found)
+        isolated.insert(isolated.end(), part.begin(), part.end());
+    return isolated;
 }
 
 RadiusSummary summarize_radii(std::span<const float> radii)

@@ -182,6 +182,10 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
     std::vector<float> radii = influence_radii(table, options.radius_scale);
     radii = apply_radius_regions(positions, cloud.origin, std::move(radii), options.radius_regions);
     result.radius = summarize_radii(radii);
+    result.isolated = isolated_samples(positions, table);
+    for (auto& index : result.isolated)
+        index = order[index];
+    std::sort(result.isolated.begin(), result.isolated.end());
     timer.lap("radius");
 
     // Back to the input order. The PCA normals' array (its pages already mapped) takes the

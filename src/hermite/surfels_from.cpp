@@ -36,12 +36,25 @@ void check_radius_scale(double scale)
         throw InvalidInput("radius scale must be positive and finite");
 }
 
-/// Automatic radii: the distance to the k-th neighbour times `scale`.
-std::vector<float> automatic_radii(const PointCloudView& cloud, std::size_t k, double scale)
+/// Removes the samples at `indices` (ascending). \return how many were removed
+std::size_t drop_samples(PointCloud& cloud, std::span<const std::uint32_t> indices)
+{
+    if (indices.empty())
+        return 0;
+    std::vector<std::uint8_t> keep(cloud.size(), 1);
+    for (const std::uint32_t i : indices)
+        keep[i] = 0;
+    return keep_points(cloud, keep);
+}
+
+/// Automatic radii: the distance to the k-th neighbour times `scale`; and the isolated samples
+/// (isolated_samples()).
+std::pair<std::vector<float>, std::vector<std::uint32_t>> automatic_radii(
+    const PointCloudView& cloud, std::size_t k, double scale)
 {
     const KdTree tree(cloud.positions);
     const KnnTable knn = knn_batch(tree, cloud.positions, k + 1, {.farthest_distance_only = true});
-    return influence_radii(knn, scale);
+    return {influence_radii(knn, scale), isolated_samples(cloud.positions, knn)};
 }
 
 } // namespace
@@ -67,6 +80,8 @@ SurfelsFromSamples surfels_from_samples(const PointCloudView& samples,
         out.flipped = result.orientation.flipped;
         out.degenerate = result.degenerate;
         out.unoriented = result.orientation.unoriented.size();
+        // The isolated samples first (their indices are the input's), then the unoriented.
+        out.isolated = drop_samples(out.surfels, result.isolated);
         drop_unoriented(out.surfels);
         return out;
     }
@@ -81,10 +96,11 @@ SurfelsFromSamples surfels_from_samples(const PointCloudView& samples,
                            "normals again (--reestimate)");
     if (!surfels.has_radii())
     {
-        surfels.radii = automatic_radii(surfels, options.k, options.radius_scale);
-        surfels.radii = apply_radius_regions(surfels.positions, surfels.origin,
-                                             std::move(surfels.radii), options.radius_regions);
+        auto [radii, isolated] = automatic_radii(surfels, options.k, options.radius_scale);
+        surfels.radii = apply_radius_regions(surfels.positions, surfels.origin, std::move(radii),
+                                             options.radius_regions);
         out.estimated_radii = true;
+        out.isolated = drop_samples(surfels, isolated);
     }
     return out;
 }
@@ -114,7 +130,7 @@ SurfelsFromMesh surfels_from_mesh(const TriMesh& mesh, const SurfelsFromMeshOpti
         throw InvalidInput("surfels from a mesh: too few vertices and samples (" +
                            std::to_string(out.surfels.size()) +
                            ") for k = " + std::to_string(options.k));
-    out.surfels.radii = automatic_radii(out.surfels, options.k, options.radius_scale);
+    out.surfels.radii = automatic_radii(out.surfels, options.k, options.radius_scale).first;
     return out;
 }
 

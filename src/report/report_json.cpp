@@ -97,7 +97,8 @@ nlohmann::json report_json(const SurfelsFromSamples& surfels)
             {"components", surfels.components},
             {"flipped", surfels.flipped},
             {"degenerate", surfels.degenerate},
-            {"unoriented", surfels.unoriented}};
+            {"unoriented", surfels.unoriented},
+            {"isolated", surfels.isolated}};
 }
 
 nlohmann::json report_json(const RefineLevelStats& s, double diagonal)

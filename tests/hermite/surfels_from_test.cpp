@@ -29,6 +29,38 @@ double outward_share(const PointCloud& cloud, double degrees)
     return static_cast<double>(good) / static_cast<double>(cloud.size());
 }
 
+// One stray return far from a scan (here 10^6 radii off a unit sphere) gets the gap to the
+// others as its radius and a plane of its own: it is left out, whether the normals are
+// estimated or given, and counted. Copies of one point (no gap) and a clean sphere lose nothing.
+TEST(SurfelsFromSamples, AStrayPointFarAwayIsLeftOut)
+{
+    PointCloud points = sample_shape(Shape::Sphere, {.count = 20000, .seed = 23});
+    points.radii.clear();
+    points.positions.insert(points.positions.end(), 30, points.positions[4321]);
+    points.normals.insert(points.normals.end(), 30, points.normals[4321]);
+    const std::size_t kept = points.size();
+    points.positions.emplace_back(1e6F, 0.0F, 0.0F);
+    points.normals.emplace_back(1.0F, 0.0F, 0.0F);
+    for (const bool estimate : {true, false})
+    {
+        const SurfelsFromSamples out = surfels_from_samples(points, {.reestimate = estimate});
+        EXPECT_EQ(out.estimated_normals, estimate);
+        EXPECT_EQ(out.isolated, 1U) << "estimated " << estimate;
+        ASSERT_EQ(out.surfels.size(), kept);
+        for (std::size_t i = 0; i < out.surfels.size(); ++i)
+        {
+            ASSERT_LT(out.surfels.positions[i].norm(), 1.001F) << i;
+            ASSERT_LT(out.surfels.radii[i], 0.2F) << i;
+        }
+    }
+    PointCloud clean = sample_shape(Shape::Sphere, {.count = 20000, .seed = 24});
+    clean.normals.clear();
+    clean.radii.clear();
+    const SurfelResult result = compute_surfels(clean);
+    EXPECT_TRUE(result.isolated.empty());
+    EXPECT_EQ(surfels_from_samples(clean).isolated, 0U);
+}
+
 TEST(SurfelsFromSamples, RawPointsGetOrientedNormalsAndFieldRadii)
 {
     PointCloud points = sample_shape(Shape::Sphere, {.count = 5000, .seed = 21});

@@ -62,6 +62,27 @@ TEST(Reconstruct, SampledSphereStopsByTheRuleWithinTheBudgetOnTheSphere)
     EXPECT_GT(report.intermediate_faces, semi.base->faces);
 }
 
+// A scan with one stray return far away (10^6 radii off the sphere): the stray was the whole
+// field's bounds and made marching cubes' cells larger than the sphere ("no triangles"); it is
+// left out (surfels_from_samples()), and the sphere comes out as without it.
+TEST(Reconstruct, AStrayPointFarAwayDoesNotSpoilTheSurface)
+{
+    PointCloud points = sample_shape(Shape::Sphere, {.count = 20000, .seed = 31});
+    points.normals.clear();
+    points.radii.clear();
+    points.positions.emplace_back(1e6F, 0.0F, 0.0F);
+    const SurfelsFromSamples surfels = surfels_from_samples(points);
+    EXPECT_EQ(surfels.isolated, 1U);
+    const ReconstructReport report = reconstruct(surfels.surfels);
+    const MultiresMesh& hierarchy = report.semi_regular.hierarchy;
+    const TriMesh finest = hierarchy.level_mesh(hierarchy.finest_level());
+    const MeshTopology topo = analyze_topology(finest);
+    EXPECT_TRUE(topo.is_closed());
+    EXPECT_EQ(topo.euler_characteristic, 2);
+    EXPECT_EQ(topo.components, 1U);
+    EXPECT_LT(sphere_error(finest), report.semi_regular.refinement.sampling_density);
+}
+
 TEST(Reconstruct, ExactLevelsAndTheBaseFaceTarget)
 {
     ReconstructOptions options;

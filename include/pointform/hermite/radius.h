@@ -48,6 +48,24 @@ struct RadiusSummary
 /// \throw InvalidInput if radii is empty or holds a NaN
 [[nodiscard]] RadiusSummary summarize_radii(std::span<const float> radii);
 
+/// \brief How many times a neighbour's reach (its distance to its k-th neighbour) a sample's
+/// nearest other sample must be away for the sample to count as isolated (isolated_samples()).
+/// On the scans and shapes of bench/peers and the shipped data (the bunny's range scans, the
+/// kitten, a LiDAR crop, a stereo table scene, noisy CAD parts) the largest ratio is 1.5.
+inline constexpr float isolation_factor = 4.0F;
+
+/// \brief The samples that lie alone, far from the rest (a scanner's stray return): those whose
+/// nearest other sample is more than isolation_factor times that sample's reach away (its
+/// distance to its own k-th neighbour, the farthest of its row). A surfel made of one such
+/// sample has a radius as large as the gap to the others, and its plane a surface that reaches
+/// that far. In parallel; ascending.
+/// \param positions  N points
+/// \param neighbors  their N by k table (with each point's own index, as knn_batch() of the
+///                   points themselves gives it) and its farthest squared distances
+/// \throw InvalidInput if the table does not fit the points
+[[nodiscard]] std::vector<std::uint32_t> isolated_samples(std::span<const Vec3f> positions,
+                                                          const KnnTable& neighbors);
+
 /// \brief A user region that sets the influence radius of the samples inside it (§4.1,
 /// interactive). Coordinates are world coordinates in the input's units.
 struct RadiusRegion

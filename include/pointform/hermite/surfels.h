@@ -63,6 +63,9 @@ struct SurfelResult
     std::size_t degenerate = 0;
     /// The smallest, median and largest of the surfels' radii.
     RadiusSummary radius;
+    /// The samples that lie alone far from the rest (isolated_samples()), ascending input
+    /// indices: their surfels are kept here; surfels_from_samples() leaves them out.
+    std::vector<std::uint32_t> isolated;
     /// Wall-clock seconds by stage, in order: "check", "spatial sort", "kd-tree", "knn",
     /// "normals", "orientation", "radius", "output order" (back to the input's order).
     std::vector<std::pair<std::string, double>> stage_seconds;
@@ -116,12 +119,16 @@ struct SurfelsFromSamples
     /// Samples left out for want of a usable normal: ones that could not be oriented, or given
     /// normals that are zero or not finite.
     std::size_t unoriented = 0;
+    /// Samples left out because they lie alone far from the rest (isolated_samples(); only
+    /// where radii were computed here).
+    std::size_t isolated = 0;
 };
 
 /// \brief Samples of any kind to the surfels of a field (Level 1 or 2 → 2): raw points get
 /// normals estimated and oriented and radii computed (compute_surfels()); points with normals
 /// keep them and get automatic radii if they have none. Samples without a usable normal
-/// (zero, non-finite, or unorientable) are dropped and counted.
+/// (zero, non-finite, or unorientable) are dropped and counted, and so are, where the radii are
+/// computed here, the samples that lie alone far from the rest (isolated_samples()).
 /// \throw InvalidInput as check_surfel_input(), for a radius_scale not positive and finite, or
 ///        when fewer than k + 1 samples with a usable normal are left
 [[nodiscard]] SurfelsFromSamples surfels_from_samples(

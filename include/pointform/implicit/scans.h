@@ -32,6 +32,7 @@ struct LoadedScan
     std::size_t samples = 0;        ///< surfels in its field
     bool estimated_normals = false; ///< the file had no normals, or reestimate
     std::size_t unoriented = 0;     ///< samples left out for want of a usable normal
+    std::size_t isolated = 0;       ///< samples left out as alone far from the rest
     std::shared_ptr<const PointField> field;
 };
 
