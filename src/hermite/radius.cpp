@@ -116,23 +116,43 @@ std::vector<float> influence_radii(const KnnTable& neighbors, double scale)
 std::vector<std::uint32_t> isolated_samples(std::span<const Vec3f> positions,
                                             const KnnTable& neighbors)
 {
-    check_knn_table(neighbors, positions.size(), positions.size(), "isolated_samples");
+    check_knn_table_shape(neighbors, positions.size(), "isolated_samples");
     const std::size_t n = positions.size();
     constexpr std::size_t block = 65536;
-    std::vector<std::vector<std::uint32_t>> found((n + block - 1) / block);
+    const std::size_t blocks = (n + block - 1) / block;
+    // An isolated sample's gap to its nearest other is at most its own reach and more than
+    // isolation_factor times the other's, so more than that times the least reach: only samples
+    // whose reach is that long can be isolated (on an evenly sampled surface, none), and only
+    // their rows are read.
+    std::vector<float> least(blocks, std::numeric_limits<float>::infinity());
+    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
+        float low = std::numeric_limits<float>::infinity();
+        for (std::size_t i = begin; i < end; ++i)
+            low = std::min(low, neighbors.farthest2(i));
+        least[begin / block] = low;
+    });
+    const float factor2 = isolation_factor * isolation_factor;
+    const float candidate2 = factor2 * *std::min_element(least.begin(), least.end());
+    std::vector<std::vector<std::uint32_t>> found(blocks);
     parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
         auto& out = found[begin / block];
         for (std::size_t i = begin; i < end; ++i)
         {
-            // The nearest other sample: the row's first entry that is not i itself.
+            if (!(neighbors.farthest2(i) > candidate2))
+                continue;
             const auto row = neighbors.neighbors(i);
+            for (const std::uint32_t j : row)
+                if (j >= n)
+                    throw InvalidInput("isolated_samples: neighbour " + std::to_string(j) +
+                                       " of row " + std::to_string(i) + " is out of range for " +
+                                       std::to_string(n) + " points");
+            // The nearest other sample: the row's first entry that is not i itself.
             const auto other =
                 std::find_if(row.begin(), row.end(), [&](std::uint32_t j) { return j != i; });
             if (other == row.end())
                 continue;
             const float gap2 = (positions[*other] - positions[i]).squaredNorm();
-            const float reach2 = neighbors.farthest2(*other);
-            if (gap2 > isolation_factor * isolation_factor * reach2)
+            if (gap2 > factor2 * neighbors.farthest2(*other))
                 out.push_back(static_cast<std::uint32_t>(i));
         }
     });

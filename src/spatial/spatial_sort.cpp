@@ -230,16 +230,27 @@ void refine_run(std::span<const Vec3f> positions, std::span<Keyed> run)
 /// keys of those runs are overwritten (only the order is kept).
 void refine_cells(std::span<const Vec3f> positions, std::span<Keyed> sorted)
 {
+    // The runs that start in each block (and may end past it), found at once.
+    const std::size_t n = sorted.size();
+    constexpr std::size_t block = std::size_t{1} << 18U;
+    std::vector<std::vector<std::pair<std::size_t, std::size_t>>> found((n + block - 1) / block);
+    parallel_blocks(n, block, [&](std::size_t first, std::size_t last) {
+        std::size_t begin = first;
+        while (begin < last && begin > 0 && sorted[begin].key == sorted[begin - 1].key)
+            ++begin;
+        while (begin < last)
+        {
+            std::size_t end = begin + 1;
+            while (end < n && sorted[end].key == sorted[begin].key)
+                ++end;
+            if (end - begin > refine_above)
+                found[first / block].emplace_back(begin, end);
+            begin = end;
+        }
+    });
     std::vector<std::pair<std::size_t, std::size_t>> runs;
-    for (std::size_t begin = 0; begin < sorted.size();)
-    {
-        std::size_t end = begin + 1;
-        while (end < sorted.size() && sorted[end].key == sorted[begin].key)
-            ++end;
-        if (end - begin > refine_above)
-            runs.emplace_back(begin, end);
-        begin = end;
-    }
+    for (const auto& part : found)
+        runs.insert(runs.end(), part.begin(), part.end());
     parallel_blocks(runs.size(), 1, [&](std::size_t first, std::size_t last) {
         for (std::size_t r = first; r < last; ++r)
             refine_run(positions, sorted.subspan(runs[r].first, runs[r].second - runs[r].first));
