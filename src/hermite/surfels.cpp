@@ -5,6 +5,7 @@
 
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
+#include "pointform/geometry/aabb.h"
 #include "pointform/hermite/normals.h"
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/spatial_sort.h"
@@ -23,6 +24,9 @@ namespace {
 /// Second-largest over largest eigenvalue of the whole cloud's covariance below which all points
 /// are taken to lie on one line. Relative, so unit-free; float storage noise is about 1e-14.
 constexpr double global_collinear_ratio = 1e-12;
+/// The largest extent of a cloud that can carry surfels: its squared distances (three squares
+/// summed in float) stay below float's largest value, 3.4e38.
+constexpr double max_extent = 1e18;
 
 /// Samples a block when the cloud is put into Morton order and back.
 constexpr std::size_t gather_block = 1U << 16U;
@@ -43,6 +47,50 @@ private:
     std::vector<std::pair<std::string, double>>& log_;
     std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
+
+/// Whether the bulk of a cloud spans a plane although its whole covariance says that the points
+/// lie on one line or at one place: one point far enough away (a stray return at 1e20) makes
+/// every other spread vanish beside its own. Up to 65,536 points taken at an even stride,
+/// without the 2% of them farthest from their coordinate-wise median.
+bool bulk_spans_a_plane(std::span<const Vec3f> positions)
+{
+    const std::size_t stride = std::max<std::size_t>(1, positions.size() / 65536);
+    std::vector<Vec3d> sample;
+    for (std::size_t i = 0; i < positions.size(); i += stride)
+        sample.push_back(positions[i].cast<double>());
+    const auto middle = static_cast<std::ptrdiff_t>(sample.size() / 2);
+    Vec3d centre;
+    std::vector<double> values(sample.size());
+    for (Eigen::Index axis = 0; axis < 3; ++axis)
+    {
+        for (std::size_t j = 0; j < sample.size(); ++j)
+            values[j] = sample[j][axis];
+        std::nth_element(values.begin(), values.begin() + middle, values.end());
+        centre[axis] = values[static_cast<std::size_t>(middle)];
+    }
+    for (std::size_t j = 0; j < sample.size(); ++j)
+        values[j] = (sample[j] - centre).squaredNorm();
+    std::vector<double> sorted = values;
+    const auto cut = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() * 98 / 100);
+    std::nth_element(sorted.begin(), cut, sorted.end());
+    const double limit = *cut;
+    Vec3d sum = Vec3d::Zero();
+    Mat3d products = Mat3d::Zero();
+    double count = 0.0;
+    for (std::size_t j = 0; j < sample.size(); ++j)
+        if (values[j] <= limit)
+        {
+            const Vec3d d = sample[j] - centre;
+            sum += d;
+            products.noalias() += d * d.transpose();
+            count += 1.0;
+        }
+    const Vec3d mean = sum / count;
+    const Mat3d covariance = products / count - mean * mean.transpose();
+    const Eigen::SelfAdjointEigenSolver<Mat3d> solver(covariance, Eigen::EigenvaluesOnly);
+    const Vec3d& lambda = solver.eigenvalues();
+    return lambda[2] > 0.0 && lambda[1] > global_collinear_ratio * lambda[2];
+}
 
 } // namespace
 
@@ -96,15 +144,28 @@ void check_surfel_input(const PointCloudView& cloud, std::size_t k)
         sum += part.sum;
         products += part.products;
     }
+    // Squared distances are summed in float by the kd-tree: beyond about 1.8e19 they overflow.
+    const Aabb box = bounding_box(cloud.positions);
+    if (box.size().maxCoeff() > max_extent)
+        throw InvalidInput("the points span " + std::to_string(box.size().maxCoeff()) +
+                           " units, more than " + std::to_string(max_extent) +
+                           ", where distances overflow single precision: remove the far "
+                           "outliers");
     const Vec3d mean = sum / static_cast<double>(n);
     const Mat3d covariance = products - static_cast<double>(n) * mean * mean.transpose();
     const Eigen::SelfAdjointEigenSolver<Mat3d> solver(covariance, Eigen::EigenvaluesOnly);
     const Vec3d& lambda = solver.eigenvalues();
-    if (!(lambda[2] > 0.0))
+    const bool coincide = !(lambda[2] > 0.0);
+    const bool line = !coincide && lambda[1] <= global_collinear_ratio * lambda[2];
+    if (!coincide && !line)
+        return;
+    // Far outliers can make a surface look like a line: only the bulk decides.
+    if (bulk_spans_a_plane(cloud.positions))
+        return;
+    if (coincide)
         throw InvalidInput("all " + std::to_string(cloud.size()) +
                            " points coincide: no surface to estimate");
-    if (lambda[1] <= global_collinear_ratio * lambda[2])
-        throw InvalidInput("all points lie on one line: no surface normal is defined");
+    throw InvalidInput("all points lie on one line: no surface normal is defined");
 }
 
 namespace {

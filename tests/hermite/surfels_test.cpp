@@ -133,6 +133,31 @@ TEST(ComputeSurfels, CloudHandedOverGivesTheSameSurfels)
     EXPECT_EQ(few.size(), 10U); // NOLINT(bugprone-use-after-move): unchanged when it throws
 }
 
+// One point very far away makes the whole cloud's covariance a line (its spread 1e28 against the
+// sphere's 1/3): the input check looks at the bulk then, and the sphere gets its normals. Points
+// on a line stay a line with a far point beside them. Beyond 1e18 float distances overflow: a
+// clear error.
+TEST(ComputeSurfels, AFarOutlierDoesNotMakeASurfaceALine)
+{
+    PointCloud cloud = sample_shape(Shape::Sphere, {.count = 5000, .seed = 14});
+    cloud.normals.clear();
+    cloud.radii.clear();
+    PointCloud too_far = cloud;
+    too_far.positions.emplace_back(1e20F, 0.0F, 0.0F);
+    EXPECT_THROW((void)compute_surfels(too_far), InvalidInput);
+    cloud.positions.emplace_back(1e14F, 0.0F, 0.0F);
+    const SurfelResult result = compute_surfels(cloud);
+    EXPECT_EQ(result.isolated, std::vector<std::uint32_t>{5000});
+    for (std::size_t i = 0; i < 5000; ++i)
+        ASSERT_GT(result.surfels.normals[i].dot(result.surfels.positions[i].normalized()), 0.95F)
+            << i;
+    PointCloud line;
+    for (int i = 0; i < 500; ++i)
+        line.positions.emplace_back(0.01F * static_cast<float>(i), 0.0F, 0.0F);
+    line.positions.emplace_back(0.0F, 1e14F, 0.0F);
+    EXPECT_THROW((void)compute_surfels(line), InvalidInput);
+}
+
 TEST(ComputeSurfels, RejectsBadInput)
 {
     PointCloud cloud = sample_shape(Shape::Sphere, {.count = 100, .seed = 13});
