@@ -196,14 +196,8 @@ Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neigh
                 for (std::size_t g = 0; g < count; ++g)
                 {
                     const std::size_t i = first + g;
-                    const std::span<const std::uint32_t> row = neighbors.neighbors(i);
-                    for (const std::uint32_t index : row)
-                        if (index >= positions.size())
-                            throw InvalidInput("estimate_normals: neighbour " +
-                                               std::to_string(index) + " of row " +
-                                               std::to_string(i) + " is out of range for " +
-                                               std::to_string(positions.size()) + " points");
-                    moments[g] = moments_of(positions, row);
+                    check_knn_row(neighbors, i, positions.size(), "estimate_normals");
+                    moments[g] = moments_of(positions, neighbors.neighbors(i));
                     cubics[g] = cubic_of(moments[g].covariance);
                 }
                 const std::array<double, root_group> lambda = least_roots(cubics, count);

@@ -133,33 +133,24 @@ std::vector<std::uint32_t> isolated_samples(std::span<const Vec3f> positions,
     });
     const float factor2 = isolation_factor * isolation_factor;
     const float candidate2 = factor2 * *std::min_element(least.begin(), least.end());
-    std::vector<std::vector<std::uint32_t>> found(blocks);
-    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
-        auto& out = found[begin / block];
-        for (std::size_t i = begin; i < end; ++i)
-        {
-            if (!(neighbors.farthest2(i) > candidate2))
-                continue;
-            const auto row = neighbors.neighbors(i);
-            for (const std::uint32_t j : row)
-                if (j >= n)
-                    throw InvalidInput("isolated_samples: neighbour " + std::to_string(j) +
-                                       " of row " + std::to_string(i) + " is out of range for " +
-                                       std::to_string(n) + " points");
-            // The nearest other sample: the row's first entry that is not i itself.
-            const auto other =
-                std::find_if(row.begin(), row.end(), [&](std::uint32_t j) { return j != i; });
-            if (other == row.end())
-                continue;
-            const float gap2 = (positions[*other] - positions[i]).squaredNorm();
-            if (gap2 > factor2 * neighbors.farthest2(*other))
-                out.push_back(static_cast<std::uint32_t>(i));
-        }
-    });
-    std::vector<std::uint32_t> isolated;
-    for (const auto& part : found)
-        isolated.insert(isolated.end(), part.begin(), part.end());
-    return isolated;
+    return parallel_collect<std::uint32_t>(
+        n, block, [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& out) {
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                if (!(neighbors.farthest2(i) > candidate2))
+                    continue;
+                check_knn_row(neighbors, i, n, "isolated_samples");
+                const auto row = neighbors.neighbors(i);
+                // The nearest other sample: the row's first entry that is not i itself.
+                const auto other =
+                    std::find_if(row.begin(), row.end(), [&](std::uint32_t j) { return j != i; });
+                if (other == row.end())
+                    continue;
+                const float gap2 = (positions[*other] - positions[i]).squaredNorm();
+                if (gap2 > factor2 * neighbors.farthest2(*other))
+                    out.push_back(static_cast<std::uint32_t>(i));
+            }
+        });
 }
 
 RadiusSummary summarize_radii(std::span<const float> radii)
@@ -221,20 +212,16 @@ RadiusSummary summarize_radii(std::span<const float> radii)
         }
         below += count;
     }
-    std::vector<std::vector<std::uint32_t>> inside(blocks);
-    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
-        auto& keys = inside[begin / block];
-        keys.reserve(counts[(begin / block) * buckets + middle]);
-        for (std::size_t i = begin; i < end; ++i)
-        {
-            const std::uint32_t key = key_of(radii[i]);
-            if (key >> low_bits == middle)
-                keys.push_back(key);
-        }
-    });
-    std::vector<std::uint32_t> keys;
-    for (const auto& part : inside)
-        keys.insert(keys.end(), part.begin(), part.end());
+    std::vector<std::uint32_t> keys = parallel_collect<std::uint32_t>(
+        n, block, [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& inside) {
+            inside.reserve(counts[(begin / block) * buckets + middle]);
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                const std::uint32_t key = key_of(radii[i]);
+                if (key >> low_bits == middle)
+                    inside.push_back(key);
+            }
+        });
     const auto at = keys.begin() + static_cast<std::ptrdiff_t>(rank - below);
     std::nth_element(keys.begin(), at, keys.end());
     return {.min = value_of(*std::min_element(lowest.begin(), lowest.end())),

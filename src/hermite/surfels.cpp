@@ -5,7 +5,6 @@
 
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
-#include "pointform/geometry/aabb.h"
 #include "pointform/hermite/normals.h"
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/spatial_sort.h"
@@ -15,6 +14,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -114,6 +114,8 @@ void check_surfel_input(const PointCloudView& cloud, std::size_t k)
         std::size_t first_bad = ~std::size_t{0};
         Vec3d sum = Vec3d::Zero();
         Mat3d products = Mat3d::Zero();
+        Vec3d low = Vec3d::Constant(std::numeric_limits<double>::infinity());
+        Vec3d high = Vec3d::Constant(-std::numeric_limits<double>::infinity());
     };
     std::vector<Moments> parts(blocks);
     const Vec3d pivot = cloud.positions[0].cast<double>();
@@ -131,11 +133,15 @@ void check_surfel_input(const PointCloudView& cloud, std::size_t k)
                 const Vec3d d = cloud.positions[i].cast<double>() - pivot;
                 part.sum += d;
                 part.products.noalias() += d * d.transpose();
+                part.low = part.low.cwiseMin(d);
+                part.high = part.high.cwiseMax(d);
             }
         }
     });
     Vec3d sum = Vec3d::Zero();
     Mat3d products = Mat3d::Zero();
+    Vec3d low = Vec3d::Zero(); // the pivot is a point
+    Vec3d high = Vec3d::Zero();
     for (const Moments& part : parts)
     {
         if (part.first_bad != ~std::size_t{0})
@@ -143,12 +149,14 @@ void check_surfel_input(const PointCloudView& cloud, std::size_t k)
                                " has a NaN or infinite coordinate");
         sum += part.sum;
         products += part.products;
+        low = low.cwiseMin(part.low);
+        high = high.cwiseMax(part.high);
     }
     // Squared distances are summed in float by the kd-tree: beyond about 1.8e19 they overflow.
-    const Aabb box = bounding_box(cloud.positions);
-    if (box.size().maxCoeff() > max_extent)
-        throw InvalidInput("the points span " + std::to_string(box.size().maxCoeff()) +
-                           " units, more than " + std::to_string(max_extent) +
+    const double span = (high - low).maxCoeff();
+    if (span > max_extent)
+        throw InvalidInput("the points span " + std::to_string(span) + " units, more than " +
+                           std::to_string(max_extent) +
                            ", where distances overflow single precision: remove the far "
                            "outliers");
     const Vec3d mean = sum / static_cast<double>(n);

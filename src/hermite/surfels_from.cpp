@@ -47,14 +47,12 @@ std::size_t drop_samples(PointCloud& cloud, std::span<const std::uint32_t> indic
     return keep_points(cloud, keep);
 }
 
-/// Automatic radii: the distance to the k-th neighbour times `scale`; and the isolated samples
-/// (isolated_samples()).
-std::pair<std::vector<float>, std::vector<std::uint32_t>> automatic_radii(
-    const PointCloudView& cloud, std::size_t k, double scale)
+/// Each point's k nearest (itself included) with only the farthest distance: what the
+/// automatic radii (influence_radii()) and the isolated samples (isolated_samples()) read.
+KnnTable reach_table(const PointCloudView& cloud, std::size_t k)
 {
     const KdTree tree(cloud.positions);
-    const KnnTable knn = knn_batch(tree, cloud.positions, k + 1, {.farthest_distance_only = true});
-    return {influence_radii(knn, scale), isolated_samples(cloud.positions, knn)};
+    return knn_batch(tree, cloud.positions, k + 1, {.farthest_distance_only = true});
 }
 
 } // namespace
@@ -96,11 +94,12 @@ SurfelsFromSamples surfels_from_samples(const PointCloudView& samples,
                            "normals again (--reestimate)");
     if (!surfels.has_radii())
     {
-        auto [radii, isolated] = automatic_radii(surfels, options.k, options.radius_scale);
-        surfels.radii = apply_radius_regions(surfels.positions, surfels.origin, std::move(radii),
+        const KnnTable reach = reach_table(surfels, options.k);
+        surfels.radii = apply_radius_regions(surfels.positions, surfels.origin,
+                                             influence_radii(reach, options.radius_scale),
                                              options.radius_regions);
         out.estimated_radii = true;
-        out.isolated = drop_samples(surfels, isolated);
+        out.isolated = drop_samples(surfels, isolated_samples(surfels.positions, reach));
     }
     return out;
 }
@@ -130,7 +129,7 @@ SurfelsFromMesh surfels_from_mesh(const TriMesh& mesh, const SurfelsFromMeshOpti
         throw InvalidInput("surfels from a mesh: too few vertices and samples (" +
                            std::to_string(out.surfels.size()) +
                            ") for k = " + std::to_string(options.k));
-    out.surfels.radii = automatic_radii(out.surfels, options.k, options.radius_scale).first;
+    out.surfels.radii = influence_radii(reach_table(out.surfels, options.k), options.radius_scale);
     return out;
 }
 

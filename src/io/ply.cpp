@@ -327,7 +327,6 @@ std::uint8_t to_color(double value, PlyType type)
     return static_cast<std::uint8_t>(std::min(value, 255.0));
 }
 
-/// Values of a binary body, read through a ByteCursor in the file's byte order.
 /// Stores a vertex property's value in its point (colours converted from their type).
 void set_property(PointRecord& point, const PlyProperty& property, double value)
 {
@@ -360,6 +359,7 @@ double load_scalar(const char* p, PlyType type, ByteOrder order)
     return 0.0;
 }
 
+/// Values of a binary body, read through a ByteCursor in the file's byte order.
 class BinarySource
 {
 public:

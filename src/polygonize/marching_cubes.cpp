@@ -463,33 +463,6 @@ void sort_unique(std::vector<std::uint64_t>& keys)
     keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
 }
 
-/// Runs `body(begin, end, out)` over fixed blocks of [0, n) in parallel and concatenates each
-/// block's output in block order, so the result does not depend on the thread count.
-template <typename T, typename Body>
-std::vector<T> parallel_collect(std::size_t n, std::size_t block, const Body& body)
-{
-    const std::size_t blocks = (n + block - 1) / block;
-    std::vector<std::vector<T>> parts(blocks);
-    parallel_blocks(blocks, 1, [&](std::size_t b0, std::size_t b1) {
-        for (std::size_t b = b0; b < b1; ++b)
-        {
-            body(b * block, std::min(n, (b + 1) * block), parts[b]);
-        }
-    });
-    std::size_t total = 0;
-    for (const auto& p : parts)
-    {
-        total += p.size();
-    }
-    std::vector<T> out;
-    out.reserve(total);
-    for (auto& p : parts)
-    {
-        out.insert(out.end(), p.begin(), p.end());
-    }
-    return out;
-}
-
 } // namespace
 
 CellGrid grid_over(const Aabb& box, double cell)

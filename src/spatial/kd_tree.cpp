@@ -16,7 +16,6 @@
 #include <limits>
 #include <memory>
 #include <string>
-#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -202,48 +201,22 @@ Node* divide_tree(NanoTree& tree, std::span<const Vec3f> points, Node*& next, Of
 /// Points a subtree at least, below which it is built by one thread (divide_tree()).
 constexpr std::size_t min_subtree = 8192;
 
-/// Points [left, right) of the tree's order (`vacc`) whose `keys` are all the same (one grid
-/// cell) but which do not all lie at one place (a far outlier makes the cells of the rest large):
-/// their keys again, over their own bounding box, and `vacc` and `keys` of the range sorted by
-/// them, ties by index (so that coincident points stay together in index order). False, and
-/// nothing changed, when they do all lie at one place.
-bool refine_cell(std::span<const Vec3f> points, std::span<std::uint32_t> vacc,
-                 std::span<std::uint64_t> keys, Offset left, Offset right)
-{
-    Vec3f low = points[vacc[left]];
-    Vec3f high = low;
-    for (Offset k = left + 1; k < right; ++k)
-    {
-        low = low.cwiseMin(points[vacc[k]]);
-        high = high.cwiseMax(points[vacc[k]]);
-    }
-    if (low == high)
-        return false;
-    const Vec3d corner = low.cast<double>();
-    const double scale = morton_scale(high.cast<double>() - corner);
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(right - left);
-    for (Offset k = left; k < right; ++k)
-        keyed[k - left] = {morton_key(points[vacc[k]], corner, scale), vacc[k]};
-    std::sort(keyed.begin(), keyed.end());
-    for (Offset k = left; k < right; ++k)
-        std::tie(keys[k], vacc[k]) = keyed[k - left];
-    return true;
-}
-
 /// The subtree of points [left, right) of the tree's order `vacc`, whose Morton `keys` do not
 /// decrease, its nodes taken in turn from `next`: each node splits its points where their keys
 /// first differ, which is a plane between two halves of a grid cell (so every point of the first
 /// child lies below every point of the second along that axis), down to leaves of at most `leaf`
 /// points, or of copies of one point, in index order. A cell of more points than a leaf that do
-/// not all lie at one place is keyed again over its own box (refine_cell()). `bbox` is set to the
-/// points' box.
+/// not all lie at one place is keyed again over its own box (order_in_own_box()). `bbox` is set
+/// to the points' box.
 Node* morton_subtree(std::span<const Vec3f> points, std::span<std::uint32_t> vacc,
                      std::span<std::uint64_t> keys, std::size_t leaf, Node*& next, Offset left,
                      Offset right, BoundingBox& bbox)
 {
     Node* node = next++;
     std::uint64_t differ = keys[left] ^ keys[right - 1];
-    if (differ == 0 && right - left > leaf && refine_cell(points, vacc, keys, left, right))
+    if (differ == 0 && right - left > leaf &&
+        order_in_own_box(points, vacc.subspan(left, right - left),
+                         keys.subspan(left, right - left)))
         differ = keys[left] ^ keys[right - 1];
     if (right - left <= leaf || differ == 0)
     {
@@ -556,9 +529,15 @@ void check_knn_table(const KnnTable& table, std::size_t rows, std::size_t points
         std::find_if(table.indices.begin(), table.indices.end(),
                      [&](std::uint32_t index) { return index >= points; }) -
         table.indices.begin());
-    throw InvalidInput(std::string(function) + ": neighbour " + std::to_string(table.indices[bad]) +
-                       " of row " + std::to_string(bad / table.k) + " is out of range for " +
-                       std::to_string(points) + " points");
+    throw_knn_index_out_of_range(table.indices[bad], bad / table.k, points, function);
+}
+
+void throw_knn_index_out_of_range(std::uint32_t index, std::size_t row, std::size_t points,
+                                  const char* function)
+{
+    throw InvalidInput(std::string(function) + ": neighbour " + std::to_string(index) + " of row " +
+                       std::to_string(row) + " is out of range for " + std::to_string(points) +
+                       " points");
 }
 
 std::span<const Vec3f> KdTree::positions() const

@@ -14,6 +14,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -194,36 +195,43 @@ void for_each_key(std::span<const Vec3f> positions, const Use& use)
 /// by keys over their own box (refine_run()).
 constexpr std::size_t refine_above = 16;
 
-/// Orders a run of points that share a key (a grid cell) by their keys over their own bounding
-/// box, ties by index, and so on inside those keys' own runs: where a far outlier made the grid's
-/// cells large, points close in space are close in the order again. Nothing changes when the
-/// run's points all lie at one place. Each round shrinks the box by at least 2^21, so float's
-/// range allows about a dozen.
-void refine_run(std::span<const Vec3f> positions, std::span<Keyed> run)
+/// Calls `use(begin, end)` for every run of more than refine_above equal keys of `sorted` that
+/// starts in [from, to) (it may end past `to`).
+template <typename Use>
+void for_each_crowded_run(std::span<const Keyed> sorted, std::size_t from, std::size_t to,
+                          const Use& use)
 {
-    Vec3f low = positions[run[0].index];
-    Vec3f high = low;
-    for (const Keyed& k : run)
-    {
-        low = low.cwiseMin(positions[k.index]);
-        high = high.cwiseMax(positions[k.index]);
-    }
-    if (!(low != high) || !low.allFinite() || !high.allFinite())
-        return;
-    const Vec3d corner = low.cast<double>();
-    const double scale = morton_scale(high.cast<double>() - corner);
-    for (Keyed& k : run)
-        k.key = morton_key(positions[k.index], corner, scale);
-    std::sort(run.begin(), run.end());
-    for (std::size_t begin = 0; begin < run.size();)
+    std::size_t begin = from;
+    while (begin < to && begin > 0 && sorted[begin].key == sorted[begin - 1].key)
+        ++begin;
+    while (begin < to)
     {
         std::size_t end = begin + 1;
-        while (end < run.size() && run[end].key == run[begin].key)
+        while (end < sorted.size() && sorted[end].key == sorted[begin].key)
             ++end;
         if (end - begin > refine_above)
-            refine_run(positions, run.subspan(begin, end - begin));
+            use(begin, end);
         begin = end;
     }
+}
+
+/// Orders a run of points that share a key (a grid cell) by their keys over their own bounding
+/// box (order_in_own_box()), and so on inside those keys' own runs: where a far outlier made the
+/// grid's cells large, points close in space are close in the order again. Each round shrinks the
+/// box by at least 2^21, so float's range allows about a dozen.
+void refine_run(std::span<const Vec3f> positions, std::span<Keyed> run)
+{
+    std::vector<std::uint32_t> indices(run.size());
+    std::vector<std::uint64_t> keys(run.size());
+    for (std::size_t j = 0; j < run.size(); ++j)
+        indices[j] = run[j].index;
+    if (!order_in_own_box(positions, indices, keys))
+        return;
+    for (std::size_t j = 0; j < run.size(); ++j)
+        run[j] = {keys[j], indices[j]};
+    for_each_crowded_run(run, 0, run.size(), [&](std::size_t begin, std::size_t end) {
+        refine_run(positions, run.subspan(begin, end - begin));
+    });
 }
 
 /// refine_run() on every run of more than refine_above equal keys of `sorted`, in parallel. The
@@ -231,26 +239,15 @@ void refine_run(std::span<const Vec3f> positions, std::span<Keyed> run)
 void refine_cells(std::span<const Vec3f> positions, std::span<Keyed> sorted)
 {
     // The runs that start in each block (and may end past it), found at once.
-    const std::size_t n = sorted.size();
-    constexpr std::size_t block = std::size_t{1} << 18U;
-    std::vector<std::vector<std::pair<std::size_t, std::size_t>>> found((n + block - 1) / block);
-    parallel_blocks(n, block, [&](std::size_t first, std::size_t last) {
-        std::size_t begin = first;
-        while (begin < last && begin > 0 && sorted[begin].key == sorted[begin - 1].key)
-            ++begin;
-        while (begin < last)
-        {
-            std::size_t end = begin + 1;
-            while (end < n && sorted[end].key == sorted[begin].key)
-                ++end;
-            if (end - begin > refine_above)
-                found[first / block].emplace_back(begin, end);
-            begin = end;
-        }
-    });
-    std::vector<std::pair<std::size_t, std::size_t>> runs;
-    for (const auto& part : found)
-        runs.insert(runs.end(), part.begin(), part.end());
+    const std::vector<std::pair<std::size_t, std::size_t>> runs =
+        parallel_collect<std::pair<std::size_t, std::size_t>>(
+            sorted.size(), std::size_t{1} << 18U,
+            [&](std::size_t first, std::size_t last,
+                std::vector<std::pair<std::size_t, std::size_t>>& out) {
+                for_each_crowded_run(sorted, first, last, [&](std::size_t begin, std::size_t end) {
+                    out.emplace_back(begin, end);
+                });
+            });
     parallel_blocks(runs.size(), 1, [&](std::size_t first, std::size_t last) {
         for (std::size_t r = first; r < last; ++r)
             refine_run(positions, sorted.subspan(runs[r].first, runs[r].second - runs[r].first));
@@ -276,6 +273,31 @@ std::uint64_t morton_key(const Vec3f& point, const Vec3d& low, double scale)
     };
     return spread_bits(cell(q.x())) | spread_bits(cell(q.y())) << 1U |
            spread_bits(cell(q.z())) << 2U;
+}
+
+bool order_in_own_box(std::span<const Vec3f> positions, std::span<std::uint32_t> indices,
+                      std::span<std::uint64_t> keys)
+{
+    if (indices.empty())
+        return false;
+    Vec3f low = positions[indices[0]];
+    Vec3f high = low;
+    for (const std::uint32_t i : indices)
+    {
+        low = low.cwiseMin(positions[i]);
+        high = high.cwiseMax(positions[i]);
+    }
+    if (!(low != high) || !low.allFinite() || !high.allFinite())
+        return false;
+    const Vec3d corner = low.cast<double>();
+    const double scale = morton_scale(high.cast<double>() - corner);
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(indices.size());
+    for (std::size_t j = 0; j < indices.size(); ++j)
+        keyed[j] = {morton_key(positions[indices[j]], corner, scale), indices[j]};
+    std::sort(keyed.begin(), keyed.end());
+    for (std::size_t j = 0; j < indices.size(); ++j)
+        std::tie(keys[j], indices[j]) = keyed[j];
+    return true;
 }
 
 void morton_keys(std::span<const Vec3f> positions, std::span<std::uint64_t> keys)

@@ -38,6 +38,28 @@ void parallel_blocks(std::size_t n, std::size_t block,
                      const std::function<void(std::size_t, std::size_t)>& body,
                      ProgressReporter* progress = nullptr);
 
+/// \brief Runs `body(begin, end, out)` over fixed blocks of [0, n) in parallel, each block
+/// appending to its own vector `out`, and concatenates those in block order, so the result does
+/// not depend on the thread count.
+template <typename T, typename Body>
+[[nodiscard]] std::vector<T> parallel_collect(std::size_t n, std::size_t block, const Body& body)
+{
+    const std::size_t blocks = (n + block - 1) / block;
+    std::vector<std::vector<T>> parts(blocks);
+    parallel_blocks(blocks, 1, [&](std::size_t b0, std::size_t b1) {
+        for (std::size_t b = b0; b < b1; ++b)
+            body(b * block, std::min(n, (b + 1) * block), parts[b]);
+    });
+    std::size_t total = 0;
+    for (const auto& part : parts)
+        total += part.size();
+    std::vector<T> out;
+    out.reserve(total);
+    for (auto& part : parts)
+        out.insert(out.end(), part.begin(), part.end());
+    return out;
+}
+
 /// \brief Sorts `items` by `less` in parallel: a power of two of pieces (about four per thread,
 /// at least 65,536 items each) sorted at once, then merged in pairs, round by round, each
 /// round's merges at once. For a strict total order (no two items equivalent, e.g. keys paired

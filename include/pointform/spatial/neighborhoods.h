@@ -55,6 +55,22 @@ void check_knn_table(const KnnTable& table, std::size_t rows, std::size_t points
 /// row's indices as it reads them (one memory pass instead of two).
 void check_knn_table_shape(const KnnTable& table, std::size_t rows, const char* function);
 
+/// \brief Throws InvalidInput naming `function`, the neighbour `index` and its `row`, out of
+/// range for `points` points (check_knn_table(), check_knn_row()).
+[[noreturn]] void throw_knn_index_out_of_range(std::uint32_t index, std::size_t row,
+                                               std::size_t points, const char* function);
+
+/// \brief The per-row check of such a caller: every index of row `row` below `points`. Inline:
+/// it runs once a row in loops over millions of them.
+/// \throw InvalidInput as check_knn_table() does
+inline void check_knn_row(const KnnTable& table, std::size_t row, std::size_t points,
+                          const char* function)
+{
+    for (const std::uint32_t index : table.neighbors(row))
+        if (index >= points)
+            throw_knn_index_out_of_range(index, row, points, function);
+}
+
 /// \brief Variable-size neighbourhoods in compressed sparse row form: the neighbours of query i
 /// are indices[offsets[i] .. offsets[i+1]), nearest first.
 struct RadiusTable

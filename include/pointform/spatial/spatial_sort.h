@@ -37,4 +37,13 @@ void morton_keys(std::span<const Vec3f> positions, std::span<std::uint64_t> keys
 /// \brief The `scale` of morton_key() for a box of these extents.
 [[nodiscard]] double morton_scale(const Vec3d& extent);
 
+/// \brief Orders `indices` (of points of `positions`) along a Morton curve over those points' own
+/// bounding box, ties by index, and sets `keys` (as many) to their keys on it: how the points of
+/// one crowded grid cell (a far outlier makes a whole cloud's cells large) are ordered again, by
+/// spatial_order() and by the kd-tree of Morton-ordered points.
+/// \return false, and nothing changed, when the points all lie at one place or one of their
+///         coordinates is not finite
+bool order_in_own_box(std::span<const Vec3f> positions, std::span<std::uint32_t> indices,
+                      std::span<std::uint64_t> keys);
+
 } // namespace pointform
