@@ -3,6 +3,7 @@
 
 #include "pointform/hermite/radius.h"
 
+#include "pointform/core/disjoint_sets.h"
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 #include "pointform/spatial/kd_tree.h"
@@ -118,12 +119,16 @@ std::vector<std::uint32_t> isolated_samples(std::span<const Vec3f> positions,
 {
     check_knn_table_shape(neighbors, positions.size(), "isolated_samples");
     const std::size_t n = positions.size();
+    if (n == 0 || neighbors.k < 2)
+        return {};
     constexpr std::size_t block = 65536;
     const std::size_t blocks = (n + block - 1) / block;
-    // An isolated sample's gap to its nearest other is at most its own reach and more than
-    // isolation_factor times the other's, so more than that times the least reach: only samples
-    // whose reach is that long can be isolated (on an evenly sampled surface, none), and only
-    // their rows are read.
+    // Two samples hold together when their gap is at most isolation_factor times the shorter of
+    // their two reaches. A member i of a group of at most k samples has a row entry j outside
+    // the group (the row has k + 1 entries); the link to j is broken although the gap is within
+    // i's own reach, so the gap exceeds the factor times j's reach, and i's reach exceeds the
+    // factor times the least reach. Only samples whose reach is that long can belong to such a
+    // group (on an evenly sampled surface, none), and only their rows are read.
     std::vector<float> least(blocks, std::numeric_limits<float>::infinity());
     parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
         float low = std::numeric_limits<float>::infinity();
@@ -133,24 +138,72 @@ std::vector<std::uint32_t> isolated_samples(std::span<const Vec3f> positions,
     });
     const float factor2 = isolation_factor * isolation_factor;
     const float candidate2 = factor2 * *std::min_element(least.begin(), least.end());
-    return parallel_collect<std::uint32_t>(
+    const std::vector<std::uint32_t> candidates = parallel_collect<std::uint32_t>(
         n, block, [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& out) {
             for (std::size_t i = begin; i < end; ++i)
-            {
-                if (!(neighbors.farthest2(i) > candidate2))
-                    continue;
-                check_knn_row(neighbors, i, n, "isolated_samples");
-                const auto row = neighbors.neighbors(i);
-                // The nearest other sample: the row's first entry that is not i itself.
-                const auto other =
-                    std::find_if(row.begin(), row.end(), [&](std::uint32_t j) { return j != i; });
-                if (other == row.end())
-                    continue;
-                const float gap2 = (positions[*other] - positions[i]).squaredNorm();
-                if (gap2 > factor2 * neighbors.farthest2(*other))
+                if (neighbors.farthest2(i) > candidate2)
                     out.push_back(static_cast<std::uint32_t>(i));
-            }
         });
+    if (candidates.empty())
+        return {};
+    const auto slot_of = [&](std::uint32_t j) {
+        const auto at = std::lower_bound(candidates.begin(), candidates.end(), j);
+        return at != candidates.end() && *at == j
+                   ? static_cast<std::size_t>(at - candidates.begin())
+                   : candidates.size();
+    };
+    // The links of each candidate's row: to a sample that is no candidate (the candidate is then
+    // anchored to the rest), or to another candidate (an edge between their slots).
+    const std::size_t c = candidates.size();
+    std::vector<std::uint8_t> anchored(c, 0);
+    const std::vector<std::pair<std::uint32_t, std::uint32_t>> links =
+        parallel_collect<std::pair<std::uint32_t, std::uint32_t>>(
+            c, 4096,
+            [&](std::size_t begin, std::size_t end,
+                std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) {
+                for (std::size_t s = begin; s < end; ++s)
+                {
+                    const std::uint32_t i = candidates[s];
+                    check_knn_row(neighbors, i, n, "isolated_samples");
+                    const float reach_i = neighbors.farthest2(i);
+                    for (const std::uint32_t j : neighbors.neighbors(i))
+                    {
+                        if (j == i)
+                            continue;
+                        const float gap2 = (positions[j] - positions[i]).squaredNorm();
+                        if (gap2 > factor2 * std::min(reach_i, neighbors.farthest2(j)))
+                            continue;
+                        const std::size_t t = slot_of(j);
+                        if (t == c)
+                            anchored[s] = 1;
+                        else
+                            out.emplace_back(static_cast<std::uint32_t>(s),
+                                             static_cast<std::uint32_t>(t));
+                    }
+                }
+            });
+    DisjointSets groups(c);
+    for (const auto& [s, t] : links)
+        groups.unite(s, t);
+    std::vector<std::uint32_t> members(c, 0);
+    std::vector<std::uint8_t> group_anchored(c, 0);
+    for (std::size_t s = 0; s < c; ++s)
+    {
+        const std::size_t root = groups.find(s);
+        ++members[root];
+        group_anchored[root] |= anchored[s];
+    }
+    // A group of at most twice k samples (the fewest that a field's component needs as support by
+    // default, default_min_component_samples()) that holds to nothing else.
+    const std::size_t largest = 2 * (neighbors.k - 1);
+    std::vector<std::uint32_t> isolated;
+    for (std::size_t s = 0; s < c; ++s)
+    {
+        const std::size_t root = groups.find(s);
+        if (group_anchored[root] == 0 && members[root] <= largest)
+            isolated.push_back(candidates[s]);
+    }
+    return isolated;
 }
 
 RadiusSummary summarize_radii(std::span<const float> radii)

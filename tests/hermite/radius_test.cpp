@@ -97,6 +97,71 @@ TEST(SummarizeRadii, SameAsSortingWhateverTheThreadCount)
     EXPECT_THROW((void)summarize_radii(with_nan), InvalidInput);
 }
 
+/// `count` points of a blob (a cube of half-side `spread`) around `centre`, appended to `points`.
+/// \return the index of the first
+std::uint32_t add_blob(std::vector<Vec3f>& points, const Vec3f& centre, int count, float spread,
+                       std::mt19937& random)
+{
+    std::uniform_real_distribution<float> offset(-spread, spread);
+    const auto first = static_cast<std::uint32_t>(points.size());
+    for (int i = 0; i < count; ++i)
+        points.push_back(centre + Vec3f(offset(random), offset(random), offset(random)));
+    return first;
+}
+
+// Stray returns come alone or in small groups away from the scan (100k samples of the unit
+// sphere; each sample's reach, its distance to its 16th neighbour, is about 0.025). Groups of
+// 1, 5 and 16 samples half a radius off the sphere, whose reach is the gap to the sphere, and
+// one of 32 spread thinly (its reaches long) are isolated; nothing else is: a group of 40 (a
+// component of its own, which the debris filter judges), a dense group of 20 (its own
+// neighbourhoods), a group of 8 within a reach of the surface (noise, held by the sphere), a
+// second sphere sampled 40 times more sparsely (its gaps are many times the first's reaches,
+// but its samples hold each other), and the first sphere itself. The same at 1-3 threads.
+TEST(IsolatedSamples, SmallGroupsAwayFromTheSurface)
+{
+    std::mt19937 random(11);
+    std::normal_distribution<float> gauss;
+    std::vector<Vec3f> points;
+    const auto on_sphere = [&](const Vec3f& centre, int count) {
+        for (int i = 0; i < count; ++i)
+        {
+            const Vec3f d(gauss(random), gauss(random), gauss(random));
+            points.push_back(centre + d.normalized());
+        }
+    };
+    on_sphere(Vec3f::Zero(), 100000);
+    std::vector<std::uint32_t> expected;
+    for (const auto& [where, count] :
+         {std::pair{Vec3f(1.5F, 0.0F, 0.0F), 1}, std::pair{Vec3f(0.0F, 1.5F, 0.0F), 5},
+          std::pair{Vec3f(0.0F, 0.0F, 1.5F), 16}, std::pair{Vec3f(-1.1F, -1.1F, 0.0F), 32}})
+    {
+        const std::uint32_t first =
+            add_blob(points, where, count, count == 32 ? 0.15F : 0.01F, random);
+        for (int i = 0; i < count; ++i)
+            expected.push_back(first + static_cast<std::uint32_t>(i));
+    }
+    add_blob(points, Vec3f(0.0F, 0.0F, -1.6F), 40, 0.15F, random);
+    add_blob(points, Vec3f(-1.6F, 0.0F, 0.0F), 20, 0.01F, random);
+    add_blob(points, Vec3f(0.0F, -1.02F, 0.0F), 8, 0.01F, random);
+    on_sphere(Vec3f(5.0F, 0.0F, 0.0F), 2500);
+
+    const KdTree tree(points);
+    const KnnTable table = knn_batch(tree, points, 17, {.farthest_distance_only = true});
+    const auto runs = test::at_thread_counts([&] { return isolated_samples(points, table); },
+                                             {.min_multi_block_loops = 1});
+    for (const auto& got : runs)
+        EXPECT_EQ(got, expected);
+    // A table of the whole distances gives the same.
+    EXPECT_EQ(isolated_samples(points, knn_batch(tree, points, 17)), expected);
+    // Copies of one point far away (no gap between them, no reach) are not isolated, and a
+    // table that does not fit the points is refused.
+    std::vector<Vec3f> copies(points.begin(), points.begin() + 100000);
+    copies.insert(copies.end(), 20, Vec3f(3.0F, 0.0F, 0.0F));
+    const KdTree copies_tree(copies);
+    EXPECT_TRUE(isolated_samples(copies, knn_batch(copies_tree, copies, 17)).empty());
+    EXPECT_THROW((void)isolated_samples(copies, table), InvalidInput);
+}
+
 TEST(RadiusRegions, BallSetsAndBoxScales)
 {
     const auto regions = parse_radius_regions(R"({"regions": [

@@ -48,19 +48,28 @@ struct RadiusSummary
 /// \throw InvalidInput if radii is empty or holds a NaN
 [[nodiscard]] RadiusSummary summarize_radii(std::span<const float> radii);
 
-/// \brief How many times a neighbour's reach (its distance to its k-th neighbour) a sample's
-/// nearest other sample must be away for the sample to count as isolated (isolated_samples()).
-/// On the scans and shapes of bench/peers and the shipped data (the bunny's range scans, the
-/// kitten, a LiDAR crop, a stereo table scene, noisy CAD parts) the largest ratio is 1.5.
-inline constexpr float isolation_factor = 4.0F;
+/// \brief Two samples hold together (isolated_samples()) when their gap is at most this many
+/// times the shorter of their two reaches (a sample's reach: its distance to its own k-th
+/// neighbour, the farthest of its row). Along a sampled surface the gap to a row's farthest
+/// entry is one reach, and neighbouring reaches differ little: on the scans and shapes of
+/// bench/peers and the shipped data (the bunny's range scans, alone and merged, the kitten, a
+/// LiDAR crop, a stereo table scene, noisy CAD parts, a sphere with one half sampled 100 times
+/// more sparsely than the other) no sample is isolated at this factor.
+inline constexpr float isolation_factor = 2.0F;
 
-/// \brief The samples that lie alone, far from the rest (a scanner's stray return): those whose
-/// nearest other sample is more than isolation_factor times that sample's reach away (its
-/// distance to its own k-th neighbour, the farthest of its row). A surfel made of one such
-/// sample has a radius as large as the gap to the others, and its plane a surface that reaches
-/// that far. In parallel; ascending.
+/// \brief The samples that lie apart from the rest, alone or in a small group (a scanner's
+/// stray returns): the groups of samples that hold together (see isolation_factor), hold to
+/// no other sample, and number at most twice k (the support a component of a reconstruction
+/// needs by default; a group of at most k samples cannot hold a neighbourhood of its own). The
+/// row of such a sample reaches past its group, to the surface: its radius would be as large
+/// as the gap, and its plane, fitted to a few samples, a surface that spans that gap. Only
+/// samples whose reach exceeds isolation_factor times the least reach are looked at, and only
+/// their rows read (on an evenly sampled surface, none): every sample of a group of at most k
+/// is one of them (its link to a row entry past the group is broken although that gap is within
+/// its reach), and a larger group counts only if all its samples are. In parallel; ascending;
+/// the same whatever the thread count.
 /// \param positions  N points
-/// \param neighbors  their N by k table (with each point's own index, as knn_batch() of the
+/// \param neighbors  their N by k + 1 table (with each point's own index, as knn_batch() of the
 ///                   points themselves gives it) and its farthest squared distances
 /// \throw InvalidInput if the table does not fit the points
 [[nodiscard]] std::vector<std::uint32_t> isolated_samples(std::span<const Vec3f> positions,
