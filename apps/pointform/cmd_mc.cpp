@@ -150,7 +150,7 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
                   "% of the diagonal; mean " + format_number(distance.mean) + ")");
     print_timings(timings);
     warn_unoriented(options.input, input.unoriented);
-    warn_isolated(options.input, input.isolated);
+    warn_isolated(options.input, input.isolated, input.copies);
 }
 
 } // namespace

@@ -101,6 +101,7 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
         out["inherited"] = orientation.inherited;
         out["unoriented"] = orientation.unoriented.size();
         out["isolated"] = result.isolated.size();
+        out["copies"] = result.copies.size();
         out["unoriented_indices"] = std::vector<std::uint32_t>(
             orientation.unoriented.begin(),
             orientation.unoriented.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(
@@ -120,6 +121,10 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
     print_row("unoriented", std::to_string(orientation.unoriented.size()));
     print_row("isolated", std::to_string(result.isolated.size()) +
                               (result.isolated.empty() ? "" : " (alone far from the rest; kept)"));
+    print_row("copies", std::to_string(result.copies.size()) +
+                            (result.copies.empty()
+                                 ? ""
+                                 : " (at the place of an earlier sample; its normal and radius)"));
     print_row("radius min/median/max", format_number(radius.min) + " / " +
                                            format_number(radius.median) + " / " +
                                            format_number(radius.max));

@@ -34,8 +34,15 @@ void warn_unoriented(const std::string& path, std::size_t unoriented)
     }
 }
 
-void warn_isolated(const std::string& path, std::size_t isolated)
+void warn_isolated(const std::string& path, std::size_t isolated, std::size_t copies)
 {
+    if (copies > 0)
+    {
+        std::fprintf(stderr,
+                     "pointform: warning: %s: %zu samples at the very place of an earlier sample "
+                     "(repeated coordinates) were merged into it\n",
+                     path.c_str(), copies);
+    }
     if (isolated > 0)
     {
         std::fprintf(stderr,

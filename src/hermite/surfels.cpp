@@ -193,17 +193,51 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
 
     // Work on the points in Morton order, so that neighbours are close in memory; map back at
     // the end. The order depends only on the positions, so results do not depend on threads.
-    const std::vector<std::uint32_t> order = spatial_order(cloud.positions);
+    // Samples at one place are one surfel: the rest is worked out on the distinct places (in
+    // the same order), and every copy takes its original's normal and radius.
+    std::vector<CoincidentCopy> copies;
+    const std::vector<std::uint32_t> order = spatial_order(cloud.positions, copies);
     std::vector<Vec3f> sorted(n);
     parallel_blocks(n, gather_block, [&](std::size_t begin, std::size_t end) {
         for (std::size_t j = begin; j < end; ++j)
             sorted[j] = cloud.positions[order[j]];
     });
-    const std::span<const Vec3f> positions = sorted;
+    std::vector<Vec3f> distinct;
+    std::vector<std::uint32_t> place; // sorted index -> index in `distinct`; empty: no copies
+    if (!copies.empty())
+    {
+        std::vector<std::uint32_t> original(n);
+        for (std::size_t i = 0; i < n; ++i)
+            original[i] = static_cast<std::uint32_t>(i);
+        for (const CoincidentCopy& c : copies)
+            original[c.copy] = c.original;
+        // The places in sorted order: an original's place, taken by its copies.
+        std::vector<std::uint32_t> place_of(n);
+        distinct.reserve(n - copies.size());
+        for (std::size_t j = 0; j < n; ++j)
+            if (original[order[j]] == order[j])
+            {
+                place_of[order[j]] = static_cast<std::uint32_t>(distinct.size());
+                distinct.push_back(sorted[j]);
+            }
+        place.resize(n);
+        for (std::size_t j = 0; j < n; ++j)
+            place[j] = place_of[original[order[j]]];
+        if (distinct.size() <= options.k)
+            throw InvalidInput("only " + std::to_string(distinct.size()) +
+                               " distinct points (the others repeat their coordinates), fewer "
+                               "than k + 1 = " +
+                               std::to_string(options.k + 1));
+        result.copies.reserve(copies.size());
+        for (const CoincidentCopy& c : copies)
+            result.copies.push_back(c.copy);
+    }
     timer.lap("spatial sort");
 
     // Only the k-th distance is needed (radii, the orientation's flux); the tree goes once the
     // table is made.
+    const std::span<const Vec3f> positions =
+        place.empty() ? std::span<const Vec3f>(sorted) : std::span<const Vec3f>(distinct);
     KnnTable table;
     {
         const KdTree tree(positions);
@@ -212,6 +246,7 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
                           {.farthest_distance_only = true, .progress = options.progress});
     }
     timer.lap("knn");
+
     Normals normals = estimate_normals(positions, table, options.progress);
     result.degenerate = normals.degenerate.size();
     timer.lap("normals");
@@ -231,7 +266,7 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
             {
                 OrientedNormals flipped = flip_normals(oriented.normals);
                 oriented.normals = std::move(flipped.normals);
-                oriented.flipped = n - oriented.flipped;
+                oriented.flipped = positions.size() - oriented.flipped;
             }
             break;
         }
@@ -250,8 +285,35 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
 
     std::vector<float> radii = influence_radii(table, options.radius_scale);
     radii = apply_radius_regions(positions, cloud.origin, std::move(radii), options.radius_regions);
-    result.radius = summarize_radii(radii);
     result.isolated = isolated_samples(positions, table);
+    if (!place.empty())
+    {
+        // Back from the places to every sample in sorted order.
+        std::vector<Vec3f> spread_normals(n);
+        std::vector<float> spread_radii(n);
+        std::vector<std::uint8_t> isolated_place(positions.size(), 0);
+        std::vector<std::uint8_t> unoriented_place(positions.size(), 0);
+        for (const std::uint32_t p : result.isolated)
+            isolated_place[p] = 1;
+        for (const std::uint32_t p : oriented.unoriented)
+            unoriented_place[p] = 1;
+        result.isolated.clear();
+        oriented.unoriented.clear();
+        for (std::size_t j = 0; j < n; ++j)
+        {
+            const std::uint32_t p = place[j];
+            spread_normals[j] = oriented.normals[p];
+            spread_radii[j] = radii[p];
+            if (isolated_place[p] != 0)
+                result.isolated.push_back(static_cast<std::uint32_t>(j));
+            if (unoriented_place[p] != 0)
+                oriented.unoriented.push_back(static_cast<std::uint32_t>(j));
+        }
+        oriented.normals = std::move(spread_normals);
+        normals.normals.assign(n, Vec3f::Zero()); // the output's buffer below
+        radii = std::move(spread_radii);
+    }
+    result.radius = summarize_radii(radii);
     for (auto& index : result.isolated)
         index = order[index];
     std::sort(result.isolated.begin(), result.isolated.end());

@@ -9,8 +9,11 @@
 #include "pointform/hermite/surfels.h"
 #include "pointform/metrics/surface_sampling.h"
 #include "pointform/spatial/kd_tree.h"
+#include "pointform/spatial/spatial_sort.h"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <string>
 #include <utility>
 
@@ -78,8 +81,14 @@ SurfelsFromSamples surfels_from_samples(const PointCloudView& samples,
         out.flipped = result.orientation.flipped;
         out.degenerate = result.degenerate;
         out.unoriented = result.orientation.unoriented.size();
-        // The isolated samples first (their indices are the input's), then the unoriented.
-        out.isolated = drop_samples(out.surfels, result.isolated);
+        // The isolated samples and the copies first (their indices are the input's), then the
+        // unoriented.
+        std::vector<std::uint32_t> left_out;
+        std::set_union(result.isolated.begin(), result.isolated.end(), result.copies.begin(),
+                       result.copies.end(), std::back_inserter(left_out));
+        out.copies = result.copies.size();
+        out.isolated = result.isolated.size();
+        drop_samples(out.surfels, left_out);
         drop_unoriented(out.surfels);
         return out;
     }
@@ -94,6 +103,21 @@ SurfelsFromSamples surfels_from_samples(const PointCloudView& samples,
                            "normals again (--reestimate)");
     if (!surfels.has_radii())
     {
+        // Samples at one place are one surfel (the first of them, with its normal).
+        std::vector<CoincidentCopy> found;
+        (void)spatial_order(surfels.positions, found);
+        if (!found.empty())
+        {
+            std::vector<std::uint32_t> copies(found.size());
+            for (std::size_t c = 0; c < found.size(); ++c)
+                copies[c] = found[c].copy;
+            out.copies = drop_samples(surfels, copies);
+            if (surfels.size() <= options.k)
+                throw InvalidInput("only " + std::to_string(surfels.size()) +
+                                   " distinct samples with usable normals (the others repeat "
+                                   "their coordinates), fewer than k + 1 = " +
+                                   std::to_string(options.k + 1));
+        }
         const KnnTable reach = reach_table(surfels, options.k);
         surfels.radii = apply_radius_regions(surfels.positions, surfels.origin,
                                              influence_radii(reach, options.radius_scale),

@@ -98,7 +98,8 @@ nlohmann::json report_json(const SurfelsFromSamples& surfels)
             {"flipped", surfels.flipped},
             {"degenerate", surfels.degenerate},
             {"unoriented", surfels.unoriented},
-            {"isolated", surfels.isolated}};
+            {"isolated", surfels.isolated},
+            {"copies", surfels.copies}};
 }
 
 nlohmann::json report_json(const RefineLevelStats& s, double diagonal)

@@ -234,23 +234,16 @@ void refine_run(std::span<const Vec3f> positions, std::span<Keyed> run)
     });
 }
 
-/// refine_run() on every run of more than refine_above equal keys of `sorted`, in parallel. The
-/// keys of those runs are overwritten (only the order is kept).
-void refine_cells(std::span<const Vec3f> positions, std::span<Keyed> sorted)
+/// refine_run() on every run of `runs` (ranges of equal keys of `sorted`) of more than
+/// refine_above, in parallel. The keys of those runs are overwritten (only the order is kept).
+void refine_cells(std::span<const Vec3f> positions, std::span<Keyed> sorted,
+                  std::span<const std::pair<std::size_t, std::size_t>> runs)
 {
-    // The runs that start in each block (and may end past it), found at once.
-    const std::vector<std::pair<std::size_t, std::size_t>> runs =
-        parallel_collect<std::pair<std::size_t, std::size_t>>(
-            sorted.size(), std::size_t{1} << 18U,
-            [&](std::size_t first, std::size_t last,
-                std::vector<std::pair<std::size_t, std::size_t>>& out) {
-                for_each_crowded_run(sorted, first, last, [&](std::size_t begin, std::size_t end) {
-                    out.emplace_back(begin, end);
-                });
-            });
     parallel_blocks(runs.size(), 1, [&](std::size_t first, std::size_t last) {
         for (std::size_t r = first; r < last; ++r)
-            refine_run(positions, sorted.subspan(runs[r].first, runs[r].second - runs[r].first));
+            if (runs[r].second - runs[r].first > refine_above)
+                refine_run(positions,
+                           sorted.subspan(runs[r].first, runs[r].second - runs[r].first));
     });
 }
 
@@ -308,11 +301,73 @@ void morton_keys(std::span<const Vec3f> positions, std::span<std::uint64_t> keys
     for_each_key(positions, [&](std::size_t i, std::uint64_t key) { keys[i] = key; });
 }
 
-std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions)
+namespace {
+
+/// The runs of two or more equal keys of `sorted`, as [begin, end) ranges, in order.
+std::vector<std::pair<std::size_t, std::size_t>> shared_key_runs(std::span<const Keyed> sorted)
+{
+    return parallel_collect<std::pair<std::size_t, std::size_t>>(
+        sorted.size(), std::size_t{1} << 18U,
+        [&](std::size_t first, std::size_t last,
+            std::vector<std::pair<std::size_t, std::size_t>>& out) {
+            std::size_t begin = first;
+            while (begin < last && begin > 0 && sorted[begin].key == sorted[begin - 1].key)
+                ++begin;
+            while (begin < last)
+            {
+                std::size_t end = begin + 1;
+                while (end < sorted.size() && sorted[end].key == sorted[begin].key)
+                    ++end;
+                if (end - begin > 1)
+                    out.emplace_back(begin, end);
+                begin = end;
+            }
+        });
+}
+
+/// The copies among the points of the runs (each a range of `sorted`, whatever order the
+/// refinement left inside it): the points of a run ordered by their coordinates, ties by index.
+std::vector<CoincidentCopy> copies_in_runs(
+    std::span<const Vec3f> positions, std::span<const Keyed> sorted,
+    std::span<const std::pair<std::size_t, std::size_t>> runs)
+{
+    std::vector<CoincidentCopy> copies = parallel_collect<CoincidentCopy>(
+        runs.size(), 64,
+        [&](std::size_t first, std::size_t last, std::vector<CoincidentCopy>& out) {
+            std::vector<std::uint32_t> members;
+            for (std::size_t r = first; r < last; ++r)
+            {
+                members.clear();
+                for (std::size_t j = runs[r].first; j < runs[r].second; ++j)
+                    members.push_back(sorted[j].index);
+                std::sort(members.begin(), members.end(), [&](std::uint32_t a, std::uint32_t b) {
+                    const Vec3f& p = positions[a];
+                    const Vec3f& q = positions[b];
+                    return std::tie(p.x(), p.y(), p.z(), a) < std::tie(q.x(), q.y(), q.z(), b);
+                });
+                std::size_t group = 0;
+                for (std::size_t m = 1; m < members.size(); ++m)
+                {
+                    if (positions[members[m]] != positions[members[group]])
+                        group = m;
+                    else
+                        out.push_back({.copy = members[m], .original = members[group]});
+                }
+            }
+        });
+    std::sort(copies.begin(), copies.end(),
+              [](const CoincidentCopy& a, const CoincidentCopy& b) { return a.copy < b.copy; });
+    return copies;
+}
+
+std::vector<std::uint32_t> order_points(std::span<const Vec3f> positions,
+                                        std::vector<CoincidentCopy>* copies)
 {
     // (Morton key, index) pairs: sorting them orders by key, ties by original index.
     const std::size_t n = positions.size();
     std::vector<std::uint32_t> order(n);
+    if (copies != nullptr)
+        copies->clear();
     if (n == 0)
         return order;
     // NOLINTNEXTLINE(cppcoreguidelines-owning-memory): not initialised, every entry is written
@@ -321,12 +376,30 @@ std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions)
         keyed[i] = {key, static_cast<std::uint32_t>(i)};
     });
     keyed = bucket_sort(std::move(keyed), n); // keys paired with their index: a strict order
-    refine_cells(positions, {keyed.get(), n});
+    // The runs of equal keys: the crowded ones are ordered again (refine_cells(), only inside
+    // each run), and points at one place share a key, so only runs can hold copies.
+    const std::vector<std::pair<std::size_t, std::size_t>> runs = shared_key_runs({keyed.get(), n});
+    refine_cells(positions, {keyed.get(), n}, runs);
+    if (copies != nullptr && !runs.empty())
+        *copies = copies_in_runs(positions, {keyed.get(), n}, runs);
     parallel_blocks(n, 1U << 16U, [&](std::size_t begin, std::size_t end) {
         for (std::size_t j = begin; j < end; ++j)
             order[j] = keyed[j].index;
     });
     return order;
+}
+
+} // namespace
+
+std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions)
+{
+    return order_points(positions, nullptr);
+}
+
+std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions,
+                                         std::vector<CoincidentCopy>& copies)
+{
+    return order_points(positions, &copies);
 }
 
 } // namespace pointform

@@ -31,7 +31,8 @@ double outward_share(const PointCloud& cloud, double degrees)
 
 // One stray return far from a scan (here 10^6 radii off a unit sphere) gets the gap to the
 // others as its radius and a plane of its own: it is left out, whether the normals are
-// estimated or given, and counted. Copies of one point (no gap) and a clean sphere lose nothing.
+// estimated or given, and counted. Copies of one point (no gap) are not isolated (they are one
+// surfel, with their original), and a clean sphere loses nothing.
 TEST(SurfelsFromSamples, AStrayPointFarAwayIsLeftOut)
 {
     PointCloud points = sample_shape(Shape::Sphere, {.count = 20000, .seed = 23});
@@ -46,7 +47,8 @@ TEST(SurfelsFromSamples, AStrayPointFarAwayIsLeftOut)
         const SurfelsFromSamples out = surfels_from_samples(points, {.reestimate = estimate});
         EXPECT_EQ(out.estimated_normals, estimate);
         EXPECT_EQ(out.isolated, 1U) << "estimated " << estimate;
-        ASSERT_EQ(out.surfels.size(), kept);
+        EXPECT_EQ(out.copies, 30U) << "estimated " << estimate; // one surfel a place
+        ASSERT_EQ(out.surfels.size(), kept - 30);
         for (std::size_t i = 0; i < out.surfels.size(); ++i)
         {
             ASSERT_LT(out.surfels.positions[i].norm(), 1.001F) << i;
@@ -59,6 +61,34 @@ TEST(SurfelsFromSamples, AStrayPointFarAwayIsLeftOut)
     const SurfelResult result = compute_surfels(clean);
     EXPECT_TRUE(result.isolated.empty());
     EXPECT_EQ(surfels_from_samples(clean).isolated, 0U);
+}
+
+// A field has one surfel a place: copies of samples (here every sample twice, and one 40
+// times) are left out and counted, whether the normals are estimated or given.
+TEST(SurfelsFromSamples, CopiesAreOneSurfel)
+{
+    PointCloud points = sample_shape(Shape::Sphere, {.count = 5000, .seed = 25});
+    points.radii.clear();
+    const std::size_t distinct = points.size();
+    for (std::size_t i = 0; i < distinct; ++i)
+    {
+        points.positions.push_back(points.positions[i]);
+        points.normals.push_back(points.normals[i]);
+    }
+    points.positions.insert(points.positions.end(), 39, points.positions[17]);
+    points.normals.insert(points.normals.end(), 39, points.normals[17]);
+    for (const bool estimate : {true, false})
+    {
+        const SurfelsFromSamples out = surfels_from_samples(points, {.reestimate = estimate});
+        EXPECT_EQ(out.copies, distinct + 39) << "estimated " << estimate;
+        EXPECT_EQ(out.isolated, 0U);
+        ASSERT_EQ(out.surfels.size(), distinct);
+        for (std::size_t i = 0; i < distinct; ++i)
+        {
+            ASSERT_EQ(out.surfels.positions[i], points.positions[i]) << i;
+            ASSERT_GT(out.surfels.radii[i], 0.0F) << i;
+        }
+    }
 }
 
 TEST(SurfelsFromSamples, RawPointsGetOrientedNormalsAndFieldRadii)

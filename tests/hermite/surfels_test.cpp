@@ -158,6 +158,41 @@ TEST(ComputeSurfels, AFarOutlierDoesNotMakeASurfaceALine)
     EXPECT_THROW((void)compute_surfels(line), InvalidInput);
 }
 
+// Samples repeated at one place (every sample of a sphere 20 times over, more than a row of
+// neighbours: each sample's k nearest were all its own copies, with no reach and no plane):
+// the surfels are worked out once a place, and every copy has its original's. The same normals
+// (within float rounding) and radii as the sphere without copies; the copies are named in input
+// order, the first of each place being the original. Too few distinct places is an error.
+TEST(ComputeSurfels, CopiesShareTheirOriginalsSurfel)
+{
+    PointCloud sphere = sample_shape(Shape::Sphere, {.count = 3000, .seed = 41});
+    sphere.normals.clear();
+    sphere.radii.clear();
+    PointCloud repeated;
+    for (int copy = 0; copy < 20; ++copy)
+        repeated.positions.insert(repeated.positions.end(), sphere.positions.begin(),
+                                  sphere.positions.end());
+    const SurfelResult plain = compute_surfels(sphere);
+    const SurfelResult result = compute_surfels(repeated);
+    EXPECT_TRUE(plain.copies.empty());
+    ASSERT_EQ(result.copies.size(), 19U * 3000U);
+    EXPECT_EQ(result.copies.front(), 3000U);
+    EXPECT_EQ(result.copies.back(), 20U * 3000U - 1U);
+    EXPECT_EQ(result.orientation.unoriented.size(), 0U);
+    EXPECT_EQ(result.degenerate, 0U);
+    for (std::size_t i = 0; i < repeated.size(); ++i)
+    {
+        const std::size_t j = i % 3000;
+        ASSERT_GT(result.surfels.normals[i].dot(plain.surfels.normals[j]), 0.9999F) << i;
+        ASSERT_FLOAT_EQ(result.surfels.radii[i], plain.surfels.radii[j]) << i;
+    }
+    PointCloud few;
+    for (int copy = 0; copy < 3; ++copy)
+        few.positions.insert(few.positions.end(), sphere.positions.begin(),
+                             sphere.positions.begin() + 10);
+    EXPECT_THROW((void)compute_surfels(few), InvalidInput);
+}
+
 TEST(ComputeSurfels, RejectsBadInput)
 {
     PointCloud cloud = sample_shape(Shape::Sphere, {.count = 100, .seed = 13});

@@ -120,6 +120,31 @@ TEST(Reconstruct, ClustersOfStraysDoNotSpoilTheSurface)
     EXPECT_LT(sphere_error(finest), report.semi_regular.refinement.sampling_density);
 }
 
+// Coordinates quantized by a scanner or a file format (here a sphere's 30k samples rounded to a
+// grid of 0.03 of its radius, about the samples' spacing): many samples fall on one place, and
+// a place with more samples than a row had neighbours of no reach and a radius of 0 ("the cloud
+// has no samples"). Each place is one surfel, and the sphere comes out closed, in one piece,
+// within the rounding of the truth.
+TEST(Reconstruct, QuantizedCoordinatesGiveTheSurface)
+{
+    PointCloud points = sample_shape(Shape::Sphere, {.count = 30000, .seed = 33});
+    points.normals.clear();
+    points.radii.clear();
+    constexpr float step = 0.03F;
+    for (Vec3f& p : points.positions)
+        p = (p / step).array().round().matrix() * step;
+    const SurfelsFromSamples surfels = surfels_from_samples(points);
+    EXPECT_GT(surfels.copies, 1000U);
+    const ReconstructReport report = reconstruct(surfels.surfels);
+    const MultiresMesh& hierarchy = report.semi_regular.hierarchy;
+    const TriMesh finest = hierarchy.level_mesh(hierarchy.finest_level());
+    const MeshTopology topo = analyze_topology(finest);
+    EXPECT_TRUE(topo.is_closed());
+    EXPECT_EQ(topo.euler_characteristic, 2);
+    EXPECT_EQ(topo.components, 1U);
+    EXPECT_LT(sphere_error(finest), step);
+}
+
 TEST(Reconstruct, ExactLevelsAndTheBaseFaceTarget)
 {
     ReconstructOptions options;

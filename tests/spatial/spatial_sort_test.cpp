@@ -122,4 +122,60 @@ TEST(SpatialOrder, AFarOutlierLeavesNeighboursClose)
 }
 
 } // namespace
+
+// Copies of samples, as a scan merged with itself or coordinates quantized by a file format
+// leave them: every copy is named with the first sample at its place, whether a place holds two
+// samples or 40 (spread through the cloud), and the order is spatial_order()'s. -0 and +0 are
+// one place. A cloud without copies has none. 150k points, so that the passes run in several
+// blocks: the same at 1-3 threads.
+TEST(SpatialOrder, CopiesWithTheFirstSampleAtTheirPlace)
+{
+    std::mt19937 random(3);
+    std::uniform_real_distribution<float> unit(0.0F, 1.0F);
+    std::vector<Vec3f> points(150000);
+    for (auto& p : points)
+        p = Vec3f(unit(random), unit(random), unit(random));
+    std::vector<CoincidentCopy> none{{1, 0}};
+    EXPECT_EQ(spatial_order(points, none), spatial_order(points));
+    EXPECT_TRUE(none.empty());
+
+    std::vector<CoincidentCopy> expected;
+    // A second copy of every 1000th point, at the end.
+    for (std::uint32_t i = 0; i < 150000; i += 1000)
+    {
+        expected.push_back({static_cast<std::uint32_t>(points.size()), i});
+        points.push_back(points[i]);
+    }
+    // 40 copies of point 7, spread through the cloud (overwriting points there).
+    for (std::uint32_t c = 1; c <= 40; ++c)
+    {
+        const std::uint32_t at = 3000 * c + 1;
+        points[at] = points[7];
+        expected.push_back({at, 7});
+    }
+    // A point at the origin with signed zeros.
+    points[9] = Vec3f(0.0F, 0.0F, 0.0F);
+    points[11] = Vec3f(-0.0F, 0.0F, -0.0F);
+    expected.push_back({11, 9});
+    std::sort(expected.begin(), expected.end(),
+              [](const CoincidentCopy& a, const CoincidentCopy& b) { return a.copy < b.copy; });
+    const auto runs = test::at_thread_counts(
+        [&] {
+            std::vector<CoincidentCopy> copies;
+            std::vector<std::uint32_t> order = spatial_order(points, copies);
+            return std::pair{order, copies};
+        },
+        {.min_multi_block_loops = 1});
+    for (const auto& [order, copies] : runs)
+    {
+        EXPECT_EQ(order, spatial_order(points));
+        ASSERT_EQ(copies.size(), expected.size());
+        for (std::size_t c = 0; c < copies.size(); ++c)
+        {
+            EXPECT_EQ(copies[c].copy, expected[c].copy) << c;
+            EXPECT_EQ(copies[c].original, expected[c].original) << c;
+        }
+    }
+}
+
 } // namespace pointform

@@ -66,8 +66,12 @@ struct SurfelResult
     /// The samples that lie alone far from the rest (isolated_samples()), ascending input
     /// indices: their surfels are kept here; surfels_from_samples() leaves them out.
     std::vector<std::uint32_t> isolated;
-    /// Wall-clock seconds by stage, in order: "check", "spatial sort", "kd-tree", "knn",
-    /// "normals", "orientation", "radius", "output order" (back to the input's order).
+    /// The samples at the very place of an earlier one (spatial_order()), ascending input
+    /// indices: the surfels are computed once a place, and each copy has its original's normal
+    /// and radius; surfels_from_samples() leaves the copies out.
+    std::vector<std::uint32_t> copies;
+    /// Wall-clock seconds by stage, in order: "check", "spatial sort" (with the copies), "kd-tree",
+    /// "knn", "normals", "orientation", "radius", "output order" (back to the input's order).
     std::vector<std::pair<std::string, double>> stage_seconds;
 };
 
@@ -122,6 +126,9 @@ struct SurfelsFromSamples
     /// Samples left out because they lie alone far from the rest (isolated_samples(); only
     /// where radii were computed here).
     std::size_t isolated = 0;
+    /// Samples left out because an earlier sample lies at the very same place
+    /// (spatial_order(); where normals or radii were computed here): a place is one surfel.
+    std::size_t copies = 0;
 };
 
 /// \brief Samples of any kind to the surfels of a field (Level 1 or 2 → 2): raw points get

@@ -22,6 +22,22 @@ namespace pointform {
 ///         their original order, so the result is deterministic
 [[nodiscard]] std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions);
 
+/// \brief A sample at the very place of an earlier one (the same coordinates), and the earliest
+/// sample at that place.
+struct CoincidentCopy
+{
+    std::uint32_t copy = 0;     ///< the later sample
+    std::uint32_t original = 0; ///< the first sample at its place, < copy
+};
+
+/// \brief spatial_order(), and the samples that repeat an earlier sample's coordinates exactly
+/// (a scan merged with itself, coordinates quantized by the scanner or the file format), each
+/// with the first sample at its place, ascending by copy. Samples at one place share a key, so
+/// only the runs of equal keys are compared (on a cloud without copies, a few pairs), in
+/// parallel; the same whatever the thread count.
+[[nodiscard]] std::vector<std::uint32_t> spatial_order(std::span<const Vec3f> positions,
+                                                       std::vector<CoincidentCopy>& copies);
+
 /// \brief The key spatial_order() sorts each point by: its cell of a grid of 2^21 cells an axis
 /// over the points' bounding box (cubic cells, the largest extent's), the cell's coordinates'
 /// bits interleaved from the top, z y x at each level (bit 3l + a is bit l of axis a). Points in
