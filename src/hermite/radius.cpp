@@ -114,6 +114,14 @@ std::vector<float> influence_radii(const KnnTable& neighbors, double scale)
     return radii;
 }
 
+namespace {
+
+/// Isolated groups that hold together at their own spacing in a whole of more samples than this
+/// are a sparsely sampled sheet, not strays (isolated_samples()).
+constexpr std::size_t sheet_samples = 128;
+
+} // namespace
+
 std::vector<std::uint32_t> isolated_samples(std::span<const Vec3f> positions,
                                             const KnnTable& neighbors)
 {
@@ -126,9 +134,12 @@ std::vector<std::uint32_t> isolated_samples(std::span<const Vec3f> positions,
     // Two samples hold together when their gap is at most isolation_factor times the shorter of
     // their two reaches. A member i of a group of at most k samples has a row entry j outside
     // the group (the row has k + 1 entries); the link to j is broken although the gap is within
-    // i's own reach, so the gap exceeds the factor times j's reach, and i's reach exceeds the
-    // factor times the least reach. Only samples whose reach is that long can belong to such a
-    // group (on an evenly sampled surface, none), and only their rows are read.
+    // i's own reach, so the gap exceeds the factor times j's reach, and so does i's reach: only
+    // samples whose reach exceeds the factor times the shortest reach in their row can belong to
+    // such a group. Their rows are read only where the reach exceeds twice that factor times the
+    // least reach of all: a stray's reach spans its gap to the surface, and on an evenly sampled
+    // surface no reach is that long, so the pass costs one read a sample (at 10M samples, the
+    // factor alone let most samples through).
     std::vector<float> least(blocks, std::numeric_limits<float>::infinity());
     parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
         float low = std::numeric_limits<float>::infinity();
@@ -137,12 +148,21 @@ std::vector<std::uint32_t> isolated_samples(std::span<const Vec3f> positions,
         least[begin / block] = low;
     });
     const float factor2 = isolation_factor * isolation_factor;
-    const float candidate2 = factor2 * *std::min_element(least.begin(), least.end());
+    const float long2 = 4.0F * factor2 * *std::min_element(least.begin(), least.end());
     const std::vector<std::uint32_t> candidates = parallel_collect<std::uint32_t>(
         n, block, [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& out) {
             for (std::size_t i = begin; i < end; ++i)
-                if (neighbors.farthest2(i) > candidate2)
+            {
+                const float reach2 = neighbors.farthest2(i);
+                if (!(reach2 > long2))
+                    continue;
+                check_knn_row(neighbors, i, n, "isolated_samples");
+                const auto row = neighbors.neighbors(i);
+                if (std::any_of(row.begin(), row.end(), [&](std::uint32_t j) {
+                        return j != i && reach2 > factor2 * neighbors.farthest2(j);
+                    }))
                     out.push_back(static_cast<std::uint32_t>(i));
+            }
         });
     if (candidates.empty())
         return {};
@@ -164,7 +184,6 @@ std::vector<std::uint32_t> isolated_samples(std::span<const Vec3f> positions,
                 for (std::size_t s = begin; s < end; ++s)
                 {
                     const std::uint32_t i = candidates[s];
-                    check_knn_row(neighbors, i, n, "isolated_samples");
                     const float reach_i = neighbors.farthest2(i);
                     for (const std::uint32_t j : neighbors.neighbors(i))
                     {
@@ -193,16 +212,49 @@ std::vector<std::uint32_t> isolated_samples(std::span<const Vec3f> positions,
         ++members[root];
         group_anchored[root] |= anchored[s];
     }
-    // A group of at most twice k samples (the fewest that a field's component needs as support by
-    // default, default_min_component_samples()) that holds to nothing else.
-    const std::size_t largest = 2 * (neighbors.k - 1);
-    std::vector<std::uint32_t> isolated;
+    // A group that cannot hold a neighbourhood of its own (at most k samples, k + 1 with the
+    // sample itself in each row) and holds to nothing else.
+    const std::size_t largest = neighbors.k - 1;
+    std::vector<std::uint8_t> stray(c, 0);
     for (std::size_t s = 0; s < c; ++s)
     {
         const std::size_t root = groups.find(s);
-        if (group_anchored[root] == 0 && members[root] <= largest)
-            isolated.push_back(candidates[s]);
+        stray[s] = group_anchored[root] == 0 && members[root] <= largest ? 1 : 0;
     }
+    // Unless it is part of a sheet: a sheet sampled sparsely beside a dense one (the far face of
+    // a thin part scanned from one side) has rows full of the dense sheet's samples, which its
+    // links cannot reach, and its samples hold each other only at their own spacing. Such
+    // samples hold together when their gap is at most the factor times the shorter of their
+    // spacings among themselves (the distance to the seventh nearest other); a sheet makes a
+    // large whole of them, stray groups a few of them at most.
+    std::vector<std::uint32_t> strays;
+    for (std::size_t s = 0; s < c; ++s)
+        if (stray[s] != 0)
+            strays.push_back(static_cast<std::uint32_t>(s));
+    if (strays.size() > largest)
+    {
+        std::vector<Vec3f> at(strays.size());
+        for (std::size_t u = 0; u < strays.size(); ++u)
+            at[u] = positions[candidates[strays[u]]];
+        const KdTree tree(at);
+        const KnnTable near = knn_batch(tree, at, std::min<std::size_t>(8, strays.size()));
+        DisjointSets wholes(strays.size());
+        for (std::size_t u = 0; u < strays.size(); ++u)
+            for (const std::uint32_t w : near.neighbors(u))
+                if (w != u && (at[w] - at[u]).squaredNorm() <=
+                                  factor2 * std::min(near.farthest2(u), near.farthest2(w)))
+                    wholes.unite(u, w);
+        std::vector<std::uint32_t> size(strays.size(), 0);
+        for (std::size_t u = 0; u < strays.size(); ++u)
+            ++size[wholes.find(u)];
+        for (std::size_t u = 0; u < strays.size(); ++u)
+            if (size[wholes.find(u)] > sheet_samples)
+                stray[strays[u]] = 0;
+    }
+    std::vector<std::uint32_t> isolated;
+    for (std::size_t s = 0; s < c; ++s)
+        if (stray[s] != 0)
+            isolated.push_back(candidates[s]);
     return isolated;
 }
 

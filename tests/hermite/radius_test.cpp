@@ -111,10 +111,12 @@ std::uint32_t add_blob(std::vector<Vec3f>& points, const Vec3f& centre, int coun
 
 // Stray returns come alone or in small groups away from the scan (100k samples of the unit
 // sphere; each sample's reach, its distance to its 16th neighbour, is about 0.025). Groups of
-// 1, 5 and 16 samples half a radius off the sphere, whose reach is the gap to the sphere, and
-// one of 32 spread thinly (its reaches long) are isolated; nothing else is: a group of 40 (a
-// component of its own, which the debris filter judges), a dense group of 20 (its own
-// neighbourhoods), a group of 8 within a reach of the surface (noise, held by the sphere), a
+// 1, 5 and 16 samples half a radius off the sphere, whose reach is the gap to the sphere, are
+// isolated; nothing else is: groups of 32 and 40 spread thinly and a dense group of 20 (each
+// holds neighbourhoods of its own: a component of the field, which the debris filter
+// judges), a group of 8 within a reach of the surface (noise, held by the sphere), the sparse
+// far face of a thin plate (each of its rows holds only the dense face's samples, but its
+// samples hold each other at their own spacing), a
 // second sphere sampled 40 times more sparsely (its gaps are many times the first's reaches,
 // but its samples hold each other), and the first sphere itself. The same at 1-3 threads.
 TEST(IsolatedSamples, SmallGroupsAwayFromTheSurface)
@@ -133,17 +135,24 @@ TEST(IsolatedSamples, SmallGroupsAwayFromTheSurface)
     std::vector<std::uint32_t> expected;
     for (const auto& [where, count] :
          {std::pair{Vec3f(1.5F, 0.0F, 0.0F), 1}, std::pair{Vec3f(0.0F, 1.5F, 0.0F), 5},
-          std::pair{Vec3f(0.0F, 0.0F, 1.5F), 16}, std::pair{Vec3f(-1.1F, -1.1F, 0.0F), 32}})
+          std::pair{Vec3f(0.0F, 0.0F, 1.5F), 16}})
     {
-        const std::uint32_t first =
-            add_blob(points, where, count, count == 32 ? 0.15F : 0.01F, random);
+        const std::uint32_t first = add_blob(points, where, count, 0.01F, random);
         for (int i = 0; i < count; ++i)
             expected.push_back(first + static_cast<std::uint32_t>(i));
     }
+    add_blob(points, Vec3f(-1.1F, -1.1F, 0.0F), 32, 0.15F, random);
     add_blob(points, Vec3f(0.0F, 0.0F, -1.6F), 40, 0.15F, random);
     add_blob(points, Vec3f(-1.6F, 0.0F, 0.0F), 20, 0.01F, random);
     add_blob(points, Vec3f(0.0F, -1.02F, 0.0F), 8, 0.01F, random);
     on_sphere(Vec3f(5.0F, 0.0F, 0.0F), 2500);
+    // A thin plate scanned from one side: a dense face, and its far face 0.1 away sampled 100
+    // times more sparsely, whose rows hold only the dense face's samples.
+    std::uniform_real_distribution<float> side(0.0F, 2.0F);
+    for (int i = 0; i < 40000; ++i)
+        points.emplace_back(side(random), side(random) + 3.0F, 0.0F);
+    for (int i = 0; i < 400; ++i)
+        points.emplace_back(side(random), side(random) + 3.0F, 0.1F);
 
     const KdTree tree(points);
     const KnnTable table = knn_batch(tree, points, 17, {.farthest_distance_only = true});

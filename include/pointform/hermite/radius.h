@@ -58,16 +58,22 @@ struct RadiusSummary
 inline constexpr float isolation_factor = 2.0F;
 
 /// \brief The samples that lie apart from the rest, alone or in a small group (a scanner's
-/// stray returns): the groups of samples that hold together (see isolation_factor), hold to
-/// no other sample, and number at most twice k (the support a component of a reconstruction
-/// needs by default; a group of at most k samples cannot hold a neighbourhood of its own). The
-/// row of such a sample reaches past its group, to the surface: its radius would be as large
-/// as the gap, and its plane, fitted to a few samples, a surface that spans that gap. Only
-/// samples whose reach exceeds isolation_factor times the least reach are looked at, and only
-/// their rows read (on an evenly sampled surface, none): every sample of a group of at most k
-/// is one of them (its link to a row entry past the group is broken although that gap is within
-/// its reach), and a larger group counts only if all its samples are. In parallel; ascending;
-/// the same whatever the thread count.
+/// stray returns): the groups of at most k samples (too few to hold a neighbourhood of their
+/// own) that hold together (see isolation_factor) and hold to no other sample. The row of such
+/// a sample reaches past its group, to the surface: its radius would be as large as the gap,
+/// and its plane, fitted to a few samples, a surface that spans that gap. Every sample of such
+/// a group has a reach longer than isolation_factor times the shortest reach in its row (its
+/// link to a row entry past the group is broken although that gap is within its own reach);
+/// rows are read only where a reach also exceeds twice that factor times the least reach of
+/// all samples (a stray's reach spans its gap; on an evenly sampled surface no reach is that
+/// long, so the pass costs one read a sample). A group closer to the surface than that is left
+/// to the field's fits, as noise. Unless such groups are part of a sheet: the far face of a thin
+/// part scanned from one side, sampled 100 times more sparsely than the near face 0.1 away, has
+/// rows full of the near face's samples, which its samples' links cannot reach. The samples of
+/// all such groups hold together when their gap is at most isolation_factor times the shorter
+/// of their spacings among themselves (the distance to the seventh nearest of them), and those
+/// in a whole of more than 128 are a sheet, not strays (stray groups apart from each other make
+/// wholes of a few groups at most). In parallel; ascending; the same whatever the thread count.
 /// \param positions  N points
 /// \param neighbors  their N by k + 1 table (with each point's own index, as knn_batch() of the
 ///                   points themselves gives it) and its farthest squared distances
