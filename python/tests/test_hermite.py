@@ -37,6 +37,20 @@ def test_given_normals_are_kept_and_unusable_ones_dropped():
     assert np.min(np.sum(again.normals * again.world(), axis=1)) > 0.9  # outward, not -p
 
 
+def test_repeated_and_stray_samples_are_left_out_and_counted():
+    # Every sample of a sphere three times over (a scan merged with itself): one surfel a place.
+    # A cluster of 5 strays half a radius off it: left out as isolated.
+    p = sphere_points(2000)
+    rng = np.random.default_rng(4)
+    strays = np.array([1.5, 0.0, 0.0]) + 0.01 * rng.standard_normal((5, 3))
+    cloud = pointform.PointCloud(np.vstack([p, p, p, strays]))
+    surfels, report = pointform.surfels(cloud)
+    assert report["copies"] == 4000 and report["isolated"] == 5
+    assert len(surfels) == 2000
+    assert np.array_equal(surfels.positions, cloud.positions[:2000])
+    assert np.all(surfels.radii > 0)
+
+
 def test_surfels_are_bit_for_bit_the_clis(tmp_path, bunny_points):
     out = tmp_path / "surfels.ply"
     run_cli("normals", BUNNY_SCAN, "-o", out, "--radius-scale", 1.0, "-q")

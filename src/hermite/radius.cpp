@@ -136,10 +136,8 @@ std::vector<std::uint32_t> isolated_samples(std::span<const Vec3f> positions,
     // the group (the row has k + 1 entries); the link to j is broken although the gap is within
     // i's own reach, so the gap exceeds the factor times j's reach, and so does i's reach: only
     // samples whose reach exceeds the factor times the shortest reach in their row can belong to
-    // such a group. Their rows are read only where the reach exceeds twice that factor times the
-    // least reach of all: a stray's reach spans its gap to the surface, and on an evenly sampled
-    // surface no reach is that long, so the pass costs one read a sample (at 10M samples, the
-    // factor alone let most samples through).
+    // such a group, and only rows of samples whose reach exceeds the factor times the least
+    // reach of all are read.
     std::vector<float> least(blocks, std::numeric_limits<float>::infinity());
     parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
         float low = std::numeric_limits<float>::infinity();
@@ -148,7 +146,7 @@ std::vector<std::uint32_t> isolated_samples(std::span<const Vec3f> positions,
         least[begin / block] = low;
     });
     const float factor2 = isolation_factor * isolation_factor;
-    const float long2 = 4.0F * factor2 * *std::min_element(least.begin(), least.end());
+    const float long2 = factor2 * *std::min_element(least.begin(), least.end());
     const std::vector<std::uint32_t> candidates = parallel_collect<std::uint32_t>(
         n, block, [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& out) {
             for (std::size_t i = begin; i < end; ++i)
