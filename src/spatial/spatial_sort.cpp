@@ -195,11 +195,11 @@ void for_each_key(std::span<const Vec3f> positions, const Use& use)
 /// by keys over their own box (refine_run()).
 constexpr std::size_t refine_above = 16;
 
-/// Calls `use(begin, end)` for every run of more than refine_above equal keys of `sorted` that
+/// Calls `use(begin, end)` for every run of more than `above` equal keys of `sorted` that
 /// starts in [from, to) (it may end past `to`).
 template <typename Use>
-void for_each_crowded_run(std::span<const Keyed> sorted, std::size_t from, std::size_t to,
-                          const Use& use)
+void for_each_run(std::span<const Keyed> sorted, std::size_t from, std::size_t to,
+                  std::size_t above, const Use& use)
 {
     std::size_t begin = from;
     while (begin < to && begin > 0 && sorted[begin].key == sorted[begin - 1].key)
@@ -209,7 +209,7 @@ void for_each_crowded_run(std::span<const Keyed> sorted, std::size_t from, std::
         std::size_t end = begin + 1;
         while (end < sorted.size() && sorted[end].key == sorted[begin].key)
             ++end;
-        if (end - begin > refine_above)
+        if (end - begin > above)
             use(begin, end);
         begin = end;
     }
@@ -229,7 +229,7 @@ void refine_run(std::span<const Vec3f> positions, std::span<Keyed> run)
         return;
     for (std::size_t j = 0; j < run.size(); ++j)
         run[j] = {keys[j], indices[j]};
-    for_each_crowded_run(run, 0, run.size(), [&](std::size_t begin, std::size_t end) {
+    for_each_run(run, 0, run.size(), refine_above, [&](std::size_t begin, std::size_t end) {
         refine_run(positions, run.subspan(begin, end - begin));
     });
 }
@@ -310,18 +310,8 @@ std::vector<std::pair<std::size_t, std::size_t>> shared_key_runs(std::span<const
         sorted.size(), std::size_t{1} << 18U,
         [&](std::size_t first, std::size_t last,
             std::vector<std::pair<std::size_t, std::size_t>>& out) {
-            std::size_t begin = first;
-            while (begin < last && begin > 0 && sorted[begin].key == sorted[begin - 1].key)
-                ++begin;
-            while (begin < last)
-            {
-                std::size_t end = begin + 1;
-                while (end < sorted.size() && sorted[end].key == sorted[begin].key)
-                    ++end;
-                if (end - begin > 1)
-                    out.emplace_back(begin, end);
-                begin = end;
-            }
+            for_each_run(sorted, first, last, 1,
+                         [&](std::size_t begin, std::size_t end) { out.emplace_back(begin, end); });
         });
 }
 

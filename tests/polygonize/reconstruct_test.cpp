@@ -63,6 +63,20 @@ TEST(Reconstruct, SampledSphereStopsByTheRuleWithinTheBudgetOnTheSphere)
     EXPECT_GT(report.intermediate_faces, semi.base->faces);
 }
 
+/// Checks that a reconstruction of samples of the unit sphere is closed, in one piece, of genus 0
+/// and within `tolerance` of the sphere (default: the samples' density).
+void expect_unit_sphere(const ReconstructReport& report, double tolerance = 0.0)
+{
+    const MultiresMesh& hierarchy = report.semi_regular.hierarchy;
+    const TriMesh finest = hierarchy.level_mesh(hierarchy.finest_level());
+    const MeshTopology topo = analyze_topology(finest);
+    EXPECT_TRUE(topo.is_closed());
+    EXPECT_EQ(topo.euler_characteristic, 2);
+    EXPECT_EQ(topo.components, 1U);
+    EXPECT_LT(sphere_error(finest),
+              tolerance > 0.0 ? tolerance : report.semi_regular.refinement.sampling_density);
+}
+
 // A scan with one stray return far away (10^6 radii off the sphere): the stray was the whole
 // field's bounds and made marching cubes' cells larger than the sphere ("no triangles"); it is
 // left out (surfels_from_samples()), and the sphere comes out as without it.
@@ -74,14 +88,7 @@ TEST(Reconstruct, AStrayPointFarAwayDoesNotSpoilTheSurface)
     points.positions.emplace_back(1e6F, 0.0F, 0.0F);
     const SurfelsFromSamples surfels = surfels_from_samples(points);
     EXPECT_EQ(surfels.isolated, 1U);
-    const ReconstructReport report = reconstruct(surfels.surfels);
-    const MultiresMesh& hierarchy = report.semi_regular.hierarchy;
-    const TriMesh finest = hierarchy.level_mesh(hierarchy.finest_level());
-    const MeshTopology topo = analyze_topology(finest);
-    EXPECT_TRUE(topo.is_closed());
-    EXPECT_EQ(topo.euler_characteristic, 2);
-    EXPECT_EQ(topo.components, 1U);
-    EXPECT_LT(sphere_error(finest), report.semi_regular.refinement.sampling_density);
+    expect_unit_sphere(reconstruct(surfels.surfels));
 }
 
 // Clusters of 1 to 15 stray returns a fifth to a half of the radius off a scanned sphere (as a
@@ -110,14 +117,7 @@ TEST(Reconstruct, ClustersOfStraysDoNotSpoilTheSurface)
     }
     const SurfelsFromSamples surfels = surfels_from_samples(points);
     EXPECT_EQ(surfels.isolated, strays);
-    const ReconstructReport report = reconstruct(surfels.surfels);
-    const MultiresMesh& hierarchy = report.semi_regular.hierarchy;
-    const TriMesh finest = hierarchy.level_mesh(hierarchy.finest_level());
-    const MeshTopology topo = analyze_topology(finest);
-    EXPECT_TRUE(topo.is_closed());
-    EXPECT_EQ(topo.euler_characteristic, 2);
-    EXPECT_EQ(topo.components, 1U);
-    EXPECT_LT(sphere_error(finest), report.semi_regular.refinement.sampling_density);
+    expect_unit_sphere(reconstruct(surfels.surfels));
 }
 
 // Coordinates quantized by a scanner or a file format (here a sphere's 30k samples rounded to a
@@ -135,14 +135,7 @@ TEST(Reconstruct, QuantizedCoordinatesGiveTheSurface)
         p = (p / step).array().round().matrix() * step;
     const SurfelsFromSamples surfels = surfels_from_samples(points);
     EXPECT_GT(surfels.copies, 1000U);
-    const ReconstructReport report = reconstruct(surfels.surfels);
-    const MultiresMesh& hierarchy = report.semi_regular.hierarchy;
-    const TriMesh finest = hierarchy.level_mesh(hierarchy.finest_level());
-    const MeshTopology topo = analyze_topology(finest);
-    EXPECT_TRUE(topo.is_closed());
-    EXPECT_EQ(topo.euler_characteristic, 2);
-    EXPECT_EQ(topo.components, 1U);
-    EXPECT_LT(sphere_error(finest), step);
+    expect_unit_sphere(reconstruct(surfels.surfels), step);
 }
 
 TEST(Reconstruct, ExactLevelsAndTheBaseFaceTarget)
