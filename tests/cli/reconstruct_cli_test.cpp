@@ -186,6 +186,50 @@ TEST(ReconstructCli, LevelsRefinesExactlyAndTheHierarchyGivesTheSameMesh)
     EXPECT_EQ(read_mesh(base).face_count(), base_faces);
 }
 
+// A scan written twice into one file (every sample repeated): `normals` gives each copy its
+// original's normal and counts the copies; `reconstruct` merges them into one surfel a place,
+// warns, reports them, and gives the same sphere as from the scan written once.
+TEST(ReconstructCli, RepeatedSamplesAreOneSurfel)
+{
+    test::TempDir dir;
+    PointCloud once = sample_shape(Shape::Sphere, {.count = 4000, .seed = 9});
+    once.normals.clear();
+    once.radii.clear();
+    PointCloud twice = once;
+    twice.positions.insert(twice.positions.end(), once.positions.begin(), once.positions.end());
+    const auto once_path = dir / "once.ply";
+    const auto twice_path = dir / "twice.ply";
+    write_point_cloud(once_path, once);
+    write_point_cloud(twice_path, twice);
+
+    const auto normals = run("normals " + quoted(twice_path) + " -o " +
+                             quoted(dir / "twice_surfels.ply") + " --json");
+    ASSERT_EQ(normals.exit_code, 0) << normals.out;
+    EXPECT_EQ(nlohmann::json::parse(normals.out)["copies"].get<std::size_t>(), 4000U);
+    const PointCloud surfels = read_point_cloud(dir / "twice_surfels.ply");
+    ASSERT_EQ(surfels.size(), 8000U);
+    for (std::size_t i = 0; i < 4000; ++i)
+        ASSERT_EQ(surfels.normals[i], surfels.normals[i + 4000]) << i;
+
+    const auto merged = run("reconstruct " + quoted(twice_path) + " -o " +
+                            quoted(dir / "twice.out.ply") + " --json");
+    ASSERT_EQ(merged.exit_code, 0) << merged.out;
+    EXPECT_EQ(nlohmann::json::parse(merged.out)["surfels"]["copies"].get<std::size_t>(), 4000U);
+    const auto told =
+        run("reconstruct " + quoted(twice_path) + " -o " + quoted(dir / "twice.out.ply"));
+    ASSERT_EQ(told.exit_code, 0) << told.out;
+    EXPECT_NE(told.out.find("4000 samples at the very place of an earlier sample"),
+              std::string::npos)
+        << told.out;
+    ASSERT_EQ(
+        run("reconstruct " + quoted(once_path) + " -o " + quoted(dir / "once.out.ply")).exit_code,
+        0);
+    const TriMesh from_twice = read_mesh(dir / "twice.out.ply");
+    const TriMesh from_once = read_mesh(dir / "once.out.ply");
+    EXPECT_EQ(from_twice.vertices.positions, from_once.vertices.positions);
+    EXPECT_EQ(from_twice.triangles, from_once.triangles);
+}
+
 TEST(ReconstructCli, HumanReportHasThePerLevelTable)
 {
     test::TempDir dir;
