@@ -233,11 +233,11 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
             result.copies.push_back(c.copy);
     }
     timer.lap("spatial sort");
+    const std::span<const Vec3f> positions =
+        place.empty() ? std::span<const Vec3f>(sorted) : std::span<const Vec3f>(distinct);
 
     // Only the k-th distance is needed (radii, the orientation's flux); the tree goes once the
     // table is made.
-    const std::span<const Vec3f> positions =
-        place.empty() ? std::span<const Vec3f>(sorted) : std::span<const Vec3f>(distinct);
     KnnTable table;
     {
         const KdTree tree(positions);
@@ -246,7 +246,6 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
                           {.farthest_distance_only = true, .progress = options.progress});
     }
     timer.lap("knn");
-
     Normals normals = estimate_normals(positions, table, options.progress);
     result.degenerate = normals.degenerate.size();
     timer.lap("normals");
