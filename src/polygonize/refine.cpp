@@ -243,11 +243,24 @@ struct Distances
     double mean = 0.0;
     double robust = 0.0;
     double p90 = 0.0;
+    /// Per sample, its closest face (an index into the faces measured), which bounds the search
+    /// of the next measurement (NearestHint).
+    std::vector<std::uint32_t> nearest;
+};
+
+/// The closest faces of an earlier measurement (Distances::nearest), on the same faces or on
+/// the level below, whose face f has the children 4f ... 4f + 3 (child_faces()): the distance
+/// to the nearest of those bounds each sample's search, which then visits little more than the
+/// faces that close (a fresh search takes the previous sample's closest point as its bound).
+struct NearestHint
+{
+    std::span<const std::uint32_t> faces;
+    bool children = false;
 };
 
 Distances distances_from(const PointCloud& samples, const MultiresMesh& mesh,
                          std::span<const Triangle> faces, std::size_t level,
-                         const ProgressCallback& progress)
+                         const ProgressCallback& progress, const NearestHint& hint = {})
 {
     TriMesh surface;
     surface.vertices.origin = mesh.origin();
@@ -257,7 +270,37 @@ Distances distances_from(const PointCloud& samples, const MultiresMesh& mesh,
         surface.vertices.positions[v] = mesh.positions()[v].cast<float>();
     surface.triangles.assign(faces.begin(), faces.end());
     const TriangleBvh bvh(surface);
-    std::vector<double> d = distances_to_mesh(bvh, samples, {.progress = progress});
+    std::vector<double> bounds;
+    if (hint.faces.size() == samples.size())
+    {
+        // Each bound is a distance to a face of this mesh, worked out as the BVH does (its
+        // corners in double from the float positions, relative to the origin), so it is never
+        // below the sample's distance.
+        bounds.assign(samples.size(), std::numeric_limits<double>::infinity());
+        const std::size_t per_hint = hint.children ? 4 : 1;
+        const auto& x = surface.vertices.positions;
+        parallel_blocks(samples.size(), 4096, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                const std::uint32_t f = hint.faces[i];
+                if (f == none || per_hint * f + per_hint > faces.size())
+                    continue;
+                const Vec3d p = samples.world(i) - surface.vertices.origin;
+                double best = std::numeric_limits<double>::infinity();
+                for (std::size_t c = per_hint * f; c < per_hint * f + per_hint; ++c)
+                {
+                    const Vec3d a = x[faces[c][0]].cast<double>();
+                    const Vec3d b = x[faces[c][1]].cast<double>();
+                    const Vec3d d = x[faces[c][2]].cast<double>();
+                    const Vec3d w = closest_point_barycentric(p, a, b, d);
+                    best = std::min(best, (p - (w[0] * a + w[1] * b + w[2] * d)).norm());
+                }
+                bounds[i] = best;
+            }
+        });
+    }
+    NearestTriangles nearest = nearest_triangles(bvh, samples, bounds, {.progress = progress});
+    std::vector<double>& d = nearest.distances;
     Distances out;
     double sum = 0.0;
     for (const double value : d)
@@ -269,6 +312,7 @@ Distances distances_from(const PointCloud& samples, const MultiresMesh& mesh,
     const RobustStats robust = robust_stats(d);
     out.robust = robust.robust;
     out.p90 = robust.p90;
+    out.nearest = std::move(nearest.faces);
     return out;
 }
 
@@ -669,8 +713,12 @@ std::string_view to_string(StopRule rule)
     return "auto";
 }
 
-RefineLevelStats refine_once(MultiresMesh& mesh, const Field& field, const RefineOptions& options,
-                             const PointCloud* samples)
+namespace {
+
+/// refine_once(); `nearest` (null, or every sample's closest face on the finest level before)
+/// bounds the distance searches and becomes the new level's.
+RefineLevelStats refine_level(MultiresMesh& mesh, const Field& field, const RefineOptions& options,
+                              const PointCloud* samples, std::vector<std::uint32_t>* nearest)
 {
     check_options(options);
     if (mesh.level_count() == 0)
@@ -693,10 +741,16 @@ RefineLevelStats refine_once(MultiresMesh& mesh, const Field& field, const Refin
             refine_split_level(mesh, std::move(split), field, options, stats);
         if (samples != nullptr && !samples->empty())
         {
-            const Distances d = distances_from(
-                *samples, mesh, faces, stats.level, [&](std::string_view, double fraction) {
+            Distances d = distances_from(
+                *samples, mesh, faces, stats.level,
+                [&](std::string_view, double fraction) {
                     return !options.progress || options.progress("refine: distance", fraction);
-                });
+                },
+                {.faces = nearest != nullptr ? std::span<const std::uint32_t>(*nearest)
+                                             : std::span<const std::uint32_t>(),
+                 .children = true});
+            if (nearest != nullptr)
+                *nearest = std::move(d.nearest);
             stats.hausdorff = d.hausdorff;
             stats.mean_distance = d.mean;
             stats.robust_distance = d.robust;
@@ -715,14 +769,27 @@ RefineLevelStats refine_once(MultiresMesh& mesh, const Field& field, const Refin
     return stats;
 }
 
+} // namespace
+
+RefineLevelStats refine_once(MultiresMesh& mesh, const Field& field, const RefineOptions& options,
+                             const PointCloud* samples)
+{
+    return refine_level(mesh, field, options, samples, nullptr);
+}
+
 namespace {
+
+/// Samples of which field_residual() measures every one; larger clouds every k-th, at least
+/// this many (RefineReport::field_residual).
+constexpr std::size_t residual_samples = std::size_t{1} << 18U;
 
 /// The field's own robust distance from the samples: the robust statistic of |f(s)|.
 double field_residual(const Field& field, const PointCloud& samples)
 {
-    std::vector<Vec3d> points(samples.size());
-    for (std::size_t i = 0; i < samples.size(); ++i)
-        points[i] = samples.world(i);
+    const std::size_t stride = std::max<std::size_t>(1, samples.size() / residual_samples);
+    std::vector<Vec3d> points((samples.size() + stride - 1) / stride);
+    for (std::size_t i = 0; i < points.size(); ++i)
+        points[i] = samples.world(i * stride);
     std::vector<FieldSample> values(points.size());
     field.evaluate(points, values);
     std::vector<double> residual;
@@ -923,15 +990,16 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
     }
     report.sampling_density = options.sampling_density > 0.0 ? options.sampling_density
                                                              : estimate_sampling_density(samples);
-    const Distances initial = distances_from(
-        samples, mesh, mesh.faces(mesh.finest_level()), mesh.finest_level(),
-        [&](std::string_view, double fraction) {
-            return !options.progress || options.progress("refine: distance", fraction);
-        });
+    Distances initial = distances_from(samples, mesh, mesh.faces(mesh.finest_level()),
+                                       mesh.finest_level(), [&](std::string_view, double fraction) {
+                                           return !options.progress ||
+                                                  options.progress("refine: distance", fraction);
+                                       });
     report.initial_hausdorff = initial.hausdorff;
     report.initial_mean_distance = initial.mean;
     report.initial_robust_distance = initial.robust;
     report.initial_p90_distance = initial.p90;
+    std::vector<std::uint32_t> nearest = std::move(initial.nearest);
     const bool automatic = options.stop_rule == StopRule::Automatic;
     if (automatic)
     {
@@ -986,7 +1054,8 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
                 break;
             }
         }
-        RefineLevelStats stats = refine_once(mesh, field, options, &samples);
+        // A level dropped by the paper's rule leaves `nearest` on it; its rule stops then.
+        RefineLevelStats stats = refine_level(mesh, field, options, &samples, &nearest);
         const double previous_hausdorff = hausdorff;
         hausdorff = *stats.hausdorff;
         if (!report.paper_level && hausdorff < report.sampling_density)
@@ -1007,9 +1076,11 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
         report.denoise_rounds = options.denoise_rounds;
         report.denoise_max_move = denoise_finest(mesh, faces, options.denoise_rounds);
         const Distances after = distances_from(
-            samples, mesh, faces, mesh.finest_level(), [&](std::string_view, double fraction) {
+            samples, mesh, faces, mesh.finest_level(),
+            [&](std::string_view, double fraction) {
                 return !options.progress || options.progress("refine: distance", fraction);
-            });
+            },
+            {.faces = nearest, .children = false});
         if (report.levels.empty())
         {
             report.initial_hausdorff = after.hausdorff;

@@ -648,28 +648,47 @@ std::vector<TriangleBvh::Hit> closest_points(const TriangleBvh& bvh, std::span<c
         for (std::size_t i = begin; i < end; ++i)
             near_origin[i] = (queries[i] - bvh.origin()).cast<float>();
     });
+    // The closest point found for the query before bounds the next one's search, as in
+    // nearest_triangles(): the same hits as unbounded searches.
     in_spatial_order(near_origin, options.progress, [&](std::span<const std::uint32_t> run) {
+        Vec3d previous = Vec3d::Constant(std::numeric_limits<double>::quiet_NaN());
         for (const std::uint32_t i : run)
-            hits[i] = bvh.closest(queries[i], options.max_distance);
+        {
+            const double bound = (queries[i] - previous).norm() * (1.0 + 1e-6);
+            TriangleBvh::Hit hit;
+            if (bound < options.max_distance)
+                hit = bvh.closest(queries[i], bound);
+            if (!hit.found())
+                hit = bvh.closest(queries[i], options.max_distance);
+            if (hit.found())
+                previous = hit.point;
+            hits[i] = hit;
+        }
     });
     return hits;
 }
 
-std::vector<double> distances_to_mesh(const TriangleBvh& bvh, const PointCloudView& points,
-                                      const ClosestPointOptions& options)
+namespace {
+
+/// The searches of distances_to_mesh() and nearest_triangles(): `faces` may be null.
+void nearest_of(const TriangleBvh& bvh, const PointCloudView& points,
+                std::span<const double> upper_bounds, const ClosestPointOptions& options,
+                std::span<double> distances, std::uint32_t* faces)
 {
-    std::vector<double> distances(points.size());
     // The closest point found for the query before bounds the next one's distance, which prunes
     // its search from the root (twice as fast far from the surface, where the queries of a run
-    // are neighbours). A bound that admits some triangle admits the nearest, so each distance
-    // is the one an unbounded search gives, bit for bit; one that admits none falls back to the
-    // unbounded search.
+    // are neighbours), and so does the caller's bound where it is smaller. A bound that admits
+    // some triangle admits the nearest, so each distance is the one an unbounded search gives,
+    // bit for bit; one that admits none falls back to the unbounded search.
     in_spatial_order(points.positions, options.progress, [&](std::span<const std::uint32_t> run) {
         Vec3d previous = Vec3d::Constant(std::numeric_limits<double>::quiet_NaN());
         for (const std::uint32_t i : run)
         {
             const Vec3d p = points.world(i);
-            const double bound = (p - previous).norm() * (1.0 + 1e-6);
+            double bound = (p - previous).norm(); // NaN for a run's first point
+            if (!upper_bounds.empty() && (std::isnan(bound) || upper_bounds[i] < bound))
+                bound = upper_bounds[i];
+            bound *= 1.0 + 1e-6;
             TriangleBvh::Hit hit;
             if (bound < options.max_distance)
                 hit = bvh.closest(p, bound);
@@ -678,9 +697,34 @@ std::vector<double> distances_to_mesh(const TriangleBvh& bvh, const PointCloudVi
             if (hit.found())
                 previous = hit.point;
             distances[i] = hit.distance;
+            if (faces != nullptr)
+                faces[i] = hit.found() ? hit.face.value : std::numeric_limits<std::uint32_t>::max();
         }
     });
+}
+
+} // namespace
+
+std::vector<double> distances_to_mesh(const TriangleBvh& bvh, const PointCloudView& points,
+                                      const ClosestPointOptions& options)
+{
+    std::vector<double> distances(points.size());
+    nearest_of(bvh, points, {}, options, distances, nullptr);
     return distances;
+}
+
+NearestTriangles nearest_triangles(const TriangleBvh& bvh, const PointCloudView& points,
+                                   std::span<const double> upper_bounds,
+                                   const ClosestPointOptions& options)
+{
+    if (!upper_bounds.empty() && upper_bounds.size() != points.size())
+        throw InvalidInput("nearest triangles: " + std::to_string(upper_bounds.size()) +
+                           " upper bounds for " + std::to_string(points.size()) + " points");
+    NearestTriangles out;
+    out.distances.resize(points.size());
+    out.faces.resize(points.size());
+    nearest_of(bvh, points, upper_bounds, options, out.distances, out.faces.data());
+    return out;
 }
 
 } // namespace pointform

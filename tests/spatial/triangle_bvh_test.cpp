@@ -301,6 +301,7 @@ TEST(TriangleBvh, BatchMatchesSingleWhateverTheThreadCount)
             ASSERT_EQ(one[i].point, runs[r][i].point) << r + 1 << " threads";
         }
         EXPECT_EQ(one[i].distance, bvh.closest(queries[i]).distance);
+        EXPECT_EQ(one[i].face, bvh.closest(queries[i]).face);
     }
     PointCloud cloud;
     for (const Vec3d& q : queries)
@@ -309,6 +310,53 @@ TEST(TriangleBvh, BatchMatchesSingleWhateverTheThreadCount)
     ASSERT_EQ(distances.size(), queries.size());
     for (std::size_t i = 0; i < queries.size(); ++i)
         EXPECT_EQ(distances[i], bvh.distance(cloud.world(i)));
+}
+
+TEST(TriangleBvh, BoundsOnlyPruneTheNearestTriangles)
+{
+    const TriMesh mesh = random_mesh(300, 600, 41);
+    const TriangleBvh bvh(mesh);
+    const auto queries = random_queries(5000, 1.5, 42);
+    PointCloud cloud;
+    for (const Vec3d& q : queries)
+        cloud.positions.push_back(q.cast<float>());
+    std::vector<TriangleBvh::Hit> truth;
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        truth.push_back(bvh.closest(cloud.world(i)));
+    // Bounds as a caller makes them: the distance to some triangle (valid: never below the
+    // nearest's), to the nearest itself (tight), half the true distance (wrong), or none.
+    std::mt19937 random(43);
+    std::uniform_int_distribution<std::size_t> any_face(0, mesh.face_count() - 1);
+    std::vector<double> some_face(cloud.size());
+    std::vector<double> tight(cloud.size());
+    std::vector<double> wrong(cloud.size());
+    std::vector<double> none(cloud.size(), std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+    {
+        const Triangle& t = mesh.triangles[any_face(random)];
+        const Vec3d p = cloud.world(i);
+        const Vec3d a = mesh.vertices.positions[t[0]].cast<double>();
+        const Vec3d b = mesh.vertices.positions[t[1]].cast<double>();
+        const Vec3d c = mesh.vertices.positions[t[2]].cast<double>();
+        const Vec3d w = closest_point_barycentric(p, a, b, c);
+        some_face[i] = (p - (w[0] * a + w[1] * b + w[2] * c)).norm();
+        tight[i] = truth[i].distance;
+        wrong[i] = 0.5 * truth[i].distance;
+    }
+    for (const auto* bounds : {&some_face, &tight, &wrong, &none})
+    {
+        const NearestTriangles found = nearest_triangles(bvh, cloud, *bounds);
+        ASSERT_EQ(found.distances.size(), cloud.size());
+        for (std::size_t i = 0; i < cloud.size(); ++i)
+        {
+            ASSERT_EQ(found.distances[i], truth[i].distance) << i;
+            ASSERT_EQ(found.faces[i], truth[i].face.value) << i;
+        }
+    }
+    const NearestTriangles unbounded = nearest_triangles(bvh, cloud);
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        ASSERT_EQ(unbounded.faces[i], truth[i].face.value);
+    EXPECT_THROW((void)nearest_triangles(bvh, cloud, std::vector<double>(3, 1.0)), InvalidInput);
 }
 
 TEST(TriangleBoxDepth, AnalyticValues)

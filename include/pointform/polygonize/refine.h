@@ -226,7 +226,9 @@ struct RefineReport
     /// StopRule::Automatic: the vertex budget used (options or the number of samples).
     std::size_t vertex_budget = 0;
     /// StopRule::Automatic: the field's own distance from the samples, the same robust
-    /// statistic over |f(s)| (|∇f| ≈ 1 near the surface): the mean of the smallest 95%.
+    /// statistic over |f(s)| (|∇f| ≈ 1 near the surface): the mean of the smallest 95%. Over
+    /// every sample up to 2^19; over every k-th (in the samples' order, at least 2^18 of them)
+    /// beyond, where the statistic is as certain and a full pass costs seconds.
     double field_residual = 0.0;
     /// StopRule::Automatic: max(detail_factor · field_residual, 0.001 · sampling_density).
     double detail_threshold = 0.0;

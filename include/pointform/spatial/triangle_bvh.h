@@ -129,6 +129,25 @@ private:
                                                     const PointCloudView& points,
                                                     const ClosestPointOptions& options = {});
 
+/// \brief Distances from points to a mesh with each point's closest triangle.
+struct NearestTriangles
+{
+    std::vector<double> distances;    ///< per point, in world units (infinity if none found)
+    std::vector<std::uint32_t> faces; ///< per point, the closest triangle (or UINT32_MAX)
+};
+
+/// \brief distances_to_mesh() with the closest triangles, and optional per-point upper bounds
+/// on the distances that prune the searches (the distance to a triangle known to be near the
+/// point, e.g. a child of the point's closest triangle on a coarser level of a subdivision).
+/// A bound only prunes: each distance and triangle is the one an unbounded search finds, and a
+/// bound below the true distance (or not finite) falls back to the unbounded search.
+/// \param upper_bounds  empty, or points.size() bounds in world units
+/// \throw InvalidInput if upper_bounds is neither empty nor of points.size()
+[[nodiscard]] NearestTriangles nearest_triangles(const TriangleBvh& bvh,
+                                                 const PointCloudView& points,
+                                                 std::span<const double> upper_bounds = {},
+                                                 const ClosestPointOptions& options = {});
+
 /// \brief How many triangles' bounding boxes a random line through the mesh's bounding box
 /// crosses, on average: the sum of the triangles' box surface areas over the mesh box's (Cauchy-
 /// Crofton). No hierarchy of axis-aligned boxes can answer a ray or closest-point query on the
