@@ -21,9 +21,17 @@ double triangle_min_angle(const Vec3d& a, const Vec3d& b, const Vec3d& c)
     const Vec3d ab = b - a;
     const Vec3d bc = c - b;
     const Vec3d ca = a - c;
-    if (ab.squaredNorm() == 0.0 || bc.squaredNorm() == 0.0 || ca.squaredNorm() == 0.0)
+    const double lab = ab.squaredNorm();
+    const double lbc = bc.squaredNorm();
+    const double lca = ca.squaredNorm();
+    if (lab == 0.0 || lbc == 0.0 || lca == 0.0)
         return 0.0;
-    return std::min({angle(ab, Vec3d(-ca)), angle(bc, Vec3d(-ab)), angle(ca, Vec3d(-bc))});
+    // The smallest angle lies opposite the shortest side (law of sines): one atan2, not three.
+    if (lbc <= lab && lbc <= lca)
+        return angle(ab, Vec3d(-ca)); // at a
+    if (lca <= lab)
+        return angle(bc, Vec3d(-ab)); // at b
+    return angle(ca, Vec3d(-bc));     // at c
 }
 
 AngleQuality angle_quality(const TriMesh& mesh, double sliver_degrees)

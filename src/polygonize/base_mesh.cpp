@@ -724,7 +724,7 @@ std::size_t flip_passes(OmMesh& mesh, Decide&& flip)
         std::size_t flips_this_pass = 0;
         for (const auto e : mesh.edges())
         {
-            if (mesh.is_boundary(e) || !mesh.is_flip_ok(e))
+            if (mesh.is_boundary(e))
             {
                 continue;
             }
@@ -737,12 +737,11 @@ std::size_t flip_passes(OmMesh& mesh, Decide&& flip)
             const auto lowest = [&mesh](OmMesh::VertexHandle v) {
                 return mesh.is_boundary(v) ? 2U : 3U;
             };
-            if (mesh.valence(a) <= lowest(a) || mesh.valence(b) <= lowest(b))
-            {
-                continue;
-            }
+            // The wanted flips are few: the geometry decides first, the connectivity's walks
+            // around the vertices (the same conditions, so the same flips) only for those.
             if (flip(to_eigen(mesh.point(a)), to_eigen(mesh.point(b)), to_eigen(mesh.point(c)),
-                     to_eigen(mesh.point(d))))
+                     to_eigen(mesh.point(d))) &&
+                mesh.is_flip_ok(e) && mesh.valence(a) > lowest(a) && mesh.valence(b) > lowest(b))
             {
                 mesh.flip(e);
                 ++flips_this_pass;

@@ -10,8 +10,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <random>
 
 namespace pointform {
 namespace {
@@ -28,6 +30,31 @@ TEST(Quality, TriangleMinAngleOfKnownTriangles)
     // A needle keeps its tiny angle accurate (atan2, not acos).
     EXPECT_NEAR(triangle_min_angle({0, 0, 0}, {1, 0, 0}, {0.5, 1e-9, 0}), 2e-9, 1e-15);
     EXPECT_EQ(triangle_min_angle({0, 0, 0}, {0, 0, 0}, {1, 0, 0}), 0.0);
+}
+
+TEST(Quality, TriangleMinAngleIsTheSmallestOfTheThree)
+{
+    // Random triangles, obtuse, needles and caps among them: the angle opposite the shortest
+    // side, against all three angles by the law of cosines.
+    std::mt19937 random(5);
+    std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+    const auto angle_at = [](const Vec3d& p, const Vec3d& q, const Vec3d& r) {
+        const Vec3d u = q - p;
+        const Vec3d v = r - p;
+        return std::acos(std::clamp(u.dot(v) / (u.norm() * v.norm()), -1.0, 1.0));
+    };
+    for (int trial = 0; trial < 2000; ++trial)
+    {
+        const Vec3d a(coordinate(random), coordinate(random), coordinate(random));
+        const Vec3d b(coordinate(random), coordinate(random), coordinate(random));
+        // Every fifth triangle nearly flat: c close to the segment ab.
+        const double squash = trial % 5 == 0 ? 1e-3 : 1.0;
+        const Vec3d c = 0.5 * (a + b) +
+                        squash * Vec3d(coordinate(random), coordinate(random), coordinate(random));
+        const double expected = std::min({angle_at(a, b, c), angle_at(b, c, a), angle_at(c, a, b)});
+        EXPECT_NEAR(triangle_min_angle(a, b, c), expected, 1e-9) << trial;
+        EXPECT_EQ(triangle_min_angle(a, b, c), triangle_min_angle(b, c, a)) << trial;
+    }
 }
 
 TEST(Quality, AngleQualityOfAGridAndItsBoundary)
