@@ -886,7 +886,7 @@ std::optional<Vec3d> project_vertex(const Field& field, const Vec3d& p, const Ve
     {
         return std::nullopt;
     }
-    return project_to_zero(field, p, direction, reach);
+    return project_to_zero(field, s, p, direction, reach);
 }
 
 /// One round: every interior vertex moved tangentially to the average of its neighbours (when

@@ -25,9 +25,9 @@ class Line
 public:
     Line(const Field& field, const Vec3d& p, const Vec3d& d) : field_(field), p_(p), d_(d) {}
 
-    [[nodiscard]] LineSample at(double t) const
+    [[nodiscard]] LineSample at(double t) const { return of(t, field_.evaluate(point(t))); }
+    [[nodiscard]] static LineSample of(double t, const FieldSample& s)
     {
-        const FieldSample s = field_.evaluate(point(t));
         if (!std::isfinite(s.value))
             return {t, std::numeric_limits<double>::quiet_NaN(), false};
         return {t, s.value, s.defined};
@@ -98,14 +98,12 @@ std::optional<double> refine_bracket(const Line& line, LineSample lo, LineSample
 
 } // namespace
 
-std::optional<Vec3d> project_to_zero(const Field& field, const Vec3d& p, const Vec3d& direction,
-                                     double max_distance)
-{
-    return project_to_zero(field, p, direction, max_distance, ProjectionOptions{});
-}
+namespace {
 
-std::optional<Vec3d> project_to_zero(const Field& field, const Vec3d& p, const Vec3d& direction,
-                                     double max_distance, const ProjectionOptions& options)
+/// project_to_zero(), with the field's sample at p if the caller has it.
+std::optional<Vec3d> project_from(const Field& field, const FieldSample* at_p, const Vec3d& p,
+                                  const Vec3d& direction, double max_distance,
+                                  const ProjectionOptions& options)
 {
     if (options.steps < 1 || options.max_iterations < 1 ||
         !(options.relative_tolerance > 0.0 && std::isfinite(options.relative_tolerance)))
@@ -121,11 +119,12 @@ std::optional<Vec3d> project_to_zero(const Field& field, const Vec3d& p, const V
     const double h = max_distance / options.steps;
     const double tolerance = options.relative_tolerance * max_distance;
 
-    const LineSample centre = line.at(0.0);
+    // p + 0·d is p, bit for bit: the caller's sample is the line's at 0.
+    const LineSample centre = at_p != nullptr ? Line::of(0.0, *at_p) : line.at(0.0);
     if (centre.defined && centre.value == 0.0)
     {
         // Exactly on the surface: accept if the field grows along the direction.
-        const FieldSample s = field.evaluate(p);
+        const FieldSample s = at_p != nullptr ? *at_p : field.evaluate(p);
         if (s.gradient.dot(direction) > 0.0)
             return p;
     }
@@ -158,6 +157,26 @@ std::optional<Vec3d> project_to_zero(const Field& field, const Vec3d& p, const V
         neg_prev = neg;
     }
     return std::nullopt;
+}
+
+} // namespace
+
+std::optional<Vec3d> project_to_zero(const Field& field, const Vec3d& p, const Vec3d& direction,
+                                     double max_distance)
+{
+    return project_from(field, nullptr, p, direction, max_distance, ProjectionOptions{});
+}
+
+std::optional<Vec3d> project_to_zero(const Field& field, const Vec3d& p, const Vec3d& direction,
+                                     double max_distance, const ProjectionOptions& options)
+{
+    return project_from(field, nullptr, p, direction, max_distance, options);
+}
+
+std::optional<Vec3d> project_to_zero(const Field& field, const FieldSample& at_p, const Vec3d& p,
+                                     const Vec3d& direction, double max_distance)
+{
+    return project_from(field, &at_p, p, direction, max_distance, ProjectionOptions{});
 }
 
 std::optional<Vec3d> newton_to_zero(const Field& field, const Vec3d& p, double max_distance)

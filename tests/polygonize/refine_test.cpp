@@ -172,6 +172,42 @@ TEST(Projection, FindsTheNearestOutwardCrossing)
                  InvalidInput);
 }
 
+TEST(Projection, TheCallersSampleAtTheStartGivesTheSamePoint)
+{
+    // A counting field: the caller's sample at p saves the evaluations at p, nothing else.
+    struct Counting : Field
+    {
+        std::shared_ptr<const Field> inner = make_sphere(Vec3d::Zero(), 1.0);
+        mutable int evaluations = 0;
+        using Field::evaluate;
+        [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override
+        {
+            ++evaluations;
+            return inner->evaluate(p);
+        }
+        [[nodiscard]] Aabb bounds() const override { return inner->bounds(); }
+    };
+    const Counting field;
+    for (const Vec3d& p : {Vec3d(0.5, 0.2, 0.1), Vec3d(0.0, 1.3, 0.0), Vec3d(1.0, 0.0, 0.0)})
+    {
+        for (const Vec3d& direction : {Vec3d(p.normalized()), Vec3d(-p.normalized())})
+        {
+            field.evaluations = 0;
+            const auto plain = project_to_zero(field, p, direction, 0.6);
+            const int plain_evaluations = field.evaluations;
+            const FieldSample at_p = field.inner->evaluate(p);
+            field.evaluations = 0;
+            const auto given = project_to_zero(field, at_p, p, direction, 0.6);
+            ASSERT_EQ(plain.has_value(), given.has_value());
+            if (plain)
+            {
+                EXPECT_EQ(*plain, *given);
+            }
+            EXPECT_LE(field.evaluations, plain_evaluations - 1); // 2 fewer on the surface
+        }
+    }
+}
+
 TEST(Projection, NewtonReachesTheNearestZero)
 {
     // On a sphere's distance field one step lands on the radial point.

@@ -49,6 +49,12 @@ struct ProjectionOptions
                                                    const Vec3d& direction, double max_distance,
                                                    const ProjectionOptions& options);
 
+/// \brief project_to_zero() given `at_p`, the field's sample at p (field.evaluate(p)), which it
+/// would otherwise evaluate first: the same point, one evaluation fewer.
+[[nodiscard]] std::optional<Vec3d> project_to_zero(const Field& field, const FieldSample& at_p,
+                                                   const Vec3d& p, const Vec3d& direction,
+                                                   double max_distance);
+
 /// \brief A point of f = 0 near p by Newton steps along the gradient, q ← q − f(q) ∇f / |∇f|²
 /// (where the field is undefined its value and gradient still say which way the surface is,
 /// see FieldSample): for a point whose projection along a direction fails or folds, e.g. a
