@@ -4,15 +4,91 @@
 #include "pointform/polygonize/components.h"
 
 #include "pointform/core/disjoint_sets.h"
+#include "pointform/core/parallel.h"
 #include "pointform/geometry/mesh_topology.h"
+#include "pointform/spatial/spatial_sort.h"
 #include "pointform/spatial/triangle_bvh.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <vector>
 
 namespace pointform {
+
+namespace {
+
+/// The samples whose nearest triangle lies in each component. The largest component (most
+/// faces) is weighed against the rest: a sample's nearest triangle among the rest (usually few
+/// faces), then whether the largest has one strictly closer (a search that stops at the first
+/// such triangle). The nearest triangle of the whole mesh is in the component found, as an
+/// exact search finds it, but for exact ties, which go to the rest.
+std::vector<std::size_t> component_support(const TriMesh& mesh,
+                                           const std::vector<std::uint32_t>& face_component,
+                                           std::size_t components, const PointCloud& samples)
+{
+    std::vector<std::size_t> faces_of(components, 0);
+    for (const std::uint32_t c : face_component)
+        ++faces_of[c];
+    const auto largest = static_cast<std::uint32_t>(
+        std::max_element(faces_of.begin(), faces_of.end()) - faces_of.begin());
+    TriMesh large;
+    TriMesh rest;
+    for (TriMesh* part : {&large, &rest})
+    {
+        part->vertices.origin = mesh.vertices.origin;
+        part->vertices.positions = mesh.vertices.positions;
+    }
+    std::vector<std::uint32_t> rest_component;
+    for (std::size_t f = 0; f < mesh.face_count(); ++f)
+    {
+        if (face_component[f] == largest)
+        {
+            large.triangles.push_back(mesh.triangles[f]);
+        }
+        else
+        {
+            rest.triangles.push_back(mesh.triangles[f]);
+            rest_component.push_back(face_component[f]);
+        }
+    }
+    const TriangleBvh large_bvh(large);
+    const TriangleBvh rest_bvh(rest);
+    large = TriMesh{};
+    rest = TriMesh{};
+
+    constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
+    std::vector<std::uint32_t> nearest(samples.size(), none);
+    const std::vector<std::uint32_t> order = spatial_order(samples.positions);
+    parallel_blocks(order.size(), 1024, [&](std::size_t begin, std::size_t end) {
+        // The nearest point among the rest found for the sample before bounds the next search.
+        Vec3d previous = Vec3d::Constant(std::numeric_limits<double>::quiet_NaN());
+        for (std::size_t k = begin; k < end; ++k)
+        {
+            const std::uint32_t i = order[k];
+            const Vec3d p = samples.world(i);
+            const double bound = (p - previous).norm() * (1.0 + 1e-6);
+            TriangleBvh::Hit hit;
+            if (std::isfinite(bound))
+                hit = rest_bvh.closest(p, bound);
+            if (!hit.found())
+                hit = rest_bvh.closest(p);
+            if (!hit.found())
+                continue; // a non-finite sample
+            previous = hit.point;
+            nearest[i] =
+                large_bvh.any_within(p, hit.distance) ? largest : rest_component[hit.face.value];
+        }
+    });
+    std::vector<std::size_t> support(components, 0);
+    for (const std::uint32_t c : nearest)
+        if (c != none)
+            ++support[c];
+    return support;
+}
+
+} // namespace
 
 std::size_t default_min_component_samples(std::size_t samples)
 {
@@ -47,16 +123,8 @@ ComponentFilterReport remove_unsupported_components(TriMesh& mesh, const PointCl
     if (report.components < 2 || min_samples == 0 || samples.empty())
         return report;
 
-    std::vector<std::size_t> support(report.components, 0);
-    {
-        const TriangleBvh bvh(mesh);
-        std::vector<Vec3d> queries(samples.size());
-        for (std::size_t i = 0; i < samples.size(); ++i)
-            queries[i] = samples.world(i);
-        for (const TriangleBvh::Hit& hit : closest_points(bvh, queries))
-            if (hit.face.is_valid())
-                ++support[face_component[hit.face.value]];
-    }
+    const std::vector<std::size_t> support =
+        component_support(mesh, face_component, report.components, samples);
     std::vector<char> keep(report.components, 0);
     for (std::size_t c = 0; c < report.components; ++c)
         keep[c] = support[c] >= min_samples ? 1 : 0;

@@ -611,6 +611,46 @@ TriangleBvh::Hit TriangleBvh::closest(const Vec3d& world_point, double max_dista
     return hit;
 }
 
+bool TriangleBvh::any_within(const Vec3d& world_point, double distance) const
+{
+    const Vec3d p = world_point - origin_;
+    if (!p.allFinite() || !(distance > 0.0))
+        return false;
+    const double limit2 = distance * distance;
+    std::array<std::uint32_t, stack_capacity>
+        stack; // NOLINT(cppcoreguidelines-pro-type-member-init)
+    std::size_t top = 0;
+    if (box_distance2(nodes_[0], p) < limit2)
+        stack[top++] = 0;
+    while (top > 0)
+    {
+        const Node& node = nodes_[stack[--top]];
+        if (node.count > 0)
+        {
+            for (std::uint32_t i = node.index; i < node.index + node.count; ++i)
+            {
+                const Corners& k = corners_[i];
+                const Vec3d bary = closest_point_barycentric(p, k.a, k.b, k.c);
+                if ((p - (bary[0] * k.a + bary[1] * k.b + bary[2] * k.c)).squaredNorm() < limit2)
+                    return true;
+            }
+            continue;
+        }
+        const std::uint32_t left = static_cast<std::uint32_t>(&node - nodes_.data()) + 1;
+        const std::uint32_t right = node.index;
+        const double dl = box_distance2(nodes_[left], p);
+        const double dr = box_distance2(nodes_[right], p);
+        // The nearer child is visited first: its triangles are the likelier to be within.
+        const bool left_first = dl <= dr;
+        PF_ASSERT(top + 2 <= stack_capacity);
+        if ((left_first ? dr : dl) < limit2)
+            stack[top++] = left_first ? right : left;
+        if ((left_first ? dl : dr) < limit2)
+            stack[top++] = left_first ? left : right;
+    }
+    return false;
+}
+
 double TriangleBvh::distance(const Vec3d& world_point) const
 {
     return closest(world_point).distance;

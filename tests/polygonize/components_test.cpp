@@ -3,16 +3,21 @@
 
 #include "pointform/polygonize/components.h"
 
+#include "pointform/core/disjoint_sets.h"
 #include "pointform/geometry/mesh_topology.h"
 #include "pointform/geometry/shapes.h"
 #include "pointform/hermite/surfels.h"
 #include "pointform/implicit/point_field.h"
 #include "pointform/polygonize/marching_cubes.h"
+#include "pointform/spatial/triangle_bvh.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <random>
+#include <vector>
 
 namespace pointform {
 namespace {
@@ -64,6 +69,50 @@ TEST(Components, StrayClustersLeaveDebrisThatIsRemoved)
     for (const Triangle& t : mesh.triangles)
         for (const std::uint32_t v : t)
             ASSERT_LT(v, mesh.vertex_count());
+}
+
+TEST(Components, SupportIsTheNearestTrianglesCount)
+{
+    // Each component's support counted by exact closest points on the whole mesh: a threshold
+    // at a component's support keeps it, one above removes it, every other component alike.
+    const PointCloud raw = sphere_with_stray_clusters();
+    const PointField field(compute_surfels(raw, {.radius_scale = 1.5}).surfels);
+    const TriMesh mesh =
+        marching_cubes(field, grid_over(field.bounds(), default_cell_size(field))).mesh;
+    const PointCloud& samples = field.surfels();
+    DisjointSets sets(mesh.vertex_count());
+    for (const Triangle& t : mesh.triangles)
+    {
+        sets.unite(t[0], t[1]);
+        sets.unite(t[0], t[2]);
+    }
+    std::map<std::size_t, std::size_t> support; // by root
+    for (const Triangle& t : mesh.triangles)
+        support[sets.find(t[0])] += 0;
+    std::vector<Vec3d> queries;
+    for (std::size_t i = 0; i < samples.size(); ++i)
+        queries.push_back(samples.world(i));
+    for (const TriangleBvh::Hit& hit : closest_points(TriangleBvh(mesh), queries))
+        ++support[sets.find(mesh.triangles[hit.face.value][0])];
+    ASSERT_GT(support.size(), 2U);
+    std::size_t best = 0;
+    for (const auto& [root, count] : support)
+        best = std::max(best, count);
+    for (const auto& [root, count] : support)
+    {
+        if (count == best)
+            continue;
+        for (const std::size_t threshold : {count, count + 1})
+        {
+            std::size_t below = 0;
+            for (const auto& [other, other_count] : support)
+                below += other_count < threshold && other_count != best ? 1 : 0;
+            TriMesh copy = mesh;
+            EXPECT_EQ(remove_unsupported_components(copy, samples, threshold).removed_components,
+                      below)
+                << "threshold " << threshold;
+        }
+    }
 }
 
 TEST(Components, SupportedComponentsStay)

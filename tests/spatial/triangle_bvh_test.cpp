@@ -359,6 +359,24 @@ TEST(TriangleBvh, BoundsOnlyPruneTheNearestTriangles)
     EXPECT_THROW((void)nearest_triangles(bvh, cloud, std::vector<double>(3, 1.0)), InvalidInput);
 }
 
+TEST(TriangleBvh, AnyWithinAgreesWithTheClosestDistance)
+{
+    const TriMesh mesh = random_mesh(300, 600, 51);
+    const TriangleBvh bvh(mesh);
+    std::mt19937 random(52);
+    std::uniform_real_distribution<double> factor(0.0, 2.0);
+    for (const Vec3d& q : random_queries(3000, 1.5, 53))
+    {
+        const double d = bvh.closest(q).distance;
+        EXPECT_FALSE(bvh.any_within(q, d * (1.0 - 1e-9)));
+        EXPECT_TRUE(bvh.any_within(q, d * (1.0 + 1e-9) + 1e-300));
+        const double r = factor(random) * d;
+        EXPECT_EQ(bvh.any_within(q, r), d < r) << r << " " << d;
+    }
+    EXPECT_FALSE(bvh.any_within(Vec3d::Zero(), 0.0));
+    EXPECT_FALSE(bvh.any_within(Vec3d::Constant(std::nan("")), 1.0));
+}
+
 TEST(TriangleBoxDepth, AnalyticValues)
 {
     // A 20 x 20 grid of [-1, 1]²: 800 triangles whose boxes are the 0.1 x 0.1 cells, twice

@@ -78,6 +78,12 @@ public:
     [[nodiscard]] Hit closest(const Vec3d& world_point,
                               double max_distance = std::numeric_limits<double>::infinity()) const;
 
+    /// \brief Whether some triangle lies closer than `distance` (strictly) to `world_point`. The
+    /// search stops at the first such triangle, so where one is near it costs a descent to a
+    /// leaf, far less than closest(). False for a non-finite point or a distance that is not
+    /// positive.
+    [[nodiscard]] bool any_within(const Vec3d& world_point, double distance) const;
+
     /// \brief Distance from `world_point` to the mesh; shorthand for closest(p).distance.
     [[nodiscard]] double distance(const Vec3d& world_point) const;
 
