@@ -356,6 +356,11 @@ void check_options(const BaseMeshOptions& options)
         throw InvalidInput("base mesh: the boundary tolerance must be finite and >= 0, got " +
                            std::to_string(*options.boundary_tolerance));
     }
+    if (!(options.min_round_gain >= 0.0 && options.min_round_gain < 1.0))
+    {
+        throw InvalidInput("base mesh: the least gain of a shape round must be in [0, 1), got " +
+                           std::to_string(options.min_round_gain));
+    }
     if (options.max_smoothing_rounds < 0)
     {
         throw InvalidInput("base mesh: smoothing rounds must be >= 0, got " +
@@ -1327,9 +1332,10 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
                 {
                     break;
                 }
-                if (bad >= previous && round >= 2)
+                if (round >= 2 && static_cast<double>(bad) >= (1.0 - options.min_round_gain) *
+                                                                  static_cast<double>(previous))
                 {
-                    break; // no longer improving
+                    break; // no longer improving much
                 }
                 previous = bad;
                 if (options.project)

@@ -812,7 +812,7 @@ std::vector<std::uint64_t> unique_edges(std::span<const Triangle> faces)
             const std::uint64_t b = std::max(t[k], t[(k + 1) % 3]);
             edges.push_back(a << 32U | b);
         }
-    std::sort(edges.begin(), edges.end());
+    parallel_sort(edges);
     edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
     return edges;
 }

@@ -157,6 +157,27 @@ TEST(BaseMesh, SampledSphereReachesTheTargetOnTheSurface)
     }
 }
 
+TEST(BaseMesh, ShapeRoundsStopWhenTheyGainLittle)
+{
+    // Noisy samples leave triangles under the target after every round: the rounds go on while
+    // each removes a tenth of them, and stop earlier than the rule that waits for none to go,
+    // with the same topology and still few thin triangles.
+    PointCloud samples = sample_shape(Shape::Sphere, {.count = 50000, .seed = 6, .noise = 0.002});
+    samples.normals.clear();
+    const PointField field(compute_surfels(samples, {.radius_scale = 1.5}).surfels);
+    const TriMesh mc =
+        marching_cubes(field, grid_over(field.bounds(), default_cell_size(field))).mesh;
+    const BaseMeshResult some = build_base_mesh(mc, field, {.target_faces = 6000});
+    const BaseMeshResult all =
+        build_base_mesh(mc, field, {.target_faces = 6000, .min_round_gain = 0.0});
+    EXPECT_GE(some.stats.smoothing_rounds, 2);
+    EXPECT_LT(some.stats.smoothing_rounds, all.stats.smoothing_rounds);
+    EXPECT_TRUE(some.stats.topology_kept) << some.stats.topology_change;
+    EXPECT_EQ(analyze_topology(some.mesh).euler_characteristic,
+              analyze_topology(mc).euler_characteristic);
+    EXPECT_LT(share_below_20(some.mesh), 0.02);
+}
+
 TEST(BaseMesh, TargetFittedToAVertexBudget)
 {
     // F0 moves by at most a factor of two, to a value whose level J has 2·0.6·budget faces.
@@ -423,6 +444,9 @@ TEST(BaseMesh, RejectsBadTargetsAndMeshes)
     EXPECT_THROW((void)build_base_mesh(TriMesh{}, *scene.field), InvalidInput);
     EXPECT_THROW((void)build_base_mesh(scene.mc, *scene.field, {.min_angle_degrees = 70.0}),
                  InvalidInput);
+    for (const double gain : {-0.1, 1.0, std::nan("")})
+        EXPECT_THROW((void)build_base_mesh(scene.mc, *scene.field, {.min_round_gain = gain}),
+                     InvalidInput);
     // Three triangles on one edge.
     TriMesh fin;
     fin.vertices.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0), Vec3f(0, -1, 0),
