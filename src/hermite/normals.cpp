@@ -11,7 +11,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 namespace pointform {
 namespace {
@@ -183,11 +185,14 @@ Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neigh
     check_knn_table_shape(neighbors, positions.size(), "estimate_normals");
     Normals result;
     result.normals.resize(positions.size());
-    std::vector<std::uint8_t> degenerate(positions.size(), 0);
+    // Each block's degenerate samples, in order; the blocks are joined in order.
+    constexpr std::size_t block = 4096;
+    std::vector<std::vector<std::uint32_t>> degenerate((positions.size() + block - 1) / block);
     ProgressReporter reporter(progress, "normals");
     parallel_blocks(
-        positions.size(), 4096,
+        positions.size(), block,
         [&](std::size_t begin, std::size_t end) {
+            std::vector<std::uint32_t>& flat = degenerate[begin / block];
             std::array<Moments, root_group> moments;
             std::array<Cubic, root_group> cubics;
             for (std::size_t first = begin; first < end; first += root_group)
@@ -208,20 +213,19 @@ Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neigh
                     if (fast.squaredNorm() > 0.0)
                     {
                         result.normals[i] = fast.cast<float>();
-                        degenerate[i] = 0;
                         continue;
                     }
                     const LocalPlane fit = solve_plane(moments[g]);
                     result.normals[i] = fit.normal.cast<float>();
-                    degenerate[i] = fit.degenerate ? 1 : 0;
+                    if (fit.degenerate)
+                        flat.push_back(static_cast<std::uint32_t>(i));
                 }
             }
         },
         &reporter);
     reporter.finish();
-    for (std::size_t i = 0; i < degenerate.size(); ++i)
-        if (degenerate[i] != 0)
-            result.degenerate.push_back(static_cast<std::uint32_t>(i));
+    for (const std::vector<std::uint32_t>& flat : degenerate)
+        result.degenerate.insert(result.degenerate.end(), flat.begin(), flat.end());
     return result;
 }
 

@@ -322,9 +322,6 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
     // oriented normals.
     result.surfels.origin = cloud.origin;
     result.surfels.radii.resize(n);
-    //    Each sample's place in the sorted order, so that the gathers below read at random and
-    //    write in order.
-    const auto rank = std::make_unique_for_overwrite<std::uint32_t[]>(n); // every entry written
     //    Nothing throws from here on, so the owner's cloud is unchanged if anything did.
     const bool moved = owner != nullptr;
     if (moved)
@@ -339,19 +336,22 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
         result.surfels.positions.resize(n); // every entry written below, in parallel
     }
     result.surfels.normals = std::move(normals.normals);
+    //    Sample order[j] takes the sorted sample j's normal and radius: read in order, written
+    //    at random (order is a permutation, so no two blocks write one entry).
     parallel_blocks(n, gather_block, [&](std::size_t begin, std::size_t end) {
         for (std::size_t j = begin; j < end; ++j)
-            rank[order[j]] = static_cast<std::uint32_t>(j);
-    });
-    parallel_blocks(n, gather_block, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i)
         {
-            if (!moved)
-                result.surfels.positions[i] = cloud.positions[i];
-            result.surfels.normals[i] = oriented.normals[rank[i]];
-            result.surfels.radii[i] = radii[rank[i]];
+            const std::uint32_t i = order[j];
+            result.surfels.normals[i] = oriented.normals[j];
+            result.surfels.radii[i] = radii[j];
         }
     });
+    if (!moved)
+        parallel_blocks(n, gather_block, [&](std::size_t begin, std::size_t end) {
+            std::copy(cloud.positions.begin() + static_cast<std::ptrdiff_t>(begin),
+                      cloud.positions.begin() + static_cast<std::ptrdiff_t>(end),
+                      result.surfels.positions.begin() + static_cast<std::ptrdiff_t>(begin));
+        });
     // The normals are the surfels'; the report keeps the rest.
     result.orientation = std::move(oriented);
     std::vector<Vec3f>().swap(result.orientation.normals);

@@ -460,30 +460,53 @@ private:
         }
         const float guess = nearest + spread2 * spread_margin;
         float limit2 = guess > nearest && guess < reach2 ? guess : reach2;
+        // A limit that keeps more than max_ranked (and k) is halved towards the last one that
+        // kept fewer than k (below) a few times, so that the short ranking serves most queries
+        // whose guess was poor (the first of a run, or one far from the samples, where the
+        // guess passes the reach). Any limit that keeps k gives the same k smallest keys.
+        float below = nearest;
+        float above = 0.0F; // the last limit that kept too many, if narrowed
+        int narrowed = 0;
         while (true)
         {
             const std::size_t kept = gather(used, slot_of, limit2);
-            if (kept >= k)
+            if (kept >= k && kept <= max_ranked)
             {
-                if (kept <= max_ranked)
-                {
-                    rank_smallest(kept, k, slots, d2);
-                }
-                else
-                {
-                    for (std::size_t j = 0; j < kept; ++j)
-                    {
-                        keys_[j] = key_of(packed_d2_[j], packed_slot_[j]);
-                    }
-                    // take_smallest() is baseline code: leave the upper halves of the
-                    // vector registers clean for it (GCC 12 does not here), or on some CPUs
-                    // every SSE instruction after this pass runs several times slower.
-                    _mm256_zeroupper();
-                    take_smallest(keys_.data(), kept, k, slots, d2);
-                }
+                rank_smallest(kept, k, slots, d2);
                 return Outcome::found;
             }
-            // Fewer than k within the limit (so it is below the reach): twice as wide.
+            if (kept >= k)
+            {
+                const float half = below + 0.5F * (limit2 - below);
+                if (k <= max_ranked && narrowed < max_narrowed && half > below && half < limit2)
+                {
+                    above = limit2;
+                    limit2 = half;
+                    ++narrowed;
+                    continue;
+                }
+                for (std::size_t j = 0; j < kept; ++j)
+                {
+                    keys_[j] = key_of(packed_d2_[j], packed_slot_[j]);
+                }
+                // take_smallest() is baseline code: leave the upper halves of the vector
+                // registers clean for it (GCC 12 does not here), or on some CPUs every SSE
+                // instruction after this pass runs several times slower.
+                _mm256_zeroupper();
+                take_smallest(keys_.data(), kept, k, slots, d2);
+                return Outcome::found;
+            }
+            // Fewer than k within the limit (so it is below the reach): halfway to the limit
+            // that kept too many, or, none known, twice as wide (at most the reach, within
+            // which k are).
+            below = limit2;
+            if (narrowed > 0)
+            {
+                const float half = below + 0.5F * (above - below);
+                limit2 = narrowed < max_narrowed && half > below && half < above ? half : above;
+                ++narrowed;
+                continue;
+            }
             const float wider = nearest + 2.0F * (limit2 - nearest);
             limit2 = wider > limit2 && wider < reach2 ? wider : reach2;
         }
@@ -599,6 +622,8 @@ private:
     static constexpr std::size_t capacity = 1024; ///< Within's
     static constexpr std::size_t buffered = 2048;
     static constexpr std::size_t max_ranked = 24;
+    /// How many times pick() may halve a limit that keeps more than max_ranked.
+    static constexpr int max_narrowed = 4;
     /// Every point's squared distance and slot (+ 8: the loops write whole vectors).
     std::array<float, buffered + 8> d2_;
     std::array<std::uint32_t, buffered + 8> slot_;
@@ -606,6 +631,117 @@ private:
     std::array<std::uint32_t, capacity + 8> packed_slot_;
     std::array<std::uint64_t, capacity + 8> keys_;
 };
+
+/// What the wide knn_nearby() keeps from query to query: the cells and octant blocks looked up
+/// last (direct-mapped by their coordinates: coherent queries come back to them), the
+/// selection's buffers, and the last query's spread from its nearest to its k-th (a guess for
+/// the next, which sets only how many points are sorted).
+struct PointGrid::Lookup
+{
+    struct CachedCell
+    {
+        std::uint64_t key = ~std::uint64_t{0}; ///< never a cell's
+        Range range;
+    };
+
+    /// Forgets everything looked up (in another grid, or in none yet).
+    void reset(std::uint64_t grid_id)
+    {
+        grid = grid_id;
+        for (CachedCell& cell : cells)
+        {
+            cell.key = ~std::uint64_t{0};
+        }
+        for (Selection::Block& block : blocks)
+        {
+            block.valid = false;
+        }
+        spread2 = std::numeric_limits<float>::quiet_NaN();
+    }
+
+    std::uint64_t grid = 0;
+    std::array<CachedCell, 512> cells;
+    std::array<Selection::Block, 8> blocks;
+    std::array<Range, 27> ranges;
+    Selection selection;
+    float spread2 = std::numeric_limits<float>::quiet_NaN();
+};
+
+std::size_t PointGrid::wide_nearby(const Vec3f& query, const Placement& place, std::size_t k,
+                                   Lookup& lookup, std::uint32_t* slot, float* d2) const
+{
+    const std::size_t want = std::min(k, count_);
+    const auto range_at = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+        if (x < 0 || y < 0 || z < 0 || x >= dims_ || y >= dims_ || z >= dims_)
+        {
+            return Range{};
+        }
+        const std::uint64_t key = packed(x, y, z);
+        Lookup::CachedCell& cached =
+            lookup.cells[static_cast<std::size_t>((x & 7) | ((y & 7) << 3) | ((z & 7) << 6))];
+        if (cached.key != key)
+        {
+            cached.key = key;
+            cached.range = cell_range(x, y, z);
+        }
+        return cached.range;
+    };
+    std::array<Range, 27>& ranges = lookup.ranges;
+    const auto octant_cells = [&] {
+        for (std::size_t j = 0; j < 8; ++j)
+        {
+            ranges[j] = range_at(place.low[0] + static_cast<std::int64_t>(j & 1U),
+                                 place.low[1] + static_cast<std::int64_t>((j >> 1U) & 1U),
+                                 place.low[2] + static_cast<std::int64_t>((j >> 2U) & 1U));
+        }
+        return std::span<const Range>(ranges.data(), 8);
+    };
+    const float octant = place.octant_reach * cell_;
+    Selection::Block* block = &lookup.blocks[static_cast<std::size_t>(
+        (place.low[0] + 3 * place.low[1] + 5 * place.low[2]) & 7)];
+    if ((!block->valid || block->low != place.low) &&
+        !block->fill(place.low, octant_cells(), xs_.data(), ys_.data(), zs_.data()))
+    {
+        block = nullptr;
+    }
+    Selection& selection = lookup.selection;
+    auto outcome =
+        block != nullptr
+            ? selection.run(*block, query, want, octant * octant, lookup.spread2, slot, d2)
+            : selection.run(octant_cells(), query, want, octant * octant, lookup.spread2,
+                            xs_.data(), ys_.data(), zs_.data(), slot, d2);
+    if (outcome == Selection::Outcome::fewer)
+    {
+        std::size_t j = 0;
+        for (std::int64_t z = place.cell[2] - 1; z <= place.cell[2] + 1; ++z)
+        {
+            for (std::int64_t y = place.cell[1] - 1; y <= place.cell[1] + 1; ++y)
+            {
+                for (std::int64_t x = place.cell[0] - 1; x <= place.cell[0] + 1; ++x)
+                {
+                    ranges[j++] = range_at(x, y, z);
+                }
+            }
+        }
+        const float ring = (1.0F + place.ring_reach) * cell_;
+        outcome = selection.run(ranges, query, want, ring * ring, lookup.spread2, xs_.data(),
+                                ys_.data(), zs_.data(), slot, d2);
+    }
+    std::size_t found = 0;
+    if (outcome == Selection::Outcome::too_large)
+    {
+        found = knn_within(query, want, std::span(slot, want), std::span(d2, want));
+    }
+    else if (outcome == Selection::Outcome::found)
+    {
+        found = want;
+    }
+    if (found != 0)
+    {
+        lookup.spread2 = d2[want - 1] - d2[0];
+    }
+    return found;
+}
 
 #endif // PF_GRID_AVX2
 
@@ -790,6 +926,33 @@ std::size_t PointGrid::knn_nearby(const Vec3f& query, std::size_t k, std::span<s
     {
         return 0;
     }
+#if PF_GRID_AVX2
+    if (k <= max_k && has_avx2())
+    {
+        // Each thread keeps its lookups from query to query (coherent queries, such as the
+        // steps of a projection along a line, come back to the same cells).
+        thread_local std::unique_ptr<Lookup> lookup;
+        if (!lookup)
+        {
+            lookup = std::make_unique_for_overwrite<Lookup>();
+            lookup->reset(id_);
+        }
+        if (lookup->grid != id_)
+        {
+            lookup->reset(id_);
+        }
+        Placement place;
+        return placed(query, place)
+                   ? wide_nearby(query, place, k, *lookup, slots.data(), squared_distances.data())
+                   : 0;
+    }
+#endif
+    return knn_within(query, k, slots, squared_distances);
+}
+
+std::size_t PointGrid::knn_within(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
+                                  std::span<float> squared_distances) const
+{
     Placement place;
     if (k <= max_k && placed(query, place))
     {
@@ -891,45 +1054,12 @@ void PointGrid::knn_nearby(std::span<const Vec3f> queries, std::size_t k,
     // Each query gets Within's answer for the same passes as knn_nearby() (the octant block
     // with its reach, then the 3 × 3 × 3 block with its), only found faster (Selection), so the
     // answers are the same whatever the order of the queries and the guesses.
-    // The cells that coherent queries look up come back again and again: the last ones looked
-    // up are kept in a small table, direct-mapped by their coordinates modulo 8.
+    // The lookups are kept from query to query: coherent queries come back to the same cells.
     constexpr std::size_t run = 32;
     std::array<Placement, run> places;
     std::array<bool, run> placed_ok{};
-    struct CachedCell
-    {
-        std::uint64_t key = ~std::uint64_t{0}; ///< never a cell's
-        Range range;
-    };
-    auto cell_store = std::make_unique<std::array<CachedCell, 512>>();
-    std::array<CachedCell, 512>& cells = *cell_store;
-    const auto range_at = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-        if (x < 0 || y < 0 || z < 0 || x >= dims_ || y >= dims_ || z >= dims_)
-        {
-            return Range{};
-        }
-        const std::uint64_t key = packed(x, y, z);
-        CachedCell& cached =
-            cells[static_cast<std::size_t>((x & 7) | ((y & 7) << 3) | ((z & 7) << 6))];
-        if (cached.key != key)
-        {
-            cached.key = key;
-            cached.range = cell_range(x, y, z);
-        }
-        return cached.range;
-    };
-    auto selection = std::make_unique_for_overwrite<Selection>();
-    // Coherent queries come back to a few octant blocks: the last few are kept gathered
-    // (direct-mapped by their position).
-    auto block_store = std::make_unique_for_overwrite<std::array<Selection::Block, 8>>();
-    std::array<Selection::Block, 8>& blocks = *block_store;
-    for (Selection::Block& block : blocks)
-    {
-        block.valid = false;
-    }
-    std::array<Range, 27> ranges;
-    // The last query's k-th squared distance minus its nearest's: about the next one's.
-    float spread2 = std::numeric_limits<float>::quiet_NaN();
+    const auto lookup = std::make_unique_for_overwrite<Lookup>(); // reset() sets what is read
+    lookup->reset(id_);
     for (std::size_t start = 0; start < n;)
     {
         const std::size_t end = std::min(n, start + run);
@@ -939,67 +1069,11 @@ void PointGrid::knn_nearby(std::span<const Vec3f> queries, std::size_t k,
         }
         for (std::size_t i = start; i < end; ++i)
         {
-            found[i] = 0;
-            if (!placed_ok[i - start])
-            {
-                continue;
-            }
-            const Placement& place = places[i - start];
-            const Vec3f& query = queries[i];
-            std::uint32_t* slot = slots.data() + i * k;
-            float* d2 = squared_distances.data() + i * k;
-            const auto octant_cells = [&] {
-                for (std::size_t j = 0; j < 8; ++j)
-                {
-                    ranges[j] = range_at(place.low[0] + static_cast<std::int64_t>(j & 1U),
-                                         place.low[1] + static_cast<std::int64_t>((j >> 1U) & 1U),
-                                         place.low[2] + static_cast<std::int64_t>((j >> 2U) & 1U));
-                }
-                return std::span<const Range>(ranges.data(), 8);
-            };
-            const float octant = place.octant_reach * cell_;
-            Selection::Block* block = &blocks[static_cast<std::size_t>(
-                (place.low[0] + 3 * place.low[1] + 5 * place.low[2]) & 7)];
-            if ((!block->valid || block->low != place.low) &&
-                !block->fill(place.low, octant_cells(), xs_.data(), ys_.data(), zs_.data()))
-            {
-                block = nullptr;
-            }
-            auto outcome =
-                block != nullptr
-                    ? selection->run(*block, query, want, octant * octant, spread2, slot, d2)
-                    : selection->run(octant_cells(), query, want, octant * octant, spread2,
-                                     xs_.data(), ys_.data(), zs_.data(), slot, d2);
-            if (outcome == Selection::Outcome::fewer)
-            {
-                std::size_t j = 0;
-                for (std::int64_t z = place.cell[2] - 1; z <= place.cell[2] + 1; ++z)
-                {
-                    for (std::int64_t y = place.cell[1] - 1; y <= place.cell[1] + 1; ++y)
-                    {
-                        for (std::int64_t x = place.cell[0] - 1; x <= place.cell[0] + 1; ++x)
-                        {
-                            ranges[j++] = range_at(x, y, z);
-                        }
-                    }
-                }
-                const float ring = (1.0F + place.ring_reach) * cell_;
-                outcome = selection->run(ranges, query, want, ring * ring, spread2, xs_.data(),
-                                         ys_.data(), zs_.data(), slot, d2);
-            }
-            if (outcome == Selection::Outcome::too_large)
-            {
-                found[i] = static_cast<std::uint32_t>(
-                    knn_nearby(query, k, std::span(slot, k), std::span(d2, k)));
-            }
-            else if (outcome == Selection::Outcome::found)
-            {
-                found[i] = static_cast<std::uint32_t>(want);
-            }
-            if (found[i] != 0)
-            {
-                spread2 = d2[want - 1] - d2[0];
-            }
+            found[i] = placed_ok[i - start]
+                           ? static_cast<std::uint32_t>(wide_nearby(
+                                 queries[i], places[i - start], k, *lookup, slots.data() + i * k,
+                                 squared_distances.data() + i * k))
+                           : 0;
         }
         start = end;
     }

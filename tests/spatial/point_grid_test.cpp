@@ -214,6 +214,103 @@ TEST(PointGrid, BatchAnswersAsOneByOneInAnyOrder)
     }
 }
 
+/// The k smallest (squared distance, slot) keys of every point of the grid, the distance
+/// summed as the grid sums it ((x − q)² + (y − q)² + (z − q)², in float, in that order).
+std::vector<std::uint32_t> smallest_slots(const PointGrid& grid, std::span<const Vec3f> points,
+                                          const Vec3f& q, std::size_t k)
+{
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> keys;
+    for (std::uint32_t slot = 0; slot < grid.slot_count(); ++slot)
+    {
+        const std::uint32_t index = grid.original_index(slot);
+        if (index == PointGrid::padding_slot)
+        {
+            continue;
+        }
+        const float dx = points[index].x() - q.x();
+        const float dy = points[index].y() - q.y();
+        const float dz = points[index].z() - q.z();
+        const float xx = dx * dx;
+        const float yy = dy * dy;
+        const float zz = dz * dz;
+        keys.emplace_back(std::bit_cast<std::uint32_t>((xx + yy) + zz), slot);
+    }
+    std::partial_sort(keys.begin(), keys.begin() + static_cast<std::ptrdiff_t>(k), keys.end());
+    std::vector<std::uint32_t> slots;
+    for (std::size_t j = 0; j < k; ++j)
+    {
+        slots.push_back(keys[j].second);
+    }
+    return slots;
+}
+
+TEST(PointGrid, AnswersAreTheExactSmallestKeysWhateverCameBefore)
+{
+    // Whatever the grid answers, one by one (which keeps what it looked up from one query to
+    // the next) or in a batch, is the k smallest (distance, slot) keys of all its points, bit
+    // for bit: queries on and off a sphere, in Morton order and at random, far ones among them
+    // (where the guess from the last query fails and the selection narrows or widens), for k
+    // on both sides of the short ranking's limit.
+    const PointCloud cloud = sample_shape(Shape::Sphere, {.count = 5000, .seed = 9});
+    const KdTree tree(cloud.positions);
+    std::mt19937_64 rng(21);
+    std::normal_distribution<float> gauss;
+    std::uniform_real_distribution<float> shell(-2.0F, 2.0F); // in cells
+    std::vector<Vec3f> directions(600);
+    std::vector<float> offsets(directions.size());
+    for (std::size_t i = 0; i < directions.size(); ++i)
+    {
+        directions[i] = Vec3f(gauss(rng), gauss(rng), gauss(rng)).normalized();
+        offsets[i] = shell(rng);
+    }
+    for (const std::size_t k : {2U, 9U, 17U, 24U, 25U, 40U})
+    {
+        // Cells as a point field sizes them for k neighbours.
+        std::vector<std::uint32_t> index(k);
+        std::vector<float> d2(k);
+        tree.knn(cloud.positions[0], k, index, d2);
+        const float cell = 2.5F * std::sqrt(d2[k - 1]);
+        const PointGrid grid(cloud.positions, cell, tree);
+        std::vector<Vec3f> queries(directions.size());
+        for (std::size_t i = 0; i < queries.size(); ++i)
+        {
+            queries[i] = directions[i] * (1.0F + offsets[i] * cell);
+        }
+        const std::vector<std::uint32_t> order = spatial_order(queries);
+        std::vector<Vec3f> coherent(queries.size());
+        for (std::size_t i = 0; i < order.size(); ++i)
+        {
+            coherent[i] = queries[order[i]];
+        }
+        for (const std::vector<Vec3f>* run : {&coherent, &queries})
+        {
+            std::vector<std::uint32_t> slots(run->size() * k);
+            std::vector<float> batch_d2(run->size() * k);
+            std::vector<std::uint32_t> found(run->size());
+            grid.knn_nearby(*run, k, slots, batch_d2, found);
+            std::size_t answered = 0;
+            for (std::size_t i = 0; i < run->size(); ++i)
+            {
+                std::vector<std::uint32_t> single(k);
+                std::vector<float> single_d2(k);
+                const std::size_t count = grid.knn_nearby((*run)[i], k, single, single_d2);
+                ASSERT_EQ(count, found[i]) << "query " << i << " k " << k;
+                if (count == 0)
+                {
+                    continue;
+                }
+                ++answered;
+                const std::vector<std::uint32_t> truth =
+                    smallest_slots(grid, cloud.positions, (*run)[i], k);
+                ASSERT_EQ(single, truth) << "query " << i << " k " << k;
+                ASSERT_TRUE(std::equal(truth.begin(), truth.end(), slots.begin() + i * k))
+                    << "query " << i << " k " << k;
+            }
+            EXPECT_GT(answered, run->size() / 3) << "k " << k;
+        }
+    }
+}
+
 TEST(PointGrid, BatchHandlesTiesCrowdsAndQueriesItCannotPlace)
 {
     // A lattice (ties everywhere), with a pile of duplicates in one cell (more than a pass

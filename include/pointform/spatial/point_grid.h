@@ -89,6 +89,7 @@ private:
     class Within;
     class Selection;
     struct OctantCache;
+    struct Lookup;
     /// Where a query falls: its cell, its octant block (the 2 × 2 × 2 cells from low to low + 1
     /// on each axis) and, in cells, the distance within which every point is in the octant
     /// block (octant_reach), and in the 3 × 3 × 3 block around the cell, minus 1 (ring_reach).
@@ -105,6 +106,13 @@ private:
 
     std::size_t knn_far(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
                         std::span<float> squared_distances) const;
+    /// knn_nearby() by Within alone (k at most the point count).
+    std::size_t knn_within(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
+                           std::span<float> squared_distances) const;
+    /// knn_nearby() of one placed query with AVX2 (Selection), `lookup` kept from the last
+    /// query of this grid; `slot` and `d2` hold k entries.
+    std::size_t wide_nearby(const Vec3f& query, const Placement& place, std::size_t k,
+                            Lookup& lookup, std::uint32_t* slot, float* d2) const;
     [[nodiscard]] Range cell_range(std::int64_t x, std::int64_t y, std::int64_t z) const;
 
     const KdTree* fallback_;
