@@ -9,6 +9,8 @@
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/spatial_sort.h"
 
+#include "orientation_detail.h"
+
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
@@ -258,7 +260,8 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
         {
             const std::size_t graph_k =
                 options.graph_k == 0 ? std::min<std::size_t>(options.k, 10) : options.graph_k;
-            oriented = orient_normals_mst(
+            // estimate_normals() checked every row of the table.
+            oriented = detail::orient_checked_table(
                 positions, normals.normals, table,
                 {.k = graph_k, .rule = options.rule, .progress = options.progress});
             if (options.orient == OrientMode::Flip)
