@@ -718,35 +718,77 @@ OmMesh to_openmesh(const TriMesh& mesh)
 /// Passes of edge flips until one flips nothing (at most 10): every interior edge that OpenMesh
 /// can flip and whose ends keep their lowest valence (an interior vertex three, a boundary one
 /// two) is offered to `flip` with its quad: the edge a-b, its triangles a-b-c and b-a-d (so a
-/// flip makes a-d-c and d-b-c). \return the flips made
+/// flip makes a-d-c and d-b-c). `flip` must be a function of the quad's positions alone, safe to
+/// call from several threads. \return the flips made
+///
+/// Flips change the connectivity only, so `flip` says the same of a quad until one of its
+/// triangles changes: each pass first asks it, in parallel, about every edge whose quad is not
+/// the one last asked about (all of them in the first pass), then walks the edges in order,
+/// asking again only about those whose quad a flip of this pass changed. The flips are those of
+/// one walk that asks about every edge.
 template <class Decide>
 std::size_t flip_passes(OmMesh& mesh, Decide&& flip)
 {
     constexpr int max_passes = 10;
+    using Quad = std::array<int, 4>;
+    struct Decision
+    {
+        Quad quad{-1, -1, -1, -1}; ///< no edge's
+        bool flip = false;
+    };
+    const std::size_t edges = mesh.n_edges();
+    std::vector<Decision> decided(edges);
+    const auto interior = [&mesh](OmMesh::EdgeHandle e) {
+        return !(mesh.has_edge_status() && mesh.status(e).deleted()) && !mesh.is_boundary(e);
+    };
+    const auto quad_of = [&mesh](OmMesh::EdgeHandle e) {
+        const auto h = mesh.halfedge_handle(e, 0);
+        const auto o = mesh.opposite_halfedge_handle(h);
+        return Quad{mesh.from_vertex_handle(h).idx(), mesh.to_vertex_handle(h).idx(),
+                    mesh.to_vertex_handle(mesh.next_halfedge_handle(h)).idx(),
+                    mesh.to_vertex_handle(mesh.next_halfedge_handle(o)).idx()};
+    };
+    const auto point = [&mesh](int v) {
+        return to_eigen(mesh.point(OmMesh::VertexHandle(v)));
+    };
+    const auto decide = [&](std::size_t i) {
+        const Quad quad = quad_of(OmMesh::EdgeHandle(static_cast<int>(i)));
+        if (decided[i].quad != quad)
+        {
+            decided[i] = {quad,
+                          flip(point(quad[0]), point(quad[1]), point(quad[2]), point(quad[3]))};
+        }
+        return decided[i].flip;
+    };
     std::size_t flips = 0;
     for (int pass = 0; pass < max_passes; ++pass)
     {
+        parallel_blocks(edges, 1024, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                if (interior(OmMesh::EdgeHandle(static_cast<int>(i))))
+                {
+                    decide(i);
+                }
+            }
+        });
         std::size_t flips_this_pass = 0;
         for (const auto e : mesh.edges())
         {
-            if (mesh.is_boundary(e))
+            if (!interior(e))
             {
                 continue;
             }
             const auto h = mesh.halfedge_handle(e, 0);
-            const auto o = mesh.opposite_halfedge_handle(h);
             const auto a = mesh.from_vertex_handle(h);
             const auto b = mesh.to_vertex_handle(h);
-            const auto c = mesh.to_vertex_handle(mesh.next_halfedge_handle(h));
-            const auto d = mesh.to_vertex_handle(mesh.next_halfedge_handle(o));
             const auto lowest = [&mesh](OmMesh::VertexHandle v) {
                 return mesh.is_boundary(v) ? 2U : 3U;
             };
             // The wanted flips are few: the geometry decides first, the connectivity's walks
             // around the vertices (the same conditions, so the same flips) only for those.
-            if (flip(to_eigen(mesh.point(a)), to_eigen(mesh.point(b)), to_eigen(mesh.point(c)),
-                     to_eigen(mesh.point(d))) &&
-                mesh.is_flip_ok(e) && mesh.valence(a) > lowest(a) && mesh.valence(b) > lowest(b))
+            if (decide(static_cast<std::size_t>(e.idx())) && mesh.is_flip_ok(e) &&
+                mesh.valence(a) > lowest(a) && mesh.valence(b) > lowest(b))
             {
                 mesh.flip(e);
                 ++flips_this_pass;
