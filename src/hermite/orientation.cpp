@@ -783,6 +783,16 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
     return forest;
 }
 
+/// Throws unless there are as many normals and neighbour rows as positions.
+void check_sizes(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
+                 const KnnTable& neighbors)
+{
+    if (normals.size() != positions.size() || neighbors.rows() != positions.size())
+        throw InvalidInput("orientation: " + std::to_string(positions.size()) + " points, " +
+                           std::to_string(normals.size()) + " normals and " +
+                           std::to_string(neighbors.rows()) + " neighbour rows must agree");
+}
+
 } // namespace
 
 RiemannianForest riemannian_spanning_forest(std::span<const Vec3f> positions,
@@ -790,10 +800,7 @@ RiemannianForest riemannian_spanning_forest(std::span<const Vec3f> positions,
                                             const KnnTable& neighbors,
                                             const OrientationOptions& options)
 {
-    if (normals.size() != positions.size() || neighbors.rows() != positions.size())
-        throw InvalidInput("orientation: " + std::to_string(positions.size()) + " points, " +
-                           std::to_string(normals.size()) + " normals and " +
-                           std::to_string(neighbors.rows()) + " neighbour rows must agree");
+    check_sizes(positions, normals, neighbors);
     check_knn_table(neighbors, positions.size(), positions.size(), "orientation");
     return spanning_forest(positions, normals, Guide{}, neighbors, options);
 }
@@ -1745,10 +1752,7 @@ OrientedNormals orient_normals_mst(std::span<const Vec3f> positions,
                                    std::span<const Vec3f> fine_normals, const KnnTable& neighbors,
                                    const OrientationOptions& options)
 {
-    if (fine_normals.size() != positions.size() || neighbors.rows() != positions.size())
-        throw InvalidInput("orientation: " + std::to_string(positions.size()) + " points, " +
-                           std::to_string(fine_normals.size()) + " normals and " +
-                           std::to_string(neighbors.rows()) + " neighbour rows must agree");
+    check_sizes(positions, fine_normals, neighbors);
     check_knn_table(neighbors, positions.size(), positions.size(), "orientation");
     return detail::orient_checked_table(positions, fine_normals, neighbors, options);
 }
@@ -1758,10 +1762,7 @@ OrientedNormals detail::orient_checked_table(std::span<const Vec3f> positions,
                                              const KnnTable& neighbors,
                                              const OrientationOptions& options)
 {
-    if (fine_normals.size() != positions.size() || neighbors.rows() != positions.size())
-        throw InvalidInput("orientation: " + std::to_string(positions.size()) + " points, " +
-                           std::to_string(fine_normals.size()) + " normals and " +
-                           std::to_string(neighbors.rows()) + " neighbour rows must agree");
+    check_sizes(positions, fine_normals, neighbors);
     // On noisy clouds, orientation follows normals at a coarser scale and hands their signs to
     // the samples' own normals at the end. Edges that jump between sheets (Guide::jumps()) pass
     // no orientation.
