@@ -934,8 +934,7 @@ std::size_t PointGrid::knn_nearby(const Vec3f& query, std::size_t k, std::span<s
         thread_local std::unique_ptr<Lookup> lookup;
         if (!lookup)
         {
-            lookup = std::make_unique_for_overwrite<Lookup>();
-            lookup->reset(id_);
+            lookup = std::make_unique_for_overwrite<Lookup>(); // grid 0: no grid's, reset below
         }
         if (lookup->grid != id_)
         {
