@@ -8,6 +8,7 @@
 #include "pointform/geometry/level_topology.h"
 #include "pointform/polygonize/projection.h"
 #include "pointform/spatial/kd_tree.h"
+#include "pointform/spatial/spatial_sort.h"
 #include "pointform/spatial/triangle_bvh.h"
 
 #include <algorithm>
@@ -260,7 +261,8 @@ struct NearestHint
 
 Distances distances_from(const PointCloud& samples, const MultiresMesh& mesh,
                          std::span<const Triangle> faces, std::size_t level,
-                         const ProgressCallback& progress, const NearestHint& hint = {})
+                         const ProgressCallback& progress, const NearestHint& hint = {},
+                         std::span<const std::uint32_t> order = {})
 {
     TriMesh surface;
     surface.vertices.origin = mesh.origin();
@@ -299,7 +301,8 @@ Distances distances_from(const PointCloud& samples, const MultiresMesh& mesh,
             }
         });
     }
-    NearestTriangles nearest = nearest_triangles(bvh, samples, bounds, {.progress = progress});
+    NearestTriangles nearest =
+        nearest_triangles(bvh, samples, bounds, {.progress = progress, .order = order});
     std::vector<double>& d = nearest.distances;
     Distances out;
     double sum = 0.0;
@@ -718,7 +721,8 @@ namespace {
 /// refine_once(); `nearest` (null, or every sample's closest face on the finest level before)
 /// bounds the distance searches and becomes the new level's.
 RefineLevelStats refine_level(MultiresMesh& mesh, const Field& field, const RefineOptions& options,
-                              const PointCloud* samples, std::vector<std::uint32_t>* nearest)
+                              const PointCloud* samples, std::vector<std::uint32_t>* nearest,
+                              std::span<const std::uint32_t> order = {})
 {
     check_options(options);
     if (mesh.level_count() == 0)
@@ -748,7 +752,8 @@ RefineLevelStats refine_level(MultiresMesh& mesh, const Field& field, const Refi
                 },
                 {.faces = nearest != nullptr ? std::span<const std::uint32_t>(*nearest)
                                              : std::span<const std::uint32_t>(),
-                 .children = true});
+                 .children = true},
+                order);
             if (nearest != nullptr)
                 *nearest = std::move(d.nearest);
             stats.hausdorff = d.hausdorff;
@@ -990,11 +995,13 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
     }
     report.sampling_density = options.sampling_density > 0.0 ? options.sampling_density
                                                              : estimate_sampling_density(samples);
+    // Every level is measured from the same samples: sorted along the Morton curve once.
+    const std::vector<std::uint32_t> order = spatial_order(samples.positions);
+    const ProgressCallback distance_progress = [&](std::string_view, double fraction) {
+        return !options.progress || options.progress("refine: distance", fraction);
+    };
     Distances initial = distances_from(samples, mesh, mesh.faces(mesh.finest_level()),
-                                       mesh.finest_level(), [&](std::string_view, double fraction) {
-                                           return !options.progress ||
-                                                  options.progress("refine: distance", fraction);
-                                       });
+                                       mesh.finest_level(), distance_progress, {}, order);
     report.initial_hausdorff = initial.hausdorff;
     report.initial_mean_distance = initial.mean;
     report.initial_robust_distance = initial.robust;
@@ -1013,6 +1020,36 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
     if (initial.hausdorff < report.sampling_density)
         report.paper_level = 0;
     double hausdorff = initial.hausdorff;
+    // The automatic stop reads no distance from the samples: it measures a level once the next
+    // one's stop test has run, so that a level which then ends on noise is measured once, after
+    // its smoothing. `nearest` stays on the level below until then (its children bound the
+    // searches).
+    bool unmeasured = false;
+    const auto measure = [&](std::span<const Triangle> faces, bool children) {
+        const auto start = std::chrono::steady_clock::now();
+        Distances d = distances_from(samples, mesh, faces, mesh.finest_level(), distance_progress,
+                                     {.faces = nearest, .children = children}, order);
+        nearest = std::move(d.nearest);
+        unmeasured = false;
+        if (report.levels.empty())
+        {
+            report.initial_hausdorff = d.hausdorff;
+            report.initial_mean_distance = d.mean;
+            report.initial_robust_distance = d.robust;
+            report.initial_p90_distance = d.p90;
+            return;
+        }
+        RefineLevelStats& finest = report.levels.back();
+        finest.hausdorff = d.hausdorff;
+        finest.mean_distance = d.mean;
+        finest.robust_distance = d.robust;
+        finest.p90_distance = d.p90;
+        finest.seconds +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        hausdorff = d.hausdorff;
+        if (!report.paper_level && hausdorff < report.sampling_density)
+            report.paper_level = finest.level - start_level;
+    };
     while (true)
     {
         if (options.stop_rule == StopRule::Paper && hausdorff < report.sampling_density)
@@ -1054,8 +1091,16 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
                 break;
             }
         }
+        if (automatic)
+        {
+            if (unmeasured)
+                measure(mesh.faces(mesh.finest_level()), true);
+            report.levels.push_back(refine_level(mesh, field, options, nullptr, nullptr));
+            unmeasured = true;
+            continue;
+        }
         // A level dropped by the paper's rule leaves `nearest` on it; its rule stops then.
-        RefineLevelStats stats = refine_level(mesh, field, options, &samples, &nearest);
+        RefineLevelStats stats = refine_level(mesh, field, options, &samples, &nearest, order);
         const double previous_hausdorff = hausdorff;
         hausdorff = *stats.hausdorff;
         if (!report.paper_level && hausdorff < report.sampling_density)
@@ -1075,28 +1120,10 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
         const std::vector<Triangle> faces = mesh.faces(mesh.finest_level());
         report.denoise_rounds = options.denoise_rounds;
         report.denoise_max_move = denoise_finest(mesh, faces, options.denoise_rounds);
-        const Distances after = distances_from(
-            samples, mesh, faces, mesh.finest_level(),
-            [&](std::string_view, double fraction) {
-                return !options.progress || options.progress("refine: distance", fraction);
-            },
-            {.faces = nearest, .children = false});
-        if (report.levels.empty())
-        {
-            report.initial_hausdorff = after.hausdorff;
-            report.initial_mean_distance = after.mean;
-            report.initial_robust_distance = after.robust;
-            report.initial_p90_distance = after.p90;
-        }
-        else
-        {
-            RefineLevelStats& finest = report.levels.back();
-            finest.hausdorff = after.hausdorff;
-            finest.mean_distance = after.mean;
-            finest.robust_distance = after.robust;
-            finest.p90_distance = after.p90;
-        }
+        measure(faces, unmeasured);
     }
+    else if (unmeasured)
+        measure(mesh.faces(mesh.finest_level()), true);
     return report;
 }
 

@@ -663,16 +663,24 @@ namespace {
 /// 1.1M triangles, 1M queries in random order ran twice as fast). The runs are fixed whatever
 /// the thread count.
 template <class Body>
-void in_spatial_order(std::span<const Vec3f> positions, const ProgressCallback& callback,
+void in_spatial_order(std::span<const Vec3f> positions, const ClosestPointOptions& options,
                       const Body& body)
 {
-    const std::vector<std::uint32_t> order = spatial_order(positions);
-    ProgressReporter progress(callback, "point-to-mesh distance");
+    std::vector<std::uint32_t> sorted;
+    std::span<const std::uint32_t> order = options.order;
+    if (order.empty())
+    {
+        sorted = spatial_order(positions);
+        order = sorted;
+    }
+    else if (order.size() != positions.size() ||
+             *std::max_element(order.begin(), order.end()) >= positions.size())
+        throw InvalidInput("closest points: the order given is not one of the " +
+                           std::to_string(positions.size()) + " queries");
+    ProgressReporter progress(options.progress, "point-to-mesh distance");
     parallel_blocks(
         order.size(), query_block,
-        [&](std::size_t begin, std::size_t end) {
-            body(std::span<const std::uint32_t>(order).subspan(begin, end - begin));
-        },
+        [&](std::size_t begin, std::size_t end) { body(order.subspan(begin, end - begin)); },
         &progress);
     progress.finish();
 }
@@ -690,7 +698,7 @@ std::vector<TriangleBvh::Hit> closest_points(const TriangleBvh& bvh, std::span<c
     });
     // The closest point found for the query before bounds the next one's search, as in
     // nearest_triangles(): the same hits as unbounded searches.
-    in_spatial_order(near_origin, options.progress, [&](std::span<const std::uint32_t> run) {
+    in_spatial_order(near_origin, options, [&](std::span<const std::uint32_t> run) {
         Vec3d previous = Vec3d::Constant(std::numeric_limits<double>::quiet_NaN());
         for (const std::uint32_t i : run)
         {
@@ -720,7 +728,7 @@ void nearest_of(const TriangleBvh& bvh, const PointCloudView& points,
     // are neighbours), and so does the caller's bound where it is smaller. A bound that admits
     // some triangle admits the nearest, so each distance is the one an unbounded search gives,
     // bit for bit; one that admits none falls back to the unbounded search.
-    in_spatial_order(points.positions, options.progress, [&](std::span<const std::uint32_t> run) {
+    in_spatial_order(points.positions, options, [&](std::span<const std::uint32_t> run) {
         Vec3d previous = Vec3d::Constant(std::numeric_limits<double>::quiet_NaN());
         for (const std::uint32_t i : run)
         {

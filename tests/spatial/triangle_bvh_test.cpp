@@ -8,6 +8,7 @@
 
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
+#include "pointform/spatial/spatial_sort.h"
 
 #include "support/polygon_fan.h"
 #include "support/thread_counts.h"
@@ -357,6 +358,39 @@ TEST(TriangleBvh, BoundsOnlyPruneTheNearestTriangles)
     for (std::size_t i = 0; i < cloud.size(); ++i)
         ASSERT_EQ(unbounded.faces[i], truth[i].face.value);
     EXPECT_THROW((void)nearest_triangles(bvh, cloud, std::vector<double>(3, 1.0)), InvalidInput);
+}
+
+TEST(TriangleBvh, AGivenQueryOrderChangesNoResult)
+{
+    const TriMesh mesh = random_mesh(300, 600, 44);
+    const TriangleBvh bvh(mesh);
+    PointCloud cloud;
+    for (const Vec3d& q : random_queries(4000, 1.5, 45))
+        cloud.positions.push_back(q.cast<float>());
+    const NearestTriangles sorted = nearest_triangles(bvh, cloud);
+    // The order a caller keeps between passes (spatial_order()), and any other permutation: a
+    // reversed one, and a shuffled one, which only runs the queries beside other neighbours.
+    std::vector<std::uint32_t> keep = spatial_order(cloud.positions);
+    std::vector<std::uint32_t> reversed(keep.rbegin(), keep.rend());
+    std::vector<std::uint32_t> shuffled = keep;
+    std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(46));
+    for (const auto* order : {&keep, &reversed, &shuffled})
+    {
+        const NearestTriangles found = nearest_triangles(bvh, cloud, {}, {.order = *order});
+        const std::vector<double> distances = distances_to_mesh(bvh, cloud, {.order = *order});
+        for (std::size_t i = 0; i < cloud.size(); ++i)
+        {
+            ASSERT_EQ(found.distances[i], sorted.distances[i]) << i;
+            ASSERT_EQ(found.faces[i], sorted.faces[i]) << i;
+            ASSERT_EQ(distances[i], sorted.distances[i]) << i;
+        }
+    }
+    // An order of other points, or with an index past the queries, is refused.
+    const std::vector<std::uint32_t> short_order(keep.begin(), keep.end() - 1);
+    EXPECT_THROW((void)nearest_triangles(bvh, cloud, {}, {.order = short_order}), InvalidInput);
+    std::vector<std::uint32_t> past = keep;
+    past[7] = static_cast<std::uint32_t>(cloud.size());
+    EXPECT_THROW((void)distances_to_mesh(bvh, cloud, {.order = past}), InvalidInput);
 }
 
 TEST(TriangleBvh, AnyWithinAgreesWithTheClosestDistance)

@@ -34,6 +34,10 @@ struct ClosestPointOptions
     double max_distance = std::numeric_limits<double>::infinity();
     /// Optional progress report, called from one thread.
     ProgressCallback progress;
+    /// Optional spatial_order() of the query points, for a caller that measures the same
+    /// points again (each pass would sort them anew); empty, or a permutation of the queries.
+    /// The order only decides which queries a search runs beside: the results are the same.
+    std::span<const std::uint32_t> order;
 };
 
 /// \brief Exact closest points on a triangle mesh, accelerated by a bounding-volume hierarchy.
