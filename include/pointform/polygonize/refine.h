@@ -236,7 +236,8 @@ struct RefineReport
     double initial_next_detail = 0.0;
     /// The first level (0 = the one refine() started from) whose Hausdorff distance from the
     /// samples is below the sampling density, the paper's stop (§5.2.4); unset if none of the
-    /// levels made (the dropped one included) reached it.
+    /// levels made (the dropped one included) reached it. Under StopRule::Automatic a level
+    /// is measured as it is output: the finest after its smoothing (denoise_rounds).
     std::optional<std::size_t> paper_level;
     /// Rounds of smoothing given to the finest level (RefineOptions::denoise_rounds), 0 if none;
     /// the finest level's distances (levels.back(), or initial_* for the base) are measured
