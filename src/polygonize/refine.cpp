@@ -719,10 +719,12 @@ std::string_view to_string(StopRule rule)
 namespace {
 
 /// refine_once(); `nearest` (null, or every sample's closest face on the finest level before)
-/// bounds the distance searches and becomes the new level's.
+/// bounds the distance searches and becomes the new level's; `faces` (null, or where the new
+/// level's faces go) saves a caller rebuilding them (MultiresMesh::faces()).
 RefineLevelStats refine_level(MultiresMesh& mesh, const Field& field, const RefineOptions& options,
                               const PointCloud* samples, std::vector<std::uint32_t>* nearest,
-                              std::span<const std::uint32_t> order = {})
+                              std::span<const std::uint32_t> order = {},
+                              std::vector<Triangle>* faces = nullptr)
 {
     check_options(options);
     if (mesh.level_count() == 0)
@@ -741,12 +743,12 @@ RefineLevelStats refine_level(MultiresMesh& mesh, const Field& field, const Refi
     stats.level = split.level;
     try
     {
-        const std::vector<Triangle> faces =
+        std::vector<Triangle> level_faces =
             refine_split_level(mesh, std::move(split), field, options, stats);
         if (samples != nullptr && !samples->empty())
         {
             Distances d = distances_from(
-                *samples, mesh, faces, stats.level,
+                *samples, mesh, level_faces, stats.level,
                 [&](std::string_view, double fraction) {
                     return !options.progress || options.progress("refine: distance", fraction);
                 },
@@ -761,6 +763,8 @@ RefineLevelStats refine_level(MultiresMesh& mesh, const Field& field, const Refi
             stats.robust_distance = d.robust;
             stats.p90_distance = d.p90;
         }
+        if (faces != nullptr)
+            *faces = std::move(level_faces);
     }
     catch (...)
     {
@@ -851,9 +855,10 @@ struct NextDetail
     double tail = 0.0;
 };
 
-NextDetail next_detail(const MultiresMesh& mesh, const Field& field)
+NextDetail next_detail(const MultiresMesh& mesh, std::span<const Triangle> faces,
+                       const Field& field)
 {
-    const std::vector<std::uint64_t> edges = unique_edges(mesh.faces(mesh.finest_level()));
+    const std::vector<std::uint64_t> edges = unique_edges(faces);
     std::vector<Vec3d> midpoints(edges.size());
     for (std::size_t e = 0; e < edges.size(); ++e)
         midpoints[e] = 0.5 * (mesh.world(static_cast<std::uint32_t>(edges[e] >> 32U)) +
@@ -1000,8 +1005,10 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
     const ProgressCallback distance_progress = [&](std::string_view, double fraction) {
         return !options.progress || options.progress("refine: distance", fraction);
     };
-    Distances initial = distances_from(samples, mesh, mesh.faces(mesh.finest_level()),
-                                       mesh.finest_level(), distance_progress, {}, order);
+    // The finest level's faces, kept by the automatic stop from level to level.
+    std::vector<Triangle> faces = mesh.faces(mesh.finest_level());
+    Distances initial =
+        distances_from(samples, mesh, faces, mesh.finest_level(), distance_progress, {}, order);
     report.initial_hausdorff = initial.hausdorff;
     report.initial_mean_distance = initial.mean;
     report.initial_robust_distance = initial.robust;
@@ -1025,7 +1032,7 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
     // its smoothing. `nearest` stays on the level below until then (its children bound the
     // searches).
     bool unmeasured = false;
-    const auto measure = [&](std::span<const Triangle> faces, bool children) {
+    const auto measure = [&](bool children) {
         const auto start = std::chrono::steady_clock::now();
         Distances d = distances_from(samples, mesh, faces, mesh.finest_level(), distance_progress,
                                      {.faces = nearest, .children = children}, order);
@@ -1069,7 +1076,7 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
                 report.stop = RefineStop::VertexBudget;
                 break;
             }
-            const NextDetail next = next_detail(mesh, field);
+            const NextDetail next = next_detail(mesh, faces, field);
             const double detail = next.robust;
             const double previous = report.levels.empty() ? std::numeric_limits<double>::infinity()
                                     : report.levels.size() == 1
@@ -1094,8 +1101,9 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
         if (automatic)
         {
             if (unmeasured)
-                measure(mesh.faces(mesh.finest_level()), true);
-            report.levels.push_back(refine_level(mesh, field, options, nullptr, nullptr));
+                measure(true);
+            report.levels.push_back(
+                refine_level(mesh, field, options, nullptr, nullptr, {}, &faces));
             unmeasured = true;
             continue;
         }
@@ -1117,13 +1125,12 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
     }
     if (report.stop == RefineStop::NoisyDetails && options.denoise_rounds > 0)
     {
-        const std::vector<Triangle> faces = mesh.faces(mesh.finest_level());
         report.denoise_rounds = options.denoise_rounds;
         report.denoise_max_move = denoise_finest(mesh, faces, options.denoise_rounds);
-        measure(faces, unmeasured);
+        measure(unmeasured);
     }
     else if (unmeasured)
-        measure(mesh.faces(mesh.finest_level()), true);
+        measure(true);
     return report;
 }
 

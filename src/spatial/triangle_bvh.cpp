@@ -673,10 +673,18 @@ void in_spatial_order(std::span<const Vec3f> positions, const ClosestPointOption
         sorted = spatial_order(positions);
         order = sorted;
     }
-    else if (order.size() != positions.size() ||
-             *std::max_element(order.begin(), order.end()) >= positions.size())
-        throw InvalidInput("closest points: the order given is not one of the " +
-                           std::to_string(positions.size()) + " queries");
+    else
+    {
+        // A permutation: every query once (a repeated one would be written by two threads).
+        std::vector<char> seen(positions.size(), 0);
+        const bool permutation = order.size() == positions.size() &&
+                                 std::all_of(order.begin(), order.end(), [&](std::uint32_t i) {
+                                     return i < seen.size() && std::exchange(seen[i], char{1}) == 0;
+                                 });
+        if (!permutation)
+            throw InvalidInput("closest points: the order given is not one of the " +
+                               std::to_string(positions.size()) + " queries");
+    }
     ProgressReporter progress(options.progress, "point-to-mesh distance");
     parallel_blocks(
         order.size(), query_block,

@@ -385,12 +385,16 @@ TEST(TriangleBvh, AGivenQueryOrderChangesNoResult)
             ASSERT_EQ(distances[i], sorted.distances[i]) << i;
         }
     }
-    // An order of other points, or with an index past the queries, is refused.
+    // An order of other points, with an index past the queries, or with one query twice (and
+    // so another never) is refused.
     const std::vector<std::uint32_t> short_order(keep.begin(), keep.end() - 1);
     EXPECT_THROW((void)nearest_triangles(bvh, cloud, {}, {.order = short_order}), InvalidInput);
     std::vector<std::uint32_t> past = keep;
     past[7] = static_cast<std::uint32_t>(cloud.size());
     EXPECT_THROW((void)distances_to_mesh(bvh, cloud, {.order = past}), InvalidInput);
+    std::vector<std::uint32_t> twice = keep;
+    twice[7] = twice[8];
+    EXPECT_THROW((void)distances_to_mesh(bvh, cloud, {.order = twice}), InvalidInput);
 }
 
 TEST(TriangleBvh, AnyWithinAgreesWithTheClosestDistance)

@@ -35,7 +35,8 @@ struct ClosestPointOptions
     /// Optional progress report, called from one thread.
     ProgressCallback progress;
     /// Optional spatial_order() of the query points, for a caller that measures the same
-    /// points again (each pass would sort them anew); empty, or a permutation of the queries.
+    /// points again (each pass would sort them anew); empty, or a permutation of the queries
+    /// (anything else is refused: InvalidInput).
     /// The order only decides which queries a search runs beside: the results are the same.
     std::span<const std::uint32_t> order;
 };
