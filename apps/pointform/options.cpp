@@ -215,6 +215,10 @@ void add_refine_options(CLI::App& cmd, SemiRegularCommandOptions& options)
                    "0 keeps the projected level")
         ->check(CLI::Range(std::size_t{0}, max_denoise_rounds))
         ->capture_default_str();
+    cmd.add_flag("!--no-hole-fairing", options.semi_regular.fair_unsupported,
+                 "Keep the finest level as projected where no sample supports it (filled holes "
+                 "and their rims) instead of fairing it to the smoothest surface that continues "
+                 "the mesh around it");
     cmd.add_flag("--ascii", options.ascii, "Write ascii PLY instead of binary");
     cmd.add_flag("--json", options.json, "Print the report as JSON");
 }

@@ -93,6 +93,13 @@ void print_refinement(const SemiRegularReport& r)
                                       " rounds of Taubin smoothing of the finest level (its "
                                       "details were noise); farthest move " +
                                       format_number(r.refinement.denoise_max_move));
+        if (r.refinement.unsupported.regions > 0)
+            print_row("faired", std::to_string(r.refinement.unsupported.regions) +
+                                    " regions no sample supports (filled holes and their "
+                                    "rims), " +
+                                    std::to_string(r.refinement.unsupported.vertices) +
+                                    " vertices; farthest move " +
+                                    format_number(r.refinement.unsupported.max_move));
     }
     print_row("VEN fix",
               "fold vertices whose fold the vertex-based edge normal fixed / fold "

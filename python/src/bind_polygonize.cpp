@@ -283,13 +283,14 @@ void bind_polygonize(py::module_& m)
            const std::optional<std::filesystem::path>& base_mesh, const py::object& base_triangles,
            long long k, double radius_scale, const std::string& predictor, int relax_iterations,
            const std::string& relaxation, double fill_holes, double rim_reach,
-           long long denoise_rounds) {
+           long long denoise_rounds, bool hole_fairing) {
             ReconstructOptions options;
             options.fill_holes = fill_holes; // checked by the base mesh
             options.rim_reach = rim_reach;   // checked by the point field
             options.semi_regular =
                 semi_regular_options(levels, base_faces, stop_rule, predictor, relax_iterations,
                                      relaxation, denoise_rounds);
+            options.semi_regular.fair_unsupported = hole_fairing;
             options.fit = parse_plane_fit(fit);
             if (resolution != 0 && resolution < 2)
                 throw InvalidInput("resolution must be at least 2 (or 0 = automatic), got " +
@@ -346,11 +347,12 @@ void bind_polygonize(py::module_& m)
         py::arg("fill_holes") = ReconstructOptions{}.fill_holes,
         py::arg("rim_reach") = ReconstructOptions{}.rim_reach,
         py::arg("denoise_rounds") = static_cast<long long>(RefineOptions{}.denoise_rounds),
+        py::arg("hole_fairing") = RefineOptions{}.fair_unsupported,
         "reconstruct(cloud, *, levels=None, base_faces=None, stop_rule='auto', fit='quadric', "
         "resolution=0, cell=0.0, min_component_samples=None, base_mesh=None, base_triangles=None, "
         "k=16, "
         "radius_scale=1.5, predictor=..., relax_iterations=..., relaxation=..., fill_holes=0.05, "
-        "rim_reach=0.25, denoise_rounds=5) "
+        "rim_reach=0.25, denoise_rounds=5, hole_fairing=True) "
         "-> Hierarchy\n\n"
         "Points to a semi-regular multiresolution mesh (paper §5), as `pointform reconstruct` "
         "does, with the same defaults and the same result: surfels (pointform.surfels() with "
@@ -363,7 +365,9 @@ void bind_polygonize(py::module_& m)
         "enclosing at most fill_holes of their component's area closed (0 keeps them), then "
         "1-to-4 refinement projected onto the field: exactly to "
         "`levels` (0-8), or until stop_rule says so ('auto' or 'paper'); a level where 'auto' "
-        "stops on noise is smoothed by denoise_rounds rounds of Taubin's smoothing (0 = none). "
+        "stops on noise is smoothed by denoise_rounds rounds of Taubin's smoothing (0 = none), "
+        "and with 'auto' the regions no sample supports (filled holes and their rims) are "
+        "faired unless hole_fairing=False (`--no-hole-fairing`). "
         "Raises InvalidInput "
         "for bad points or options, or work that would not fit in memory.");
 

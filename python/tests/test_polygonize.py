@@ -218,6 +218,27 @@ def test_fill_holes_is_the_mc_clis(tmp_path):
         pointform.fill_holes(mesh, max_share=1.0)
 
 
+def test_holes_are_faired_as_the_cli_does(tmp_path):
+    # A noisy sphere with holes: the regions no sample supports are faired (hole_fairing,
+    # `--no-hole-fairing`), the same bytes and report as the CLI either way.
+    points = tmp_path / "holes.ply"
+    run_cli("sample", "sphere", "-n", 30000, "--noise", 0.002, "--holes", 6, "--hole-radius",
+            0.04, "--seed", 4, "-o", points)
+    cloud = pointform.read_points(points)
+    for fairing in (True, False):
+        hierarchy = pointform.reconstruct(cloud, hole_fairing=fairing)
+        out = tmp_path / f"cli{fairing}.pfh"
+        cli_report = run_cli("reconstruct", points, "-o", tmp_path / "cli.ply", "--save-hierarchy",
+                             out, "--json", *([] if fairing else ["--no-hole-fairing"]),
+                             json_output=True)
+        for key in ("unsupported_regions", "unsupported_vertices"):
+            assert cli_report[key] == hierarchy.report[key]
+        assert (hierarchy.report["unsupported_regions"] > 0) == fairing
+        mine = tmp_path / f"py{fairing}.pfh"
+        hierarchy.save(mine)
+        assert mine.read_bytes() == out.read_bytes()
+
+
 def test_noisy_levels_are_denoised_as_the_cli_does(tmp_path):
     # A noisy sphere stops on noise and is smoothed (denoise_rounds, `--denoise`): the same
     # bytes and report as the CLI either way, and closer to the sphere when smoothed.

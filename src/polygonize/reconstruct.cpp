@@ -66,6 +66,7 @@ RefineOptions refine_options_of(const SemiRegularOptions& options, const Progres
     refine_options.relax_iterations = options.relax_iterations;
     refine_options.relaxation = options.relaxation;
     refine_options.denoise_rounds = options.denoise_rounds;
+    refine_options.fair_unsupported = options.fair_unsupported;
     refine_options.stop_rule = options.stop_rule;
     refine_options.progress = progress;
     return refine_options;

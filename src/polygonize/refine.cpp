@@ -11,6 +11,8 @@
 #include "pointform/spatial/spatial_sort.h"
 #include "pointform/spatial/triangle_bvh.h"
 
+#include <Eigen/SparseCholesky>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -910,17 +912,18 @@ NextDetail next_detail(const MultiresMesh& mesh, std::span<const Triangle> faces
     return out;
 }
 
-/// Taubin's λ|μ smoothing of the finest level, of `faces` (RefineOptions::denoise_rounds): `rounds`
-/// times every vertex moves λ of the way to the mean of its neighbours, then μ of it; a vertex on a
-/// boundary edge stays. Jacobi steps in parallel blocks: the same positions whatever the thread
-/// count. Returns the farthest move.
-double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, std::size_t rounds)
+/// The vertex rings of `faces` over `n` vertices, in compressed rows: the neighbours of v are
+/// adjacent[offsets[v], offsets[v + 1]), sorted and without repeats; `boundary` marks the ends
+/// of an edge used by one face only.
+struct Rings
 {
-    constexpr double lambda = 0.5;
-    constexpr double mu = -0.53;
-    const std::size_t n = mesh.vertex_count();
-    // Neighbours in compressed rows, each row sorted and without repeats; an edge used by one
-    // face only marks its ends as boundary.
+    std::vector<std::uint32_t> offsets;
+    std::vector<std::uint32_t> adjacent;
+    std::vector<std::uint8_t> boundary;
+};
+
+Rings vertex_rings(std::span<const Triangle> faces, std::size_t n)
+{
     std::vector<std::uint64_t> directed;
     directed.reserve(6 * faces.size());
     for (const Triangle& t : faces)
@@ -932,10 +935,10 @@ double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, std::
             directed.push_back(b << 32U | a);
         }
     parallel_sort(directed);
-    std::vector<std::uint8_t> boundary(n, 0);
-    std::vector<std::uint32_t> offsets(n + 1, 0);
-    std::vector<std::uint32_t> adjacent;
-    adjacent.reserve(directed.size() / 2);
+    Rings rings;
+    rings.boundary.assign(n, 0);
+    rings.offsets.assign(n + 1, 0);
+    rings.adjacent.reserve(directed.size() / 2);
     for (std::size_t i = 0; i < directed.size();)
     {
         std::size_t j = i;
@@ -943,14 +946,26 @@ double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, std::
             ++j;
         const auto from = static_cast<std::uint32_t>(directed[i] >> 32U);
         if (j - i == 1)
-            boundary[from] = 1; // the edge has one face: it appears once each way
-        adjacent.push_back(static_cast<std::uint32_t>(directed[i] & 0xffffffffU));
-        ++offsets[from + 1];
+            rings.boundary[from] = 1; // the edge has one face: it appears once each way
+        rings.adjacent.push_back(static_cast<std::uint32_t>(directed[i] & 0xffffffffU));
+        ++rings.offsets[from + 1];
         i = j;
     }
-    std::vector<std::uint64_t>().swap(directed);
     for (std::size_t v = 0; v < n; ++v)
-        offsets[v + 1] += offsets[v];
+        rings.offsets[v + 1] += rings.offsets[v];
+    return rings;
+}
+
+/// Taubin's λ|μ smoothing of the finest level, of `faces` (RefineOptions::denoise_rounds): `rounds`
+/// times every vertex moves λ of the way to the mean of its neighbours, then μ of it; a vertex on a
+/// boundary edge stays. Jacobi steps in parallel blocks: the same positions whatever the thread
+/// count. Returns the farthest move.
+double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, std::size_t rounds)
+{
+    constexpr double lambda = 0.5;
+    constexpr double mu = -0.53;
+    const std::size_t n = mesh.vertex_count();
+    const Rings rings = vertex_rings(faces, n);
     const std::span<Vec3d> x = mesh.mutable_positions();
     const std::vector<Vec3d> start(x.begin(), x.end());
     std::vector<Vec3d> next(n);
@@ -961,12 +976,14 @@ double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, std::
             for (std::size_t v = begin; v < end; ++v)
             {
                 next[v] = x[v];
-                if (boundary[v] != 0 || offsets[v + 1] == offsets[v])
+                const std::uint32_t first = rings.offsets[v];
+                const std::uint32_t last = rings.offsets[v + 1];
+                if (rings.boundary[v] != 0 || last == first)
                     continue;
                 Vec3d mean = Vec3d::Zero();
-                for (std::uint32_t e = offsets[v]; e < offsets[v + 1]; ++e)
-                    mean += x[adjacent[e]];
-                mean /= static_cast<double>(offsets[v + 1] - offsets[v]);
+                for (std::uint32_t e = first; e < last; ++e)
+                    mean += x[rings.adjacent[e]];
+                mean /= static_cast<double>(last - first);
                 next[v] = x[v] + step * (mean - x[v]);
             }
         });
@@ -976,6 +993,232 @@ double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, std::
     for (std::size_t v = 0; v < n; ++v)
         farthest = std::max(farthest, (x[v] - start[v]).norm());
     return farthest;
+}
+
+/// fair_unsupported(): a vertex is a region's core when its nearest sample is farther than
+/// this many sample spacings (the spacing there: that sample's influence radius over the
+/// cloud's median ratio of radius to nearest-neighbour distance). A point dropped at random
+/// among samples of spacing s is farther than c·s from all of them with probability about
+/// 2^(-c²): 1.3% at 2.5, on a regular mesh as fine as its samples a few scattered vertices,
+/// which the next rule leaves alone.
+constexpr double unsupported_core = 2.5;
+/// ... and a region is kept only when one of its core vertices has every neighbour in the core
+/// too: a hole's patch, not a scattered vertex or a line of them (a crease whose corner the
+/// mesh cuts).
+/// A kept region then takes in, ring by ring, up to this many rings of neighbours ...
+constexpr std::size_t unsupported_band_rings = 3;
+/// ... that are farther than this many spacings from every sample: the rim around a hole, where
+/// the field extrapolates the last few (noisy) samples' fits and the mesh follows them.
+constexpr double unsupported_band = 1.5;
+
+/// Fairs the finest level where no sample supports it (RefineOptions::fair_unsupported): the
+/// regions of vertices far from every sample (filled holes and the rims around them, see
+/// unsupported_core) take the smoothest surface that continues the mesh around them, thin-plate
+/// fairing as the base mesh's hole patches (Σ ‖L x‖² least over the region and its neighbours,
+/// L the uniform Laplacian, every other vertex held). Vertices on the mesh's boundary are held.
+UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle> faces,
+                                    const PointCloud& samples, double spacing)
+{
+    UnsupportedFairing out;
+    const std::size_t n = mesh.vertex_count();
+    if (samples.empty() || n == 0 || !(spacing > 0.0))
+        return out;
+    // The local spacing at a sample: its influence radius scaled by the cloud's median ratio.
+    double radius_scale = 0.0;
+    if (samples.radii.size() == samples.size())
+    {
+        std::vector<float> radii(samples.radii);
+        const auto middle = radii.begin() + static_cast<std::ptrdiff_t>(radii.size() / 2);
+        std::nth_element(radii.begin(), middle, radii.end());
+        if (*middle > 0.0F && std::isfinite(*middle))
+            radius_scale = spacing / static_cast<double>(*middle);
+    }
+    const KdTree tree(samples.positions);
+    const Vec3d shift = mesh.origin() - samples.origin;
+    const std::span<Vec3d> x = mesh.mutable_positions();
+    // Distance to the nearest sample in local spacings.
+    std::vector<float> excess(n, 0.0F);
+    parallel_blocks(n, vertex_block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t v = begin; v < end; ++v)
+        {
+            float squared = 0.0F;
+            const PointId nearest = tree.nearest((x[v] + shift).cast<float>(), &squared);
+            if (!nearest.is_valid())
+                continue;
+            double local = spacing;
+            if (radius_scale > 0.0)
+            {
+                const double r = radius_scale * static_cast<double>(samples.radii[nearest.value]);
+                if (r > 0.0 && std::isfinite(r))
+                    local = r;
+            }
+            excess[v] = static_cast<float>(std::sqrt(static_cast<double>(squared)) / local);
+        }
+    });
+    const Rings rings = vertex_rings(faces, n);
+    const auto ring = [&](std::size_t v) {
+        return std::span<const std::uint32_t>(rings.adjacent)
+            .subspan(rings.offsets[v], rings.offsets[v + 1] - rings.offsets[v]);
+    };
+    const auto core = [&](std::size_t v) {
+        return rings.boundary[v] == 0 && static_cast<double>(excess[v]) > unsupported_core &&
+               rings.offsets[v + 1] > rings.offsets[v];
+    };
+    // The core's connected regions; those with an interior vertex are kept.
+    constexpr std::uint32_t unset = std::numeric_limits<std::uint32_t>::max();
+    std::vector<std::uint32_t> region(n, unset);
+    std::vector<char> free(n, 0);
+    std::vector<std::uint32_t> members;
+    std::vector<std::uint32_t> stack;
+    std::uint32_t regions = 0;
+    for (std::size_t seed = 0; seed < n; ++seed)
+    {
+        if (region[seed] != unset || !core(seed))
+            continue;
+        members.clear();
+        stack.assign(1, static_cast<std::uint32_t>(seed));
+        region[seed] = regions;
+        bool interior = false;
+        while (!stack.empty())
+        {
+            const std::uint32_t v = stack.back();
+            stack.pop_back();
+            members.push_back(v);
+            bool all = true;
+            for (const std::uint32_t w : ring(v))
+            {
+                if (!core(w))
+                {
+                    all = false;
+                    continue;
+                }
+                if (region[w] == unset)
+                {
+                    region[w] = regions;
+                    stack.push_back(w);
+                }
+            }
+            interior = interior || all;
+        }
+        ++regions;
+        if (interior)
+            for (const std::uint32_t v : members)
+                free[v] = 1;
+    }
+    // The band around the kept regions.
+    std::vector<std::uint32_t> front;
+    for (std::size_t v = 0; v < n; ++v)
+        if (free[v] != 0)
+            front.push_back(static_cast<std::uint32_t>(v));
+    for (std::size_t r = 0; r < unsupported_band_rings && !front.empty(); ++r)
+    {
+        std::vector<std::uint32_t> next;
+        for (const std::uint32_t v : front)
+            for (const std::uint32_t w : ring(v))
+                if (free[w] == 0 && rings.boundary[w] == 0 &&
+                    static_cast<double>(excess[w]) > unsupported_band)
+                {
+                    free[w] = 1;
+                    next.push_back(w);
+                }
+        std::sort(next.begin(), next.end());
+        front = std::move(next);
+    }
+    // Regions of the free vertices; one with no held neighbour (a whole component far from
+    // the samples) has nothing to continue and stays.
+    std::fill(region.begin(), region.end(), unset);
+    std::vector<std::uint32_t> column(n, unset);
+    std::vector<std::uint32_t> unknowns;
+    for (std::size_t seed = 0; seed < n; ++seed)
+    {
+        if (free[seed] == 0 || region[seed] != unset)
+            continue;
+        members.clear();
+        stack.assign(1, static_cast<std::uint32_t>(seed));
+        region[seed] = 0;
+        bool held = false;
+        while (!stack.empty())
+        {
+            const std::uint32_t v = stack.back();
+            stack.pop_back();
+            members.push_back(v);
+            for (const std::uint32_t w : ring(v))
+            {
+                if (free[w] == 0)
+                    held = true;
+                else if (region[w] == unset)
+                {
+                    region[w] = 0;
+                    stack.push_back(w);
+                }
+            }
+        }
+        if (!held)
+            continue;
+        ++out.regions;
+        std::sort(members.begin(), members.end());
+        unknowns.insert(unknowns.end(), members.begin(), members.end());
+    }
+    if (unknowns.empty())
+        return out;
+    std::sort(unknowns.begin(), unknowns.end());
+    for (std::size_t i = 0; i < unknowns.size(); ++i)
+        column[unknowns[i]] = static_cast<std::uint32_t>(i);
+    // One row per free vertex and per neighbour of one: its uniform Laplacian.
+    std::vector<std::uint32_t> rows = unknowns;
+    std::vector<char> in_rows(n, 0);
+    for (const std::uint32_t v : unknowns)
+        in_rows[v] = 1;
+    for (const std::uint32_t v : unknowns)
+        for (const std::uint32_t w : ring(v))
+            if (in_rows[w] == 0)
+            {
+                in_rows[w] = 1;
+                rows.push_back(w);
+            }
+    using Sparse = Eigen::SparseMatrix<double>;
+    std::vector<Eigen::Triplet<double>> entries;
+    Eigen::MatrixXd fixed = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), 3);
+    for (std::size_t r = 0; r < rows.size(); ++r)
+    {
+        const std::uint32_t v = rows[r];
+        const std::span<const std::uint32_t> neighbours = ring(v);
+        if (neighbours.empty())
+            continue;
+        const double weight = 1.0 / static_cast<double>(neighbours.size());
+        const auto add = [&](std::uint32_t w, double coefficient) {
+            if (column[w] != unset)
+                entries.emplace_back(static_cast<int>(r), static_cast<int>(column[w]), coefficient);
+            else
+                fixed.row(static_cast<Eigen::Index>(r)) += coefficient * x[w].transpose();
+        };
+        for (const std::uint32_t w : neighbours)
+            add(w, weight);
+        add(v, -1.0);
+    }
+    Sparse a(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(unknowns.size()));
+    a.setFromTriplets(entries.begin(), entries.end());
+    const Sparse normal = a.transpose() * a;
+    Eigen::SimplicialLDLT<Sparse> solver(normal);
+    if (solver.info() != Eigen::Success)
+    {
+        out.regions = 0;
+        return out;
+    }
+    const Eigen::MatrixXd solution = solver.solve(-(a.transpose() * fixed));
+    if (solver.info() != Eigen::Success || !solution.allFinite())
+    {
+        out.regions = 0;
+        return out;
+    }
+    out.vertices = unknowns.size();
+    for (std::size_t i = 0; i < unknowns.size(); ++i)
+    {
+        const Vec3d moved = solution.row(static_cast<Eigen::Index>(i)).transpose();
+        out.max_move = std::max(out.max_move, (moved - x[unknowns[i]]).norm());
+        x[unknowns[i]] = moved;
+    }
+    return out;
 }
 
 } // namespace
@@ -1123,14 +1366,20 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
         }
         report.levels.push_back(stats);
     }
+    bool moved = false;
     if (report.stop == RefineStop::NoisyDetails && options.denoise_rounds > 0)
     {
         report.denoise_rounds = options.denoise_rounds;
         report.denoise_max_move = denoise_finest(mesh, faces, options.denoise_rounds);
-        measure(unmeasured);
+        moved = true;
     }
-    else if (unmeasured)
-        measure(true);
+    if (automatic && options.fair_unsupported)
+    {
+        report.unsupported = fair_unsupported(mesh, faces, samples, report.sampling_density);
+        moved = moved || report.unsupported.vertices > 0;
+    }
+    if (moved || unmeasured)
+        measure(unmeasured);
     return report;
 }
 

@@ -53,6 +53,8 @@ struct SemiRegularOptions
     Relaxation relaxation = RefineOptions{}.relaxation;
     /// Smoothing rounds of a finest level that stopped on noise (RefineOptions::denoise_rounds).
     std::size_t denoise_rounds = RefineOptions{}.denoise_rounds;
+    /// Fair the regions no sample supports (RefineOptions::fair_unsupported).
+    bool fair_unsupported = RefineOptions{}.fair_unsupported;
     /// Holes of the automatic base mesh filled (BaseMeshOptions::fill_holes); 0 = none.
     double fill_holes = 0.0;
 };
