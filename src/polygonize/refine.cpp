@@ -956,10 +956,61 @@ Rings vertex_rings(std::span<const Triangle> faces, std::size_t n)
     return rings;
 }
 
+/// The edges of `faces` whose two faces' normals differ by more than 30° (crease_cosine): per
+/// entry of `rings.adjacent`, 1 where the edge to that neighbour is one.
+std::vector<std::uint8_t> crease_edges(std::span<const Vec3d> x, std::span<const Triangle> faces,
+                                       const Rings& rings)
+{
+    std::vector<Vec3d> normal(faces.size());
+    parallel_blocks(faces.size(), vertex_block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t f = begin; f < end; ++f)
+        {
+            const Triangle& t = faces[f];
+            normal[f] = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).normalized();
+        }
+    });
+    // Each edge with the faces beside it: (smaller end, larger end, face), sorted.
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> sides;
+    sides.reserve(3 * faces.size());
+    for (std::size_t f = 0; f < faces.size(); ++f)
+        for (std::size_t c = 0; c < 3; ++c)
+        {
+            const std::uint64_t a = faces[f][c];
+            const std::uint64_t b = faces[f][(c + 1) % 3];
+            sides.emplace_back(std::min(a, b) << 32U | std::max(a, b),
+                               static_cast<std::uint32_t>(f));
+        }
+    std::sort(sides.begin(), sides.end());
+    std::vector<std::uint8_t> crease(rings.adjacent.size(), 0);
+    const auto mark = [&](std::uint32_t v, std::uint32_t w) {
+        const auto first = rings.adjacent.begin() + rings.offsets[v];
+        const auto last = rings.adjacent.begin() + rings.offsets[v + 1];
+        const auto at = std::lower_bound(first, last, w);
+        if (at != last && *at == w)
+            crease[static_cast<std::size_t>(at - rings.adjacent.begin())] = 1;
+    };
+    for (std::size_t i = 0; i + 1 < sides.size(); ++i)
+    {
+        if (sides[i].first != sides[i + 1].first ||
+            (i + 2 < sides.size() && sides[i + 2].first == sides[i].first))
+            continue; // a boundary edge, or a non-manifold one
+        if (normal[sides[i].second].dot(normal[sides[i + 1].second]) < crease_cosine)
+        {
+            const auto a = static_cast<std::uint32_t>(sides[i].first >> 32U);
+            const auto b = static_cast<std::uint32_t>(sides[i].first & 0xffffffffU);
+            mark(a, b);
+            mark(b, a);
+        }
+    }
+    return crease;
+}
+
 /// Taubin's λ|μ smoothing of the finest level, of `faces` (RefineOptions::denoise_rounds): `rounds`
 /// times every vertex moves λ of the way to the mean of its neighbours, then μ of it; a vertex on a
-/// boundary edge stays. Jacobi steps in parallel blocks: the same positions whatever the thread
-/// count. Returns the farthest move.
+/// boundary edge stays. Creases (edges whose faces' normals differ by more than 30° as the level
+/// was projected) are kept: a vertex on exactly two crease edges moves along them (the mean of
+/// those two neighbours), one on one or on three or more (a corner) stays. Jacobi steps in
+/// parallel blocks: the same positions whatever the thread count. Returns the farthest move.
 double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, std::size_t rounds)
 {
     constexpr double lambda = 0.5;
@@ -967,6 +1018,20 @@ double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, std::
     const std::size_t n = mesh.vertex_count();
     const Rings rings = vertex_rings(faces, n);
     const std::span<Vec3d> x = mesh.mutable_positions();
+    const std::vector<std::uint8_t> crease = crease_edges(x, faces, rings);
+    // Per vertex: smoothed over all its neighbours (0), over its two crease neighbours (1), or
+    // held (2).
+    std::vector<std::uint8_t> kind(n, 0);
+    for (std::size_t v = 0; v < n; ++v)
+    {
+        std::size_t on = 0;
+        for (std::uint32_t e = rings.offsets[v]; e < rings.offsets[v + 1]; ++e)
+            on += crease[e];
+        kind[v] = rings.boundary[v] != 0 || rings.offsets[v + 1] == rings.offsets[v] ? 2
+                  : on == 0                                                          ? 0
+                  : on == 2                                                          ? 1
+                                                                                     : 2;
+    }
     const std::vector<Vec3d> start(x.begin(), x.end());
     std::vector<Vec3d> next(n);
     for (std::size_t round = 0; round < 2 * rounds; ++round)
@@ -976,14 +1041,17 @@ double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, std::
             for (std::size_t v = begin; v < end; ++v)
             {
                 next[v] = x[v];
-                const std::uint32_t first = rings.offsets[v];
-                const std::uint32_t last = rings.offsets[v + 1];
-                if (rings.boundary[v] != 0 || last == first)
+                if (kind[v] == 2)
                     continue;
                 Vec3d mean = Vec3d::Zero();
-                for (std::uint32_t e = first; e < last; ++e)
-                    mean += x[rings.adjacent[e]];
-                mean /= static_cast<double>(last - first);
+                std::size_t count = 0;
+                for (std::uint32_t e = rings.offsets[v]; e < rings.offsets[v + 1]; ++e)
+                    if (kind[v] == 0 || crease[e] != 0)
+                    {
+                        mean += x[rings.adjacent[e]];
+                        ++count;
+                    }
+                mean /= static_cast<double>(count);
                 next[v] = x[v] + step * (mean - x[v]);
             }
         });

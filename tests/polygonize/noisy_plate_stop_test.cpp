@@ -158,5 +158,51 @@ TEST(NoisyPlateStop, ALevelThatStopsOnNoiseIsSmoothed)
     EXPECT_THROW((void)reconstruct(samples, too_many), InvalidInput);
 }
 
+TEST(NoisyPlateStop, SmoothingKeepsCreases)
+{
+    // The noisy plate stops on noise and is smoothed; its rims are creases (90°), which Taubin's
+    // smoothing would round off. Crease edges (faces 30° apart) are kept: a vertex on two of them
+    // moves along them, a corner stays. The plate's eight corners are then no farther from the
+    // mesh than without the smoothing, while the mesh as a whole comes closer to the plate.
+    PointCloud raw_points;
+    {
+        const PointCloud drawn = sample_shape(
+            Shape::Plate, {.count = 60000, .seed = 5, .noise = 0.002, .thickness = thickness});
+        raw_points.origin = drawn.origin;
+        raw_points.positions = drawn.positions;
+    }
+    const PointCloud samples = surfels_from_samples(raw_points).surfels;
+    const ReconstructReport smoothed = reconstruct(samples, {});
+    ASSERT_EQ(smoothed.semi_regular.refinement.stop, RefineStop::NoisyDetails);
+    ASSERT_GT(smoothed.semi_regular.refinement.denoise_rounds, 0U);
+    ReconstructOptions none;
+    none.semi_regular.denoise_rounds = 0;
+    const ReconstructReport projected = reconstruct(samples, none);
+    PointCloud corners;
+    for (const double x : {-1.0, 1.0})
+        for (const double y : {-1.0, 1.0})
+            for (const double z : {-0.5 * thickness, 0.5 * thickness})
+                corners.positions.emplace_back(static_cast<float>(x), static_cast<float>(y),
+                                               static_cast<float>(z));
+    const auto corner_distance = [&](const MultiresMesh& mesh) {
+        const std::vector<double> d =
+            distances_to_mesh(TriangleBvh(mesh.level_mesh(mesh.finest_level())), corners);
+        double sum = 0.0;
+        for (const double v : d)
+            sum += v;
+        return sum / static_cast<double>(d.size());
+    };
+    const double smoothed_corners = corner_distance(smoothed.semi_regular.hierarchy);
+    const double projected_corners = corner_distance(projected.semi_regular.hierarchy);
+    RecordProperty("corners_smoothed", std::to_string(smoothed_corners));
+    RecordProperty("corners_projected", std::to_string(projected_corners));
+    EXPECT_LE(smoothed_corners, 1.05 * projected_corners);
+    const PointCloud truth =
+        sample_shape(Shape::Plate, {.count = 60000, .seed = 6, .thickness = thickness});
+    const MultiresMesh& a = smoothed.semi_regular.hierarchy;
+    const MultiresMesh& b = projected.semi_regular.hierarchy;
+    EXPECT_LT(level_error(a, a.finest_level(), truth), level_error(b, b.finest_level(), truth));
+}
+
 } // namespace
 } // namespace pointform
