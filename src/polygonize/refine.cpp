@@ -1011,7 +1011,8 @@ std::vector<std::uint8_t> crease_edges(std::span<const Vec3d> x, std::span<const
 /// was projected) are kept: a vertex on exactly two crease edges moves along them (the mean of
 /// those two neighbours), one on one or on three or more (a corner) stays. Jacobi steps in
 /// parallel blocks: the same positions whatever the thread count. Returns the farthest move.
-double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, std::size_t rounds)
+double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, std::size_t rounds,
+                      std::span<const char> faired)
 {
     constexpr double lambda = 0.5;
     constexpr double mu = -0.53;
@@ -1028,7 +1029,7 @@ double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, std::
         for (std::uint32_t e = rings.offsets[v]; e < rings.offsets[v + 1]; ++e)
             on += crease[e];
         kind[v] = rings.boundary[v] != 0 || rings.offsets[v + 1] == rings.offsets[v] ? 2
-                  : on == 0                                                          ? 0
+                  : on == 0 || faired[v] != 0                                        ? 0
                   : on == 2                                                          ? 1
                                                                                      : 2;
     }
@@ -1085,8 +1086,10 @@ constexpr double unsupported_band = 1.5;
 /// fairing as the base mesh's hole patches (Σ ‖L x‖² least over the region and its neighbours,
 /// L the uniform Laplacian, every other vertex held). Vertices on the mesh's boundary are held.
 UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle> faces,
-                                    const PointCloud& samples, double spacing)
+                                    const PointCloud& samples, double spacing,
+                                    std::vector<char>& faired)
 {
+    faired.assign(mesh.vertex_count(), 0);
     UnsupportedFairing out;
     const std::size_t n = mesh.vertex_count();
     if (samples.empty() || n == 0 || !(spacing > 0.0))
@@ -1285,6 +1288,7 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
         const Vec3d moved = solution.row(static_cast<Eigen::Index>(i)).transpose();
         out.max_move = std::max(out.max_move, (moved - x[unknowns[i]]).norm());
         x[unknowns[i]] = moved;
+        faired[unknowns[i]] = 1;
     }
     return out;
 }
@@ -1435,16 +1439,18 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
         report.levels.push_back(stats);
     }
     bool moved = false;
+    std::vector<char> faired(mesh.vertex_count(), 0);
+    if (automatic && options.fair_unsupported)
+    {
+        report.unsupported =
+            fair_unsupported(mesh, faces, samples, report.sampling_density, faired);
+        moved = report.unsupported.vertices > 0;
+    }
     if (report.stop == RefineStop::NoisyDetails && options.denoise_rounds > 0)
     {
         report.denoise_rounds = options.denoise_rounds;
-        report.denoise_max_move = denoise_finest(mesh, faces, options.denoise_rounds);
+        report.denoise_max_move = denoise_finest(mesh, faces, options.denoise_rounds, faired);
         moved = true;
-    }
-    if (automatic && options.fair_unsupported)
-    {
-        report.unsupported = fair_unsupported(mesh, faces, samples, report.sampling_density);
-        moved = moved || report.unsupported.vertices > 0;
     }
     if (moved || unmeasured)
         measure(unmeasured);

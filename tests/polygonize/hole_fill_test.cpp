@@ -15,6 +15,8 @@
 #include "pointform/polygonize/reconstruct.h"
 #include "pointform/spatial/kd_tree.h"
 
+#include "support/sphere_deviation.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -283,32 +285,6 @@ TEST(HoleFill, ANonManifoldMeshIsLeftAsItIs)
     EXPECT_EQ(mesh.face_count(), 2U);
 }
 
-/// The largest distance from the unit sphere over a level's vertices and face centroids, and
-/// its mean, among those no farther than `within` from `centre` (every one for within = ∞).
-std::pair<double, double> sphere_deviation(const MultiresMesh& mesh, const Vec3d& centre,
-                                           double within)
-{
-    double worst = 0.0;
-    double sum = 0.0;
-    std::size_t count = 0;
-    for (const Triangle& t : mesh.faces(mesh.finest_level()))
-    {
-        const Vec3d a = mesh.world(t[0]);
-        const Vec3d b = mesh.world(t[1]);
-        const Vec3d c = mesh.world(t[2]);
-        for (const Vec3d& p : {a, Vec3d((a + b + c) / 3.0)})
-        {
-            if ((p - centre).norm() > within)
-                continue;
-            const double d = std::abs(p.norm() - 1.0);
-            worst = std::max(worst, d);
-            sum += d;
-            ++count;
-        }
-    }
-    return {worst, count > 0 ? sum / static_cast<double>(count) : 0.0};
-}
-
 TEST(HoleFill, RegionsNoSampleSupportsAreFaired)
 {
     // A noisy sphere scan (raw points, noise 0.2% of the diagonal) with eight holes of radius 4%
@@ -354,19 +330,19 @@ TEST(HoleFill, RegionsNoSampleSupportsAreFaired)
     double worst_projected = 0.0;
     for (const Vec3d& c : centres)
     {
-        worst_faired =
-            std::max(worst_faired, sphere_deviation(faired.semi_regular.hierarchy, c, 0.25).first);
-        worst_projected = std::max(
-            worst_projected, sphere_deviation(projected.semi_regular.hierarchy, c, 0.25).first);
+        worst_faired = std::max(
+            worst_faired, test::sphere_deviation(faired.semi_regular.hierarchy, c, 0.25).worst);
+        worst_projected =
+            std::max(worst_projected,
+                     test::sphere_deviation(projected.semi_regular.hierarchy, c, 0.25).worst);
     }
     RecordProperty("faired", std::to_string(worst_faired));
     RecordProperty("projected", std::to_string(worst_projected));
     EXPECT_LT(worst_faired, 0.8 * worst_projected);
     EXPECT_LT(worst_faired, 0.012);
     // Elsewhere nothing gets worse: the mean deviation over the whole sphere.
-    const double inf = std::numeric_limits<double>::infinity();
-    EXPECT_LE(sphere_deviation(faired.semi_regular.hierarchy, Vec3d::Zero(), inf).second,
-              sphere_deviation(projected.semi_regular.hierarchy, Vec3d::Zero(), inf).second);
+    EXPECT_LE(test::sphere_deviation(faired.semi_regular.hierarchy).mean,
+              test::sphere_deviation(projected.semi_regular.hierarchy).mean);
     // The same topology: closed, genus 0.
     const TriMesh mesh =
         faired.semi_regular.hierarchy.level_mesh(faired.semi_regular.hierarchy.finest_level());

@@ -15,6 +15,8 @@
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/triangle_bvh.h"
 
+#include "support/sphere_deviation.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -92,25 +94,6 @@ TEST(NoisyPlateStop, StopsAtTheLevelNearestTheTruePlate)
         EXPECT_GT(error[level], error[chosen]) << "level " << level;
 }
 
-/// Mean distance to the unit sphere over a level's vertices and face centroids.
-double sphere_error(const MultiresMesh& mesh)
-{
-    double sum = 0.0;
-    std::size_t count = 0;
-    for (const Triangle& t : mesh.faces(mesh.finest_level()))
-    {
-        const Vec3d a = mesh.world(t[0]);
-        const Vec3d b = mesh.world(t[1]);
-        const Vec3d c = mesh.world(t[2]);
-        for (const Vec3d& p : {a, Vec3d((a + b + c) / 3.0)})
-        {
-            sum += std::abs(p.norm() - 1.0);
-            ++count;
-        }
-    }
-    return sum / static_cast<double>(count);
-}
-
 TEST(NoisyPlateStop, ALevelThatStopsOnNoiseIsSmoothed)
 {
     // A noisy sphere stops where the next level would follow the noise; the zero set still
@@ -133,8 +116,8 @@ TEST(NoisyPlateStop, ALevelThatStopsOnNoiseIsSmoothed)
     projected.semi_regular.denoise_rounds = 0;
     const ReconstructReport raw = reconstruct(samples, projected);
     EXPECT_EQ(raw.semi_regular.refinement.denoise_rounds, 0U);
-    const double smoothed_error = sphere_error(report.semi_regular.hierarchy);
-    const double raw_error = sphere_error(raw.semi_regular.hierarchy);
+    const double smoothed_error = test::sphere_deviation(report.semi_regular.hierarchy).mean;
+    const double raw_error = test::sphere_deviation(raw.semi_regular.hierarchy).mean;
     RecordProperty("smoothed", std::to_string(smoothed_error));
     RecordProperty("projected", std::to_string(raw_error));
     EXPECT_LT(smoothed_error, 0.85 * raw_error);

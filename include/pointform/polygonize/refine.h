@@ -149,7 +149,8 @@ struct RefineOptions
     /// them (thin-plate fairing, the rest held). Measured on the noisy inputs with holes of
     /// bench/peers (100k samples): symmetric Hausdorff to the truth, % of the diagonal, without
     /// / with: sphere 0.48 / 0.37, plate 1.22 / 0.75, part 1.35 / 1.17; the shipped bunny scan,
-    /// Chamfer to bun_zipper 0.0715 / 0.0651; a clean part unchanged (no region kept).
+    /// Chamfer to bun_zipper 0.0715 / 0.0651; a clean part unchanged (no region kept). Done
+    /// before the smoothing of denoise_rounds, which smooths the faired vertices across creases.
     bool fair_unsupported = true;
     /// refine(): stop once the one-sided Hausdorff distance from the samples to M^J is below
     /// this, in world units (§5.2.4). 0 = estimate_sampling_density(samples)
