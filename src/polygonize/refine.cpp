@@ -1073,7 +1073,10 @@ double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, std::
 constexpr double unsupported_core = 2.5;
 /// ... and a region is kept only when one of its core vertices has every neighbour in the core
 /// too: a hole's patch, not a scattered vertex or a line of them (a crease whose corner the
-/// mesh cuts).
+/// mesh cuts); or when one of its vertices is farther than this many spacings from every sample,
+/// which no random gap is (about 2^-25 of them): a spike, or a hole too narrow for an interior
+/// vertex.
+constexpr double unsupported_far = 5.0;
 /// A kept region then takes in, ring by ring, up to this many rings of neighbours ...
 constexpr std::size_t unsupported_band_rings = 3;
 /// ... that are farther than this many spacings from every sample: the rim around a hole, where
@@ -1169,7 +1172,7 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
                     stack.push_back(w);
                 }
             }
-            interior = interior || all;
+            interior = interior || all || static_cast<double>(excess[v]) > unsupported_far;
         }
         ++regions;
         if (interior)
