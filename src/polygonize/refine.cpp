@@ -956,10 +956,14 @@ Rings vertex_rings(std::span<const Triangle> faces, std::size_t n)
     return rings;
 }
 
-/// The edges of `faces` whose two faces' normals differ by more than 30° (crease_cosine): per
-/// entry of `rings.adjacent`, 1 where the edge to that neighbour is one.
+/// The crease edges of `faces`: those whose two faces' normals differ by more than 30°
+/// (crease_cosine, the projection's crease test), and by more than the noise turns them: three
+/// times atan(noise / the edge's length), `noise` the field's residual at the samples (ends
+/// that noise moves by r tilt a face of side h by about atan(r / h): at 100k noisy samples of
+/// bench/peers, level 1, about 8°; at 1M, level 2, about 30°). Per entry of `rings.adjacent`,
+/// 1 where the edge to that neighbour is one.
 std::vector<std::uint8_t> crease_edges(std::span<const Vec3d> x, std::span<const Triangle> faces,
-                                       const Rings& rings)
+                                       const Rings& rings, double noise)
 {
     std::vector<Vec3d> normal(faces.size());
     parallel_blocks(faces.size(), vertex_block, [&](std::size_t begin, std::size_t end) {
@@ -989,15 +993,19 @@ std::vector<std::uint8_t> crease_edges(std::span<const Vec3d> x, std::span<const
         if (at != last && *at == w)
             crease[static_cast<std::size_t>(at - rings.adjacent.begin())] = 1;
     };
+    const double least = std::acos(crease_cosine);
     for (std::size_t i = 0; i + 1 < sides.size(); ++i)
     {
         if (sides[i].first != sides[i + 1].first ||
             (i + 2 < sides.size() && sides[i + 2].first == sides[i].first))
             continue; // a boundary edge, or a non-manifold one
-        if (normal[sides[i].second].dot(normal[sides[i + 1].second]) < crease_cosine)
+        const auto a = static_cast<std::uint32_t>(sides[i].first >> 32U);
+        const auto b = static_cast<std::uint32_t>(sides[i].first & 0xffffffffU);
+        const double length = (x[a] - x[b]).norm();
+        const double bound = std::max(least, 3.0 * std::atan(noise / std::max(length, 1e-300)));
+        const double cosine = normal[sides[i].second].dot(normal[sides[i + 1].second]);
+        if (bound < std::numbers::pi && cosine < std::cos(bound))
         {
-            const auto a = static_cast<std::uint32_t>(sides[i].first >> 32U);
-            const auto b = static_cast<std::uint32_t>(sides[i].first & 0xffffffffU);
             mark(a, b);
             mark(b, a);
         }
@@ -1007,19 +1015,19 @@ std::vector<std::uint8_t> crease_edges(std::span<const Vec3d> x, std::span<const
 
 /// Taubin's λ|μ smoothing of the finest level, of `faces` (RefineOptions::denoise_rounds): `rounds`
 /// times every vertex moves λ of the way to the mean of its neighbours, then μ of it; a vertex on a
-/// boundary edge stays. Creases (edges whose faces' normals differ by more than 30° as the level
-/// was projected) are kept: a vertex on exactly two crease edges moves along them (the mean of
-/// those two neighbours), one on one or on three or more (a corner) stays. Jacobi steps in
+/// boundary edge stays. Creases (edges whose faces meet at more than 30° and more than the noise
+/// turns them, crease_edges()) are kept: a vertex on exactly two crease edges moves along them (the
+/// mean of those two neighbours), one on one or on three or more (a corner) stays. Jacobi steps in
 /// parallel blocks: the same positions whatever the thread count. Returns the farthest move.
 double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, std::size_t rounds,
-                      std::span<const char> faired)
+                      double noise, std::span<const char> faired)
 {
     constexpr double lambda = 0.5;
     constexpr double mu = -0.53;
     const std::size_t n = mesh.vertex_count();
     const Rings rings = vertex_rings(faces, n);
     const std::span<Vec3d> x = mesh.mutable_positions();
-    const std::vector<std::uint8_t> crease = crease_edges(x, faces, rings);
+    const std::vector<std::uint8_t> crease = crease_edges(x, faces, rings, noise);
     // Per vertex: smoothed over all its neighbours (0), over its two crease neighbours (1), or
     // held (2).
     std::vector<std::uint8_t> kind(n, 0);
@@ -1452,7 +1460,8 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
     if (report.stop == RefineStop::NoisyDetails && options.denoise_rounds > 0)
     {
         report.denoise_rounds = options.denoise_rounds;
-        report.denoise_max_move = denoise_finest(mesh, faces, options.denoise_rounds, faired);
+        report.denoise_max_move =
+            denoise_finest(mesh, faces, options.denoise_rounds, report.field_residual, faired);
         moved = true;
     }
     if (moved || unmeasured)

@@ -131,7 +131,8 @@ struct RefineOptions
     /// rounds of Taubin's λ|μ smoothing (λ = 0.5, μ = −0.53: each vertex towards, then away from,
     /// the mean of its neighbours, which removes the field's noise that the zero set still
     /// carries at the mesh's own scale without shrinking the surface; boundary vertices held;
-    /// creases kept: where the level's faces meet at more than 30°, a vertex on two such edges
+    /// creases kept: where the level's faces meet at more than 30° and more than the noise turns
+    /// them (three times atan(field residual / edge length)), a vertex on two such edges
     /// moves along them only and one on one or three or more, a corner, is held; on the noisy
     /// part of bench/peers Chamfer 0.0818 -> 0.0762 and F@0.5% 0.9980 -> 0.9985 against the
     /// smoothing across them; tests/polygonize/noisy_plate_stop_test.cpp).
