@@ -145,7 +145,8 @@ struct RefineOptions
     /// refine(), StopRule::Automatic: fair the finest level where no sample supports it. The
     /// regions of vertices far from every sample (a filled hole, BaseMeshOptions::fill_holes,
     /// and the band around it where the field extrapolates the rim's last, often noisy, fits:
-    /// farther than 2.5 local sample spacings, with an interior vertex, plus up to 3 rings of
+    /// farther than 2.5 local sample spacings, with an interior vertex or one farther than 5
+    /// (a spike), plus up to 3 rings of
     /// neighbours farther than 1.5) take the smoothest surface that continues the mesh around
     /// them (thin-plate fairing, the rest held). Measured on the noisy inputs with holes of
     /// bench/peers (100k samples): symmetric Hausdorff to the truth, % of the diagonal, without
