@@ -1019,13 +1019,12 @@ std::vector<std::uint8_t> crease_edges(std::span<const Vec3d> x, std::span<const
 /// turns them, crease_edges()) are kept: a vertex on exactly two crease edges moves along them (the
 /// mean of those two neighbours), one on one or on three or more (a corner) stays. Jacobi steps in
 /// parallel blocks: the same positions whatever the thread count. Returns the farthest move.
-double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, std::size_t rounds,
-                      double noise, std::span<const char> faired)
+double denoise_finest(MultiresMesh& mesh, std::span<const Triangle> faces, const Rings& rings,
+                      std::size_t rounds, double noise, std::span<const char> faired)
 {
     constexpr double lambda = 0.5;
     constexpr double mu = -0.53;
     const std::size_t n = mesh.vertex_count();
-    const Rings rings = vertex_rings(faces, n);
     const std::span<Vec3d> x = mesh.mutable_positions();
     const std::vector<std::uint8_t> crease = crease_edges(x, faces, rings, noise);
     // Per vertex: smoothed over all its neighbours (0), over its two crease neighbours (1), or
@@ -1096,7 +1095,7 @@ constexpr double unsupported_band = 1.5;
 /// unsupported_core) take the smoothest surface that continues the mesh around them, thin-plate
 /// fairing as the base mesh's hole patches (Σ ‖L x‖² least over the region and its neighbours,
 /// L the uniform Laplacian, every other vertex held). Vertices on the mesh's boundary are held.
-UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle> faces,
+UnsupportedFairing fair_unsupported(MultiresMesh& mesh, const Rings& rings,
                                     const PointCloud& samples, double spacing,
                                     std::vector<char>& faired)
 {
@@ -1137,7 +1136,6 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
             excess[v] = static_cast<float>(std::sqrt(static_cast<double>(squared)) / local);
         }
     });
-    const Rings rings = vertex_rings(faces, n);
     const auto ring = [&](std::size_t v) {
         return std::span<const std::uint32_t>(rings.adjacent)
             .subspan(rings.offsets[v], rings.offsets[v + 1] - rings.offsets[v]);
@@ -1146,7 +1144,8 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
         return rings.boundary[v] == 0 && static_cast<double>(excess[v]) > unsupported_core &&
                rings.offsets[v + 1] > rings.offsets[v];
     };
-    // The core's connected regions; those with an interior vertex are kept.
+    // The core's connected regions; those with an interior vertex, or one beyond
+    // unsupported_far, are kept.
     constexpr std::uint32_t unset = std::numeric_limits<std::uint32_t>::max();
     std::vector<std::uint32_t> region(n, unset);
     std::vector<char> free(n, 0);
@@ -1450,18 +1449,22 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
         report.levels.push_back(stats);
     }
     bool moved = false;
+    const bool fair = automatic && options.fair_unsupported;
+    const bool denoise = report.stop == RefineStop::NoisyDetails && options.denoise_rounds > 0;
+    // The finest level's vertex rings, for the fairing and the smoothing both.
+    const Rings rings = fair || denoise ? vertex_rings(faces, mesh.vertex_count()) : Rings{};
     std::vector<char> faired(mesh.vertex_count(), 0);
-    if (automatic && options.fair_unsupported)
+    if (fair)
     {
         report.unsupported =
-            fair_unsupported(mesh, faces, samples, report.sampling_density, faired);
+            fair_unsupported(mesh, rings, samples, report.sampling_density, faired);
         moved = report.unsupported.vertices > 0;
     }
-    if (report.stop == RefineStop::NoisyDetails && options.denoise_rounds > 0)
+    if (denoise)
     {
         report.denoise_rounds = options.denoise_rounds;
-        report.denoise_max_move =
-            denoise_finest(mesh, faces, options.denoise_rounds, report.field_residual, faired);
+        report.denoise_max_move = denoise_finest(mesh, faces, rings, options.denoise_rounds,
+                                                 report.field_residual, faired);
         moved = true;
     }
     if (moved || unmeasured)
