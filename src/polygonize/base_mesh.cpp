@@ -1150,8 +1150,9 @@ void collapse_to(OmMesh& mesh, std::size_t target, const BaseMeshStats& stats,
 /// the thread count). Each run is decimated on its own with the vertices it shares with another
 /// run locked: no collapse removes them or ends on them, so every collapse sees the whole
 /// one-ring it changes, as in the whole mesh, and the runs join again where they were cut. A run
-/// keeps its faces at the cuts as they are and takes the rest to its share of the target; the
-/// pass over the whole mesh that follows then coarsens the cuts' faces like the others. Returns
+/// keeps its faces at the cuts as they are and takes the rest to its share of
+/// block_decimation_faces_left(target); the pass over the whole mesh that follows then coarsens
+/// the cuts' faces like the others and makes the last collapses. Returns
 /// the joined mesh (the intermediate mesh's vertices, the runs' faces), or nothing when a run is
 /// not a halfedge mesh of its own (a vertex whose faces in the run OpenMesh cannot link): the
 /// caller then decimates the whole mesh at once.
@@ -1184,7 +1185,8 @@ std::optional<TriMesh> decimate_in_blocks(const TriMesh& intermediate, std::size
             for (const std::uint32_t v : intermediate.triangles[order[k]])
                 run_of[v] =
                     run_of[v] == unseen || run_of[v] == b ? static_cast<std::uint32_t>(b) : shared;
-    const double ratio = static_cast<double>(target) / static_cast<double>(faces);
+    const double ratio = std::min(
+        1.0, static_cast<double>(block_decimation_faces_left(target)) / static_cast<double>(faces));
     std::vector<std::vector<Triangle>> kept(decimation_blocks);
     std::vector<std::uint8_t> linked(decimation_blocks, 1);
     parallel_blocks(
