@@ -19,7 +19,7 @@
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/spatial_sort.h"
 
-#include <Eigen/SparseCholesky>
+#include "thin_plate.h"
 
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <OpenMesh/Tools/Decimater/DecimaterT.hh>
@@ -418,54 +418,22 @@ struct Patch
 /// Returns false, the vertices untouched, where the system is singular.
 bool fair_bilaplacian(OmMesh& mesh, const std::vector<OmMesh::VertexHandle>& free)
 {
-    if (free.empty())
-        return false;
-    // Per vertex: its column (a free vertex) or -1, and whether it has a row yet.
-    std::vector<int> column(mesh.n_vertices(), -1);
+    std::vector<std::uint32_t> indices(free.size());
     for (std::size_t i = 0; i < free.size(); ++i)
-        column[static_cast<std::size_t>(free[i].idx())] = static_cast<int>(i);
-    std::vector<OmMesh::VertexHandle> rows(free);
-    std::vector<char> in_rows(mesh.n_vertices(), 0);
-    for (const auto v : free)
-        in_rows[static_cast<std::size_t>(v.idx())] = 1;
-    for (const auto v : free)
-        for (const auto w : mesh.vv_range(v))
-            if (in_rows[static_cast<std::size_t>(w.idx())] == 0)
-            {
-                in_rows[static_cast<std::size_t>(w.idx())] = 1;
-                rows.push_back(w);
-            }
-    using Sparse = Eigen::SparseMatrix<double>;
-    std::vector<Eigen::Triplet<double>> entries;
-    Eigen::MatrixXd fixed = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), 3);
-    for (std::size_t r = 0; r < rows.size(); ++r)
-    {
-        const auto v = rows[r];
-        const auto degree = static_cast<double>(mesh.valence(v));
-        if (!(degree > 0.0))
-            continue;
-        const auto add = [&](OmMesh::VertexHandle w, double weight) {
-            if (const int c = column[static_cast<std::size_t>(w.idx())]; c >= 0)
-                entries.emplace_back(static_cast<int>(r), c, weight);
-            else
-                fixed.row(static_cast<Eigen::Index>(r)) +=
-                    weight * to_eigen(mesh.point(w)).transpose();
-        };
-        for (const auto w : mesh.vv_range(v))
-            add(w, 1.0 / degree);
-        add(v, -1.0);
-    }
-    Sparse a(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(free.size()));
-    a.setFromTriplets(entries.begin(), entries.end());
-    const Sparse normal = a.transpose() * a;
-    Eigen::SimplicialLDLT<Sparse> solver(normal);
-    if (solver.info() != Eigen::Success)
-        return false;
-    const Eigen::MatrixXd x = solver.solve(-(a.transpose() * fixed));
-    if (solver.info() != Eigen::Success || !x.allFinite())
+        indices[i] = static_cast<std::uint32_t>(free[i].idx());
+    const std::optional<std::vector<Vec3d>> faired = detail::thin_plate_fairing(
+        mesh.n_vertices(), indices,
+        [&mesh](std::uint32_t v, const auto& visit) {
+            for (const auto w : mesh.vv_range(OmMesh::VertexHandle(static_cast<int>(v))))
+                visit(static_cast<std::uint32_t>(w.idx()));
+        },
+        [&mesh](std::uint32_t v) {
+            return to_eigen(mesh.point(OmMesh::VertexHandle(static_cast<int>(v))));
+        });
+    if (!faired)
         return false;
     for (std::size_t i = 0; i < free.size(); ++i)
-        mesh.set_point(free[i], to_om(Vec3d(x.row(static_cast<Eigen::Index>(i)).transpose())));
+        mesh.set_point(free[i], to_om((*faired)[i]));
     return true;
 }
 

@@ -11,7 +11,7 @@
 #include "pointform/spatial/spatial_sort.h"
 #include "pointform/spatial/triangle_bvh.h"
 
-#include <Eigen/SparseCholesky>
+#include "thin_plate.h"
 
 #include <algorithm>
 #include <array>
@@ -1243,51 +1243,14 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, const Rings& rings,
     if (unknowns.empty())
         return out;
     std::sort(unknowns.begin(), unknowns.end());
-    for (std::size_t i = 0; i < unknowns.size(); ++i)
-        column[unknowns[i]] = static_cast<std::uint32_t>(i);
-    // One row per free vertex and per neighbour of one: its uniform Laplacian.
-    std::vector<std::uint32_t> rows = unknowns;
-    std::vector<char> in_rows(n, 0);
-    for (const std::uint32_t v : unknowns)
-        in_rows[v] = 1;
-    for (const std::uint32_t v : unknowns)
-        for (const std::uint32_t w : ring(v))
-            if (in_rows[w] == 0)
-            {
-                in_rows[w] = 1;
-                rows.push_back(w);
-            }
-    using Sparse = Eigen::SparseMatrix<double>;
-    std::vector<Eigen::Triplet<double>> entries;
-    Eigen::MatrixXd fixed = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), 3);
-    for (std::size_t r = 0; r < rows.size(); ++r)
-    {
-        const std::uint32_t v = rows[r];
-        const std::span<const std::uint32_t> neighbours = ring(v);
-        if (neighbours.empty())
-            continue;
-        const double weight = 1.0 / static_cast<double>(neighbours.size());
-        const auto add = [&](std::uint32_t w, double coefficient) {
-            if (column[w] != unset)
-                entries.emplace_back(static_cast<int>(r), static_cast<int>(column[w]), coefficient);
-            else
-                fixed.row(static_cast<Eigen::Index>(r)) += coefficient * x[w].transpose();
-        };
-        for (const std::uint32_t w : neighbours)
-            add(w, weight);
-        add(v, -1.0);
-    }
-    Sparse a(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(unknowns.size()));
-    a.setFromTriplets(entries.begin(), entries.end());
-    const Sparse normal = a.transpose() * a;
-    Eigen::SimplicialLDLT<Sparse> solver(normal);
-    if (solver.info() != Eigen::Success)
-    {
-        out.regions = 0;
-        return out;
-    }
-    const Eigen::MatrixXd solution = solver.solve(-(a.transpose() * fixed));
-    if (solver.info() != Eigen::Success || !solution.allFinite())
+    const std::optional<std::vector<Vec3d>> solution = detail::thin_plate_fairing(
+        n, unknowns,
+        [&](std::uint32_t v, const auto& visit) {
+            for (const std::uint32_t w : ring(v))
+                visit(w);
+        },
+        [&](std::uint32_t v) { return x[v]; });
+    if (!solution)
     {
         out.regions = 0;
         return out;
@@ -1295,7 +1258,7 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, const Rings& rings,
     out.vertices = unknowns.size();
     for (std::size_t i = 0; i < unknowns.size(); ++i)
     {
-        const Vec3d moved = solution.row(static_cast<Eigen::Index>(i)).transpose();
+        const Vec3d& moved = (*solution)[i];
         out.max_move = std::max(out.max_move, (moved - x[unknowns[i]]).norm());
         x[unknowns[i]] = moved;
         faired[unknowns[i]] = 1;
