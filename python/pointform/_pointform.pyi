@@ -199,7 +199,7 @@ def reconstruct(
     base_triangles: object | None = None,
     fill_holes: float = 0.05,
     rim_reach: float = 0.25,
-    denoise_rounds: int = 5,
+    denoise_rounds: int = 10,
 ) -> Hierarchy: ...
 def remesh(
     mesh: Mesh,
@@ -212,7 +212,7 @@ def remesh(
     seed: int = 1,
     k: int = 16,
     radius_scale: float = 1.5,
-    denoise_rounds: int = 5,
+    denoise_rounds: int = 10,
 ) -> Hierarchy: ...
 def model(
     expression_or_file: str,

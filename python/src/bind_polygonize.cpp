@@ -352,7 +352,7 @@ void bind_polygonize(py::module_& m)
         "resolution=0, cell=0.0, min_component_samples=None, base_mesh=None, base_triangles=None, "
         "k=16, "
         "radius_scale=1.5, predictor=..., relax_iterations=..., relaxation=..., fill_holes=0.05, "
-        "rim_reach=0.25, denoise_rounds=5, hole_fairing=True) "
+        "rim_reach=0.25, denoise_rounds=10, hole_fairing=True) "
         "-> Hierarchy\n\n"
         "Points to a semi-regular multiresolution mesh (paper §5), as `pointform reconstruct` "
         "does, with the same defaults and the same result: surfels (pointform.surfels() with "
@@ -401,7 +401,7 @@ void bind_polygonize(py::module_& m)
         py::arg("radius_scale") = default_field_radius_scale,
         py::arg("denoise_rounds") = static_cast<long long>(RefineOptions{}.denoise_rounds),
         "remesh(mesh, *, levels=None, base_faces=None, stop_rule='auto', fit='quadric', "
-        "samples=0, seed=1, k=16, radius_scale=1.5, denoise_rounds=5) -> Hierarchy\n\n"
+        "samples=0, seed=1, k=16, radius_scale=1.5, denoise_rounds=10) -> Hierarchy\n\n"
         "An irregular mesh to a semi-regular one (paper §6), as `pointform remesh` does: its "
         "surfels (pointform.surfels_from_mesh()), the mesh simplified to the base mesh "
         "(base_faces; default a quarter of its faces within [200, 20000]), refined on their "

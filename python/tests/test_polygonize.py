@@ -250,7 +250,7 @@ def test_noisy_levels_are_denoised_as_the_cli_does(tmp_path):
         kwargs = {} if rounds is None else {"denoise_rounds": rounds}
         hierarchy = pointform.reconstruct(cloud, **kwargs)
         assert hierarchy.report["stop"] == "noisy details"
-        assert hierarchy.report["denoise_rounds"] == (5 if rounds is None else 0)
+        assert hierarchy.report["denoise_rounds"] == (10 if rounds is None else 0)
         out = tmp_path / f"cli{rounds}.pfh"
         cli_report = run_cli("reconstruct", points, "-o", tmp_path / "cli.ply", "--save-hierarchy",
                              out, "--json", *([] if rounds is None else ["--denoise", rounds]),
