@@ -1208,7 +1208,6 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, const Rings& rings,
     // Regions of the free vertices; one with no held neighbour (a whole component far from
     // the samples) has nothing to continue and stays.
     std::fill(region.begin(), region.end(), unset);
-    std::vector<std::uint32_t> column(n, unset);
     std::vector<std::uint32_t> unknowns;
     for (std::size_t seed = 0; seed < n; ++seed)
     {
