@@ -250,6 +250,9 @@ def run_measured(cmd, env, timeout, log_stem: Path):
     """Runs cmd under /usr/bin/time in its own process group; never outlives `timeout`."""
     time_path = log_stem.with_suffix(".time")
     full = [TIME, "-o", str(time_path), "-f", "%M %e", *map(str, cmd)]
+    # Each run starts with no dirty pages of an earlier one (a 400 MB output of the run before can
+    # slow this run's write several-fold while the kernel writes it back).
+    os.sync()
     start = time.perf_counter()
     proc = subprocess.Popen(full, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env=env, start_new_session=True)

@@ -8,6 +8,7 @@
 #include "detail_readers.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -713,9 +714,28 @@ ReadResult read_body(Source& source, const PlyHeader& header, NonFinitePolicy po
     return result;
 }
 
-void write_header(OutputBuffer& out, const PointCloudView& cloud, std::size_t faces, bool ascii)
+/// Whether binary files need doubles for the world positions: not when the origin is zero, nor
+/// when every world coordinate is a float (a float input read with an origin is such a cloud:
+/// its floats go back out as they came in, at half the size).
+bool needs_world_double(const PointCloudView& cloud)
 {
-    const bool world_double = !cloud.origin.isZero(0.0);
+    if (cloud.origin.isZero(0.0))
+        return false;
+    std::atomic<bool> exact{true};
+    parallel_blocks(cloud.size(), 1U << 16U, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end && exact.load(std::memory_order_relaxed); ++i)
+        {
+            const Vec3d w = cloud.world(i);
+            if (w.cast<float>().cast<double>() != w)
+                exact.store(false, std::memory_order_relaxed);
+        }
+    });
+    return !exact.load();
+}
+
+void write_header(OutputBuffer& out, const PointCloudView& cloud, std::size_t faces, bool ascii,
+                  bool world_double)
+{
     out.write("ply\nformat ");
     out.write(ascii ? "ascii 1.0\n" : "binary_little_endian 1.0\n");
     out.write("comment written by pointform\nelement vertex ");
@@ -757,6 +777,13 @@ void write_binary_vertices(OutputBuffer& out, const PointCloudView& cloud, bool 
             put(p, w.x());
             put(p, w.y());
             put(p, w.z());
+        }
+        else if (!cloud.origin.isZero(0.0))
+        {
+            const Vec3f v = cloud.world(i).cast<float>(); // exact: see needs_world_double()
+            put(p, v.x());
+            put(p, v.y());
+            put(p, v.z());
         }
         else
         {
@@ -812,8 +839,9 @@ ReadResult read_ply(const std::filesystem::path& path, std::string_view bytes,
 void write_ply(OutputBuffer& out, const PointCloudView& cloud, std::span<const Triangle> triangles,
                bool ascii, int precision)
 {
-    write_header(out, cloud, triangles.size(), ascii);
-    const bool world_double = !cloud.origin.isZero(0.0);
+    // Text keeps the double world values (its numbers are read back as doubles).
+    const bool world_double = ascii ? !cloud.origin.isZero(0.0) : needs_world_double(cloud);
+    write_header(out, cloud, triangles.size(), ascii, world_double);
     if (!ascii)
         write_binary_vertices(out, cloud, world_double);
     for (std::size_t i = 0; ascii && i < cloud.size(); ++i)

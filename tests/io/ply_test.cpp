@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <random>
 #include <set>
 
 namespace pointform::test {
@@ -76,6 +77,47 @@ TEST(PlyRoundTrip, GeoreferencedOriginKeepsPrecision)
             ASSERT_LT((back.world(i) - cloud.world(i)).norm(), 1e-4) << i;
         expect_same_cloud(cloud, back, 1e-6);
     }
+}
+
+TEST(PlyRoundTrip, FloatInputWithAnOriginGoesBackOutAsTheSameFloats)
+{
+    // A float PLY whose first point is away from zero is read with an origin (its rounded first
+    // point); its world coordinates are still the file's floats, so it is written back with
+    // float x y z (not doubles at twice the size) and the very same values.
+    TempDir dir;
+    std::mt19937 random(5);
+    std::uniform_real_distribution<float> around(-3.0F, 3.0F);
+    std::vector<Vec3f> floats;
+    Bytes b;
+    b.text("ply\nformat binary_little_endian 1.0\nelement vertex 3000\nproperty float x\n"
+           "property float y\nproperty float z\nend_header\n");
+    for (int i = 0; i < 3000; ++i)
+    {
+        const Vec3f p(7.6F + around(random), -12.3F + around(random), 0.01F * around(random));
+        floats.push_back(p);
+        b.le(p.x()).le(p.y()).le(p.z());
+    }
+    write_file(dir / "in.ply", b.str());
+    const PointCloud cloud = read_point_cloud(dir / "in.ply");
+    ASSERT_FALSE(cloud.origin.isZero(0.0));
+    write_point_cloud(dir / "out.ply", cloud);
+    const std::string text = read_file(dir / "out.ply");
+    EXPECT_NE(text.find("property float x"), std::string::npos);
+    EXPECT_EQ(text.find("property double"), std::string::npos);
+    const PointCloud back = read_point_cloud(dir / "out.ply");
+    ASSERT_EQ(back.size(), floats.size());
+    for (std::size_t i = 0; i < floats.size(); ++i)
+        ASSERT_EQ(back.world(i), floats[i].cast<double>()) << i;
+
+    // One coordinate that no float holds, and the file goes back to doubles.
+    PointCloud finer = cloud;
+    finer.positions[1234].x() = std::nextafter(finer.positions[1234].x(), 100.0F);
+    finer.origin.x() += 1e-9;
+    write_point_cloud(dir / "finer.ply", finer);
+    EXPECT_NE(read_file(dir / "finer.ply").find("property double x"), std::string::npos);
+    const PointCloud finer_back = read_point_cloud(dir / "finer.ply");
+    for (std::size_t i = 0; i < finer.size(); ++i)
+        ASSERT_LT((finer_back.world(i) - finer.world(i)).norm(), 1e-5) << i;
 }
 
 TEST(PlyRoundTrip, MeshBinaryAndAscii)
