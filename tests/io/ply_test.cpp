@@ -89,8 +89,9 @@ TEST(PlyRoundTrip, FloatInputWithAnOriginGoesBackOutAsTheSameFloats)
     std::uniform_real_distribution<float> around(-3.0F, 3.0F);
     std::vector<Vec3f> floats;
     Bytes b;
-    b.text("ply\nformat binary_little_endian 1.0\nelement vertex 3000\nproperty float x\n"
-           "property float y\nproperty float z\nend_header\n");
+    b.text(
+        "ply\nformat binary_little_endian 1.0\nelement vertex 3000\nproperty float x\n"
+        "property float y\nproperty float z\nend_header\n");
     for (int i = 0; i < 3000; ++i)
     {
         const Vec3f p(7.6F + around(random), -12.3F + around(random), 0.01F * around(random));
