@@ -187,7 +187,17 @@ DistanceComparison compare(const ShapeRef& a, const ShapeRef& b, const CompareOp
     result.relative.symmetric = scaled(result.absolute.symmetric, factor);
     result.relative.hausdorff = result.absolute.hausdorff * factor;
     result.relative.chamfer = result.absolute.chamfer * factor;
-    const auto share_within = [](const std::vector<double>& distances, double limit) {
+    // The F-score's shares are of area: a mesh's area-uniform samples only (the first
+    // options.samples; its vertices, added after them, measure its corners for the maxima but
+    // would weigh the shares by vertex density). A point set counts every point.
+    const auto area_samples = [&options](const ShapeRef& shape, const std::vector<double>& all) {
+        const std::size_t count =
+            shape.mesh != nullptr && options.samples > 0 ? options.samples : all.size();
+        return std::span<const double>(all.data(), std::min(count, all.size()));
+    };
+    const std::span<const double> area_a_to_b = area_samples(a, a_to_b);
+    const std::span<const double> area_b_to_a = area_samples(b, b_to_a);
+    const auto share_within = [](std::span<const double> distances, double limit) {
         const auto within = std::count_if(distances.begin(), distances.end(),
                                           [limit](double d) { return d <= limit; });
         return static_cast<double>(within) / static_cast<double>(distances.size());
@@ -197,8 +207,8 @@ DistanceComparison compare(const ShapeRef& a, const ShapeRef& b, const CompareOp
         FScore score;
         score.threshold = tau;
         score.absolute_threshold = tau * result.diagonal;
-        score.precision = share_within(b_to_a, score.absolute_threshold);
-        score.recall = share_within(a_to_b, score.absolute_threshold);
+        score.precision = share_within(area_b_to_a, score.absolute_threshold);
+        score.recall = share_within(area_a_to_b, score.absolute_threshold);
         const double sum = score.precision + score.recall;
         score.f = sum > 0.0 ? 2.0 * score.precision * score.recall / sum : 0.0;
         result.fscores.push_back(score);

@@ -288,6 +288,41 @@ TEST(Compare, FScoreOfAHalfCoveredSquare)
     EXPECT_THROW((void)compare(a, b, {.fscore_thresholds = {std::nan("")}}), InvalidInput);
 }
 
+TEST(Compare, FScoreSharesAreOfAreaNotOfVertices)
+{
+    // A: the unit square. B: the unit square (two triangles) and, 1 above it, a square of a
+    // tenth of the area cut into 20000 triangles. Precision is B's share of area within τ of A,
+    // 1 / 1.1, however many vertices the far square has (counted with the area samples, its
+    // 10201 vertices would pull it to about 0.75).
+    const TriMesh a = rectangle(1.0F);
+    TriMesh b = rectangle(1.0F);
+    const int n = 100;
+    const float side = std::sqrt(0.1F);
+    const auto first = static_cast<std::uint32_t>(b.vertex_count());
+    for (int y = 0; y <= n; ++y)
+        for (int x = 0; x <= n; ++x)
+            b.vertices.positions.emplace_back(side * static_cast<float>(x) / n,
+                                              side * static_cast<float>(y) / n, 1.0F);
+    const auto id = [first](int x, int y) {
+        return first + static_cast<std::uint32_t>(y * (n + 1) + x);
+    };
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x)
+        {
+            b.triangles.push_back({id(x, y), id(x + 1, y), id(x + 1, y + 1)});
+            b.triangles.push_back({id(x, y), id(x + 1, y + 1), id(x, y + 1)});
+        }
+    const std::size_t samples = 40000;
+    const DistanceComparison result =
+        compare(a, b, {.samples = samples, .fscore_thresholds = {0.05}});
+    const double precision = 1.0 / 1.1;
+    EXPECT_NEAR(result.fscores[0].precision, precision,
+                4.0 * std::sqrt(precision * (1.0 - precision) / samples));
+    EXPECT_DOUBLE_EQ(result.fscores[0].recall, 1.0);
+    // The maxima still see the vertices: the far square's corners are 1 from A at least.
+    EXPECT_GE(result.absolute.b_to_a.max, 1.0);
+}
+
 TEST(Compare, BadInputIsRejected)
 {
     const TriMesh cube = test::box_mesh(Vec3d(0, 0, 0), Vec3d(1, 1, 1));

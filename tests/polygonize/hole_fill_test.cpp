@@ -10,6 +10,7 @@
 #include "pointform/hermite/surfels.h"
 #include "pointform/implicit/point_field.h"
 #include "pointform/implicit/primitives.h"
+#include "pointform/metrics/quality.h"
 #include "pointform/polygonize/base_mesh.h"
 #include "pointform/polygonize/marching_cubes.h"
 #include "pointform/polygonize/reconstruct.h"
@@ -348,6 +349,73 @@ TEST(HoleFill, RegionsNoSampleSupportsAreFaired)
         faired.semi_regular.hierarchy.level_mesh(faired.semi_regular.hierarchy.finest_level());
     EXPECT_TRUE(analyze_topology(mesh).is_closed());
     EXPECT_EQ(analyze_topology(mesh).euler_characteristic, 2);
+}
+
+/// The share of `points` within `reach` of one of `centres`.
+template <typename Points>
+double share_near(const Points& points, std::size_t count, const std::vector<Vec3d>& centres,
+                  double reach)
+{
+    std::size_t near = 0;
+    for (std::size_t i = 0; i < count; ++i)
+        near += std::any_of(centres.begin(), centres.end(),
+                            [&](const Vec3d& c) { return (points.world(i) - c).norm() < reach; })
+                    ? 1
+                    : 0;
+    return static_cast<double>(near) / static_cast<double>(count);
+}
+
+TEST(HoleFill, PatchesAreAsCoarseAsTheRestAndFairedRegionsWellShaped)
+{
+    // A noisy scan (raw points) of the thin plate, whose flat faces the decimation makes
+    // coarse, with six holes of radius 5% of the diagonal (0.14). A patch's rings first take
+    // the edge length of its rim, which the decimation left at about the marching-cubes mesh's:
+    // re-decimated with its rim (only the patches' and the rims' vertices) to the density of the
+    // rest, the base mesh holds about as many vertices over the holes as their area takes, not
+    // several times as many. The faired regions of the finest level are then relaxed along
+    // their surface: few thin triangles anywhere.
+    constexpr double hole = 0.05 * 2.8284;
+    PointCloud raw_points;
+    std::vector<Vec3d> centres;
+    const PointCloud all = sample_shape(Shape::Plate, {.count = 60000, .seed = 9});
+    {
+        const PointCloud drawn = sample_shape(
+            Shape::Plate,
+            {.count = 60000, .seed = 9, .noise = 0.002, .holes = 6, .hole_radius = 0.05});
+        raw_points.origin = drawn.origin;
+        raw_points.positions = drawn.positions;
+        const KdTree kept(drawn.positions);
+        for (std::size_t i = 0; i < all.size(); ++i)
+        {
+            float squared = 0.0F;
+            (void)kept.nearest(all.positions[i], &squared);
+            if (std::sqrt(static_cast<double>(squared)) > 0.8 * hole &&
+                std::none_of(centres.begin(), centres.end(),
+                             [&](const Vec3d& c) { return (c - all.world(i)).norm() < hole; }))
+                centres.push_back(all.world(i));
+        }
+    }
+    ASSERT_GE(centres.size(), 3U);
+    const ReconstructReport report = reconstruct(surfels_from_samples(raw_points).surfels, {});
+    const BaseMeshStats& base = *report.semi_regular.base;
+    EXPECT_GE(base.holes_filled, centres.size());
+    EXPECT_TRUE(base.topology_kept) << base.topology_change;
+    // Base vertices within half a hole's radius of its centre, against the area there (the
+    // share of the noiseless area-uniform samples).
+    const MultiresMesh& hierarchy = report.semi_regular.hierarchy;
+    const TriMesh level0 = hierarchy.level_mesh(0);
+    const double area_share = share_near(all, all.size(), centres, 0.5 * hole);
+    const double vertex_share =
+        share_near(level0.vertices, level0.vertex_count(), centres, 0.5 * hole);
+    RecordProperty("vertex_share", std::to_string(vertex_share));
+    RecordProperty("area_share", std::to_string(area_share));
+    EXPECT_LT(vertex_share, 2.0 * area_share);
+    const TriMesh finest = hierarchy.level_mesh(hierarchy.finest_level());
+    const AngleQuality angles = angle_quality(finest);
+    RecordProperty("slivers", std::to_string(angles.sliver_share));
+    EXPECT_LT(angles.sliver_share, 0.01);
+    EXPECT_TRUE(analyze_topology(finest).is_closed());
+    EXPECT_EQ(analyze_topology(finest).euler_characteristic, 2);
 }
 
 TEST(HoleFill, ASampledSurfaceHasNoUnsupportedRegion)

@@ -87,7 +87,9 @@ struct CompareOptions
 /// \brief F-score at a distance threshold τ, A taken as the reference (ground truth) and B as
 /// the reconstruction (Knapitsch et al. 2017, Tanks and Temples): precision is the fraction of
 /// B's samples within τ of A, recall the fraction of A's samples within τ of B, and F their
-/// harmonic mean (0 when both are 0).
+/// harmonic mean (0 when both are 0). A mesh's samples here are its area-uniform ones only
+/// (CompareOptions::samples; not the vertices that include_vertices adds for the maxima), so
+/// the fractions are of its area, whatever the density of its vertices.
 struct FScore
 {
     double threshold = 0.0;          ///< τ relative to the diagonal
