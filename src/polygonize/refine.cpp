@@ -11,6 +11,7 @@
 #include "pointform/spatial/spatial_sort.h"
 #include "pointform/spatial/triangle_bvh.h"
 
+#include "relax.h"
 #include "thin_plate.h"
 
 #include <algorithm>
@@ -1090,96 +1091,11 @@ constexpr std::size_t unsupported_band_rings = 3;
 /// the field extrapolates the last few (noisy) samples' fits and the mesh follows them.
 constexpr double unsupported_band = 1.5;
 
-/// Rounds of tangential relaxation of the faired vertices (fair_unsupported()).
+/// Rounds of tangential relaxation of the faired vertices (fair_unsupported(),
+/// detail::relax_tangentially()). Measured on three simulated scans of the fandisk
+/// (bench/peers/virtual_scan.py, seeds 1-3), triangles under 20° at the default: 3.03 / 4.42 /
+/// 3.30% unrelaxed, 1.91 / 2.00 / 1.50% after 50 rounds.
 constexpr int faired_relax_rounds = 50;
-
-/// Moves each vertex of `free` (sorted) towards the mean of its neighbours within its tangent
-/// plane (the area-weighted normal of its faces), `rounds` Jacobi steps in parallel blocks (the
-/// same positions whatever the thread count), then puts it back on the surface the region had
-/// before (the closest point of its faces and the ring of faces around them). Thin-plate
-/// fairing with the uniform Laplacian makes a region smooth across, but where its rim is uneven
-/// (a hole's jagged edge, held vertices of unequal spacing) it leaves vertices bunched along the
-/// surface. Measured on three simulated scans of the fandisk (bench/peers/virtual_scan.py,
-/// seeds 1-3), triangles under 20° at the default: 3.03 / 4.42 / 3.30% unrelaxed, 1.91 / 2.00
-/// / 1.50% after 50 rounds; projecting after every round instead of the last cost 0.3-0.7 s
-/// more for the same shares.
-void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces, const Rings& rings,
-                        std::span<const std::uint32_t> free, int rounds)
-{
-    std::vector<std::uint32_t> slot(x.size(), std::numeric_limits<std::uint32_t>::max());
-    for (std::size_t i = 0; i < free.size(); ++i)
-        slot[free[i]] = static_cast<std::uint32_t>(i);
-    std::vector<std::uint32_t> touching;
-    for (std::size_t f = 0; f < faces.size(); ++f)
-        if (std::any_of(faces[f].begin(), faces[f].end(), [&slot](std::uint32_t v) {
-                return slot[v] != std::numeric_limits<std::uint32_t>::max();
-            }))
-            touching.push_back(static_cast<std::uint32_t>(f));
-    if (touching.empty())
-        return;
-    // The faired surface, which every moved vertex is put back on.
-    TriMesh reference;
-    {
-        std::vector<std::uint32_t> local(x.size(), std::numeric_limits<std::uint32_t>::max());
-        reference.triangles.reserve(touching.size());
-        for (const std::uint32_t f : touching)
-        {
-            Triangle t{};
-            for (std::size_t c = 0; c < 3; ++c)
-            {
-                const std::uint32_t v = faces[f][c];
-                if (local[v] == std::numeric_limits<std::uint32_t>::max())
-                {
-                    local[v] = static_cast<std::uint32_t>(reference.vertices.positions.size());
-                    reference.vertices.positions.push_back(x[v].cast<float>());
-                }
-                t[c] = local[v];
-            }
-            reference.triangles.push_back(t);
-        }
-    }
-    const TriangleBvh surface(reference);
-    std::vector<Vec3d> normal(free.size());
-    std::vector<Vec3d> next(free.size());
-    for (int round = 0; round < rounds; ++round)
-    {
-        const bool project = round + 1 == rounds;
-        std::fill(normal.begin(), normal.end(), Vec3d::Zero());
-        for (const std::uint32_t f : touching)
-        {
-            const Triangle& t = faces[f];
-            const Vec3d n = area_normal(x[t[0]], x[t[1]], x[t[2]]);
-            for (const std::uint32_t v : t)
-                if (slot[v] != std::numeric_limits<std::uint32_t>::max())
-                    normal[slot[v]] += n;
-        }
-        parallel_blocks(free.size(), vertex_block, [&](std::size_t begin, std::size_t end) {
-            for (std::size_t i = begin; i < end; ++i)
-            {
-                const std::uint32_t v = free[i];
-                next[i] = x[v];
-                const double length = normal[i].norm();
-                if (!(length > 0.0) || rings.offsets[v + 1] == rings.offsets[v])
-                    continue;
-                const Vec3d n = normal[i] / length;
-                Vec3d mean = Vec3d::Zero();
-                for (std::uint32_t e = rings.offsets[v]; e < rings.offsets[v + 1]; ++e)
-                    mean += x[rings.adjacent[e]];
-                mean /= static_cast<double>(rings.offsets[v + 1] - rings.offsets[v]);
-                const Vec3d move = mean - x[v];
-                next[i] = x[v] + move - move.dot(n) * n;
-                if (project)
-                {
-                    const TriangleBvh::Hit hit = surface.closest(next[i]);
-                    if (hit.found())
-                        next[i] = hit.point;
-                }
-            }
-        });
-        for (std::size_t i = 0; i < free.size(); ++i)
-            x[free[i]] = next[i];
-    }
-}
 
 /// Fairs the finest level where no sample supports it (RefineOptions::fair_unsupported): the
 /// regions of vertices far from every sample (filled holes and the rims around them, see
@@ -1352,7 +1268,8 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
         x[unknowns[i]] = (*solution)[i];
         faired[unknowns[i]] = 1;
     }
-    relax_tangentially(x, faces, rings, unknowns, faired_relax_rounds);
+    detail::relax_tangentially(x, faces, rings.offsets, rings.adjacent, unknowns,
+                               faired_relax_rounds);
     for (const std::uint32_t v : unknowns)
         out.max_move = std::max(out.max_move, (x[v] - before[v]).norm());
     return out;
