@@ -19,6 +19,7 @@
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/spatial_sort.h"
 
+#include "relax.h"
 #include "thin_plate.h"
 
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
@@ -1112,6 +1113,42 @@ void collapse_to(OmMesh& mesh, std::size_t target, const BaseMeshStats& stats,
     decimater.set_observer(nullptr);
 }
 
+/// Rounds of tangential relaxation of the faired vertices (relax_faired()).
+constexpr int faired_relax_rounds = 50;
+
+/// The `free` vertices of `mesh`, just faired, relaxed along the faired surface
+/// (detail::relax_tangentially()), in `position` (by vertex index) and in the mesh.
+void relax_faired(OmMesh& mesh, const std::vector<OmMesh::VertexHandle>& free,
+                  std::vector<Vec3d>& position)
+{
+    std::vector<Triangle> faces;
+    faces.reserve(mesh.n_faces());
+    for (const auto f : mesh.faces())
+    {
+        Triangle t{};
+        std::size_t c = 0;
+        for (const auto v : mesh.fv_range(f))
+            t[c++] = static_cast<std::uint32_t>(v.idx());
+        faces.push_back(t);
+    }
+    std::vector<std::uint32_t> offsets(mesh.n_vertices() + 1, 0);
+    std::vector<std::uint32_t> adjacent;
+    for (const auto v : mesh.vertices())
+    {
+        for (const auto w : mesh.vv_range(v))
+            adjacent.push_back(static_cast<std::uint32_t>(w.idx()));
+        offsets[static_cast<std::size_t>(v.idx()) + 1] =
+            static_cast<std::uint32_t>(adjacent.size());
+    }
+    std::vector<std::uint32_t> indices;
+    for (const auto v : free)
+        indices.push_back(static_cast<std::uint32_t>(v.idx()));
+    std::sort(indices.begin(), indices.end());
+    detail::relax_tangentially(position, faces, offsets, adjacent, indices, faired_relax_rounds);
+    for (const std::uint32_t v : indices)
+        mesh.set_point(OmMesh::VertexHandle(static_cast<int>(v)), to_om(position[v]));
+}
+
 /// The mesh with its holes just filled (fill_holes(); `filled` marks the patches' vertices,
 /// `rim` the vertices that were on a boundary before) decimated again to `target` faces (the
 /// patches at the mean face area of the rest), by collapses that remove only patch and rim
@@ -1443,8 +1480,20 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
                         free.push_back(w);
                     }
             if (fair_bilaplacian(mesh, free))
+            {
                 for (const auto v : free)
                     state.position[static_cast<std::size_t>(v.idx())] = to_eigen(mesh.point(v));
+                // Then spread along the faired surface and flipped to better angles, as the
+                // rounds did the rest: faired where the rounds left them, the patches' vertices
+                // bunched into thin triangles, which refinement splits into four alike at every
+                // level. Measured on three simulated fandisk scans (virtual_scan.py, seeds
+                // 1-3), the finest level's triangles under 20°: 1.48 / 2.35 / 1.48% without,
+                // 1.37 / 2.16 / 1.28% with; Chamfer 0.209 / 1.010 / 0.726 -> 0.205 / 0.999 /
+                // 0.716 (% of the diagonal).
+                relax_faired(mesh, free, state.position);
+                mesh.update_face_normals();
+                stats.flips += improve_by_flips(mesh, options.max_flip_dihedral_degrees * degrees);
+            }
         }
         reporter.finish();
     }
