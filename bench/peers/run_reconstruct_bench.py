@@ -5,7 +5,9 @@ pointform reconstruct (semi-regular, §5) against pointform mc at the same verte
 paper's Fig. 4 claim), Open3D's Poisson at depth 9 and, with --bpa, ball pivoting.
 
 Every tool starts from the same raw points (an analytic shape sampled by `pointform sample`,
-clean or with 0.2% noise and holes) and estimates its own normals: pointform inside its
+clean or with 0.2% noise and holes; the shipped bunny scan; or simulated multi-view range scans
+of a CAD part, data/meshes/fandisk.obj, by virtual_scan.py: occlusion, grazing dropout, range
+noise, holes and strays, measured against the mesh) and estimates its own normals: pointform inside its
 commands, Open3D with estimate_normals + orient_normals_consistent_tangent_plane (k = 16), so
 times are end to end. Per tool: wall time, peak memory (/usr/bin/time), vertices, accuracy
 against the true analytic surface (symmetric Hausdorff and Chamfer in % of the diagonal,
@@ -34,7 +36,9 @@ import open3d as o3d
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from run_normals_bench import run_measured  # noqa: E402
 from plyio import write_ply  # noqa: E402
-from run_surface_bench import BUNNY_MESH, VARIANTS, evaluate_isolated, load_points  # noqa: E402
+from run_surface_bench import (BUNNY_MESH, SCANNED_MESHES, VARIANTS, evaluate_isolated,  # noqa: E402
+                               load_points)
+from virtual_scan import scan, surface_samples  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 
@@ -127,9 +131,13 @@ def main(argv=None) -> int:
     faulthandler.enable()
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--pointform", default="build/release/apps/pointform/pointform")
-    ap.add_argument("--shapes", default="sphere,torus,blobby,part,plate,bunny",
-                    help="analytic shapes of `pointform sample`, and bunny (the shipped scan, "
-                         "clean only, against the Stanford reconstruction bun_zipper)")
+    ap.add_argument("--shapes", default="sphere,torus,blobby,part,plate,bunny,fandisk",
+                    help="analytic shapes of `pointform sample`, bunny (the shipped scan, "
+                         "clean only, against the Stanford reconstruction bun_zipper), and "
+                         "fandisk or spot (simulated scans of data/meshes/, against the mesh: "
+                         "--scan-seeds; --size and --variants do not apply)")
+    ap.add_argument("--scan-seeds", default="1,2,3",
+                    help="seeds of virtual_scan.py for each scanned mesh, comma-separated")
     ap.add_argument("--variants", default="clean,noisy+holes")
     ap.add_argument("--size", type=int, default=100000)
     ap.add_argument("--bpa", action="store_true", help="also ball pivoting (slow)")
@@ -161,16 +169,25 @@ def main(argv=None) -> int:
             if shape == "bunny":
                 # The truth is the Stanford reconstruction; the samples are its own vertices.
                 write_points(truth_path, load_points(BUNNY_MESH))
+            elif shape in SCANNED_MESHES:
+                # The truth's points (for recall): area-uniform samples of the mesh.
+                truth_mesh = o3d.io.read_triangle_mesh(str(SCANNED_MESHES[shape]))
+                write_points(truth_path,
+                             surface_samples(truth_mesh, 200000, np.random.default_rng(99))[0])
             else:
                 run_measured([args.pointform, "sample", shape, "-n", "200000", "--seed", "99",
                               "-o", truth_path], env, 600, work / "truth")
             truth = load_points(truth_path)
-            for variant in args.variants.split(","):
+            variants = (args.variants.split(",") if shape not in SCANNED_MESHES else
+                        [f"scan {seed}" for seed in args.scan_seeds.split(",")])
+            for variant in variants:
                 raw = work / "raw.ply"
                 if shape == "bunny":
                     if variant != "clean":
                         continue
                     write_points(raw, load_points(BUNNY_MESH))
+                elif shape in SCANNED_MESHES:
+                    write_points(raw, scan(str(SCANNED_MESHES[shape]), int(variant.split()[1])))
                 else:
                     run_measured([args.pointform, "sample", shape, "-n", str(args.size), "-o",
                                   work / "with_normals.ply", *VARIANTS[variant]], env, 600,
@@ -182,7 +199,8 @@ def main(argv=None) -> int:
 
                 def measure(name, cmd, out):
                     status, wall, peak, report = run_measured(cmd, env, args.timeout, work / "tool")
-                    row = {"shape": shape, "variant": variant, "size": args.size, "tool": name,
+                    row = {"shape": shape, "variant": variant,
+                           "size": len(samples) if shape in SCANNED_MESHES else args.size, "tool": name,
                            "status": status, "wall_s": wall, "peak_mib": peak}
                     levels = (report or {}).get("levels") or []
                     if levels and "folded_faces" in levels[-1]:

@@ -97,6 +97,9 @@ def _blobby_distance(p: np.ndarray) -> np.ndarray:
 
 # The Stanford bunny's own reconstruction: the truth of the shipped scan (its vertices).
 BUNNY_MESH = HERE.parent.parent / "data" / "bunny" / "bun_zipper.ply"
+# Meshes that run_reconstruct_bench.py scans (virtual_scan.py): each is the truth of its scans.
+SCANNED_MESHES = {"fandisk": HERE.parent.parent / "data" / "meshes" / "fandisk.obj",
+                  "spot": HERE.parent.parent / "data" / "meshes" / "spot.obj"}
 
 
 def _mesh_distance(mesh_path: Path, p: np.ndarray) -> np.ndarray:
@@ -126,6 +129,8 @@ def true_distance(shape: str, p: np.ndarray) -> np.ndarray:
         return _blobby_distance(p)
     if shape == "bunny":
         return _mesh_distance(BUNNY_MESH, p)
+    if shape in SCANNED_MESHES:
+        return _mesh_distance(SCANNED_MESHES[shape], p)
     if shape == "part":
         value = np.min([_primitive_sdf(q, p) for q in PART_ADDED], axis=0)
         value = np.maximum(value, -np.min([_primitive_sdf(q, p) for q in PART_REMOVED], axis=0))

@@ -27,24 +27,31 @@ import numpy as np
 import open3d as o3d
 
 
-def scan(mesh_path: str, seed: int, views: int, resolution: int, noise: float) -> np.ndarray:
-    rng = np.random.default_rng(seed)
-    mesh = o3d.io.read_triangle_mesh(mesh_path)
+def surface_samples(mesh, count: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """`count` area-uniform samples of an Open3D triangle mesh's faces, from `rng` (Open3D's
+    sampler has its own generator), with their faces' unit normals."""
     mesh.compute_triangle_normals()
     vertices = np.asarray(mesh.vertices)
-    low, high = vertices.min(0), vertices.max(0)
-    centre = (low + high) / 2
-    diag = float(np.linalg.norm(high - low))
-    # Area-uniform samples of the faces, from this seed's generator (Open3D's sampler has its own).
     faces = np.asarray(mesh.triangles)
     a, b, c = vertices[faces[:, 0]], vertices[faces[:, 1]], vertices[faces[:, 2]]
     area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
-    face = rng.choice(len(faces), size=3_000_000, p=area / area.sum())
+    face = rng.choice(len(faces), size=count, p=area / area.sum())
     u, v = rng.uniform(size=(2, len(face)))
     flip = u + v > 1
     u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
     points = a[face] + u[:, None] * (b[face] - a[face]) + v[:, None] * (c[face] - a[face])
-    normals = np.asarray(mesh.triangle_normals)[face]
+    return points, np.asarray(mesh.triangle_normals)[face]
+
+
+def scan(mesh_path: str, seed: int, views: int = 6, resolution: int = 260,
+         noise: float = 0.001) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    mesh = o3d.io.read_triangle_mesh(mesh_path)
+    vertices = np.asarray(mesh.vertices)
+    low, high = vertices.min(0), vertices.max(0)
+    centre = (low + high) / 2
+    diag = float(np.linalg.norm(high - low))
+    points, normals = surface_samples(mesh, 3_000_000, rng)
     parts = []
     for _ in range(views):
         direction = rng.normal(size=3)
