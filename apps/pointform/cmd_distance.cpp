@@ -162,8 +162,9 @@ void register_distance(CLI::App& app, const GlobalOptions& global)
     cmd->add_option("--seed", options->seed, "Seed of the sampling")->capture_default_str();
     cmd->add_option("--fscore", options->fscore,
                     "F-score thresholds as fractions of the diagonal, e.g. 0.005,0.01: A is the "
-                    "reference, B the reconstruction (precision: B's samples within the "
-                    "threshold of A; recall: A's within it of B)")
+                    "reference, B the reconstruction (precision: B's area-uniform samples "
+                    "within the threshold of A; recall: A's within it of B; a mesh's vertices "
+                    "count for the maxima only)")
         ->delimiter(',')
         ->check(CLI::PositiveNumber);
     cmd->add_flag("--json", options->json, "Print the statistics as JSON");
