@@ -286,6 +286,41 @@ TEST(HoleFill, ANonManifoldMeshIsLeftAsItIs)
     EXPECT_EQ(mesh.face_count(), 2U);
 }
 
+/// A noisy scan of a shape with holes: its raw points (noise 0.2% of the diagonal, normals left
+/// to be estimated), the noiseless samples of the whole shape from the same seed, and the holes'
+/// centres: noiseless samples farther than `gap` from every kept sample, at least `separation`
+/// apart.
+struct HoledScan
+{
+    PointCloud all;
+    PointCloud raw_points;
+    std::vector<Vec3d> centres;
+};
+
+HoledScan holed_scan(Shape shape, std::uint64_t seed, std::size_t holes, double hole_radius,
+                     double gap, double separation)
+{
+    HoledScan scan;
+    scan.all = sample_shape(shape, {.count = 60000, .seed = seed});
+    const PointCloud drawn = sample_shape(
+        shape,
+        {.count = 60000, .seed = seed, .noise = 0.002, .holes = holes, .hole_radius = hole_radius});
+    scan.raw_points.origin = drawn.origin;
+    scan.raw_points.positions = drawn.positions;
+    const KdTree kept(drawn.positions);
+    for (std::size_t i = 0; i < scan.all.size(); ++i)
+    {
+        float squared = 0.0F;
+        (void)kept.nearest(scan.all.positions[i], &squared);
+        const Vec3d p = scan.all.world(i);
+        if (std::sqrt(static_cast<double>(squared)) > gap &&
+            std::none_of(scan.centres.begin(), scan.centres.end(),
+                         [&](const Vec3d& c) { return (c - p).norm() < separation; }))
+            scan.centres.push_back(p);
+    }
+    return scan;
+}
+
 TEST(HoleFill, RegionsNoSampleSupportsAreFaired)
 {
     // A noisy sphere scan (raw points, noise 0.2% of the diagonal) with eight holes of radius 4%
@@ -293,29 +328,11 @@ TEST(HoleFill, RegionsNoSampleSupportsAreFaired)
     // and the mesh that follows them bulges in and out (0.0119 off the sphere, measured),
     // beyond the flat cap's 0.14²/2 ≈ 0.01. Faired to the smoothest surface that continues the
     // mesh around it (RefineOptions::fair_unsupported), each hole follows the sphere (0.0086).
-    PointCloud raw_points;
-    std::vector<Vec3d> centres;
-    {
-        const PointCloud all = sample_shape(Shape::Sphere, {.count = 60000, .seed = 4});
-        const PointCloud drawn = sample_shape(
-            Shape::Sphere,
-            {.count = 60000, .seed = 4, .noise = 0.002, .holes = 8, .hole_radius = 0.04});
-        raw_points.origin = drawn.origin;
-        raw_points.positions = drawn.positions; // raw points: normals estimated
-        // The holes' centres: noiseless samples farther than 0.1 from every kept sample.
-        const KdTree kept(drawn.positions);
-        for (std::size_t i = 0; i < all.size(); ++i)
-        {
-            float squared = 0.0F;
-            (void)kept.nearest(all.positions[i], &squared);
-            if (std::sqrt(static_cast<double>(squared)) > 0.1 &&
-                std::none_of(centres.begin(), centres.end(),
-                             [&](const Vec3d& c) { return (c - all.world(i)).norm() < 0.3; }))
-                centres.push_back(all.world(i));
-        }
-    }
+    // The holes' centres: noiseless samples farther than 0.1 from every kept sample.
+    const HoledScan scan = holed_scan(Shape::Sphere, 4, 8, 0.04, 0.1, 0.3);
+    const std::vector<Vec3d>& centres = scan.centres;
     ASSERT_GE(centres.size(), 4U);
-    const PointCloud samples = surfels_from_samples(raw_points).surfels;
+    const PointCloud samples = surfels_from_samples(scan.raw_points).surfels;
     const ReconstructReport faired = reconstruct(samples, {});
     ReconstructOptions projected_options;
     projected_options.semi_regular.fair_unsupported = false;
@@ -375,28 +392,10 @@ TEST(HoleFill, PatchesAreAsCoarseAsTheRestAndFairedRegionsWellShaped)
     // several times as many. The faired regions of the finest level are then relaxed along
     // their surface: few thin triangles anywhere.
     constexpr double hole = 0.05 * 2.8284;
-    PointCloud raw_points;
-    std::vector<Vec3d> centres;
-    const PointCloud all = sample_shape(Shape::Plate, {.count = 60000, .seed = 9});
-    {
-        const PointCloud drawn = sample_shape(
-            Shape::Plate,
-            {.count = 60000, .seed = 9, .noise = 0.002, .holes = 6, .hole_radius = 0.05});
-        raw_points.origin = drawn.origin;
-        raw_points.positions = drawn.positions;
-        const KdTree kept(drawn.positions);
-        for (std::size_t i = 0; i < all.size(); ++i)
-        {
-            float squared = 0.0F;
-            (void)kept.nearest(all.positions[i], &squared);
-            if (std::sqrt(static_cast<double>(squared)) > 0.8 * hole &&
-                std::none_of(centres.begin(), centres.end(),
-                             [&](const Vec3d& c) { return (c - all.world(i)).norm() < hole; }))
-                centres.push_back(all.world(i));
-        }
-    }
+    const HoledScan scan = holed_scan(Shape::Plate, 9, 6, 0.05, 0.8 * hole, hole);
+    const std::vector<Vec3d>& centres = scan.centres;
     ASSERT_GE(centres.size(), 3U);
-    const ReconstructReport report = reconstruct(surfels_from_samples(raw_points).surfels, {});
+    const ReconstructReport report = reconstruct(surfels_from_samples(scan.raw_points).surfels, {});
     const BaseMeshStats& base = *report.semi_regular.base;
     EXPECT_GE(base.holes_filled, centres.size());
     EXPECT_TRUE(base.topology_kept) << base.topology_change;
@@ -404,7 +403,7 @@ TEST(HoleFill, PatchesAreAsCoarseAsTheRestAndFairedRegionsWellShaped)
     // share of the noiseless area-uniform samples).
     const MultiresMesh& hierarchy = report.semi_regular.hierarchy;
     const TriMesh level0 = hierarchy.level_mesh(0);
-    const double area_share = share_near(all, all.size(), centres, 0.5 * hole);
+    const double area_share = share_near(scan.all, scan.all.size(), centres, 0.5 * hole);
     const double vertex_share =
         share_near(level0.vertices, level0.vertex_count(), centres, 0.5 * hole);
     RecordProperty("vertex_share", std::to_string(vertex_share));
