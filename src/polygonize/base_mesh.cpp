@@ -1113,9 +1113,6 @@ void collapse_to(OmMesh& mesh, std::size_t target, const BaseMeshStats& stats,
     decimater.set_observer(nullptr);
 }
 
-/// Rounds of tangential relaxation of the faired vertices (relax_faired()).
-constexpr int faired_relax_rounds = 50;
-
 /// The `free` vertices of `mesh`, just faired, relaxed along the faired surface
 /// (detail::relax_tangentially()), in `position` (by vertex index) and in the mesh.
 void relax_faired(OmMesh& mesh, const std::vector<OmMesh::VertexHandle>& free,
@@ -1144,7 +1141,8 @@ void relax_faired(OmMesh& mesh, const std::vector<OmMesh::VertexHandle>& free,
     for (const auto v : free)
         indices.push_back(static_cast<std::uint32_t>(v.idx()));
     std::sort(indices.begin(), indices.end());
-    detail::relax_tangentially(position, faces, offsets, adjacent, indices, faired_relax_rounds);
+    detail::relax_tangentially(position, faces, offsets, adjacent, indices,
+                               detail::faired_relax_rounds);
     for (const std::uint32_t v : indices)
         mesh.set_point(OmMesh::VertexHandle(static_cast<int>(v)), to_om(position[v]));
 }
@@ -1491,7 +1489,6 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
                 // 1.37 / 2.16 / 1.28% with; Chamfer 0.209 / 1.010 / 0.726 -> 0.205 / 0.999 /
                 // 0.716 (% of the diagonal).
                 relax_faired(mesh, free, state.position);
-                mesh.update_face_normals();
                 stats.flips += improve_by_flips(mesh, options.max_flip_dihedral_degrees * degrees);
             }
         }

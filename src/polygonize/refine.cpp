@@ -1091,12 +1091,6 @@ constexpr std::size_t unsupported_band_rings = 3;
 /// the field extrapolates the last few (noisy) samples' fits and the mesh follows them.
 constexpr double unsupported_band = 1.5;
 
-/// Rounds of tangential relaxation of the faired vertices (fair_unsupported(),
-/// detail::relax_tangentially()). Measured on three simulated scans of the fandisk
-/// (bench/peers/virtual_scan.py, seeds 1-3), triangles under 20° at the default: 3.03 / 4.42 /
-/// 3.30% unrelaxed, 1.91 / 2.00 / 1.50% after 50 rounds.
-constexpr int faired_relax_rounds = 50;
-
 /// Fairs the finest level where no sample supports it (RefineOptions::fair_unsupported): the
 /// regions of vertices far from every sample (filled holes and the rims around them, see
 /// unsupported_core) take the smoothest surface that continues the mesh around them, thin-plate
@@ -1262,16 +1256,17 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
         return out;
     }
     out.vertices = unknowns.size();
-    const std::vector<Vec3d> before(x.begin(), x.end());
+    std::vector<Vec3d> before(unknowns.size());
     for (std::size_t i = 0; i < unknowns.size(); ++i)
     {
+        before[i] = x[unknowns[i]];
         x[unknowns[i]] = (*solution)[i];
         faired[unknowns[i]] = 1;
     }
     detail::relax_tangentially(x, faces, rings.offsets, rings.adjacent, unknowns,
-                               faired_relax_rounds);
-    for (const std::uint32_t v : unknowns)
-        out.max_move = std::max(out.max_move, (x[v] - before[v]).norm());
+                               detail::faired_relax_rounds);
+    for (std::size_t i = 0; i < unknowns.size(); ++i)
+        out.max_move = std::max(out.max_move, (x[unknowns[i]] - before[i]).norm());
     return out;
 }
 
