@@ -18,7 +18,6 @@ struct LineSample
     double t = 0.0;
     double value = 0.0;
     bool defined = false;
-    double slope = 0.0; ///< |∇f|
 };
 
 class Line
@@ -31,7 +30,7 @@ public:
     {
         if (!std::isfinite(s.value))
             return {t, std::numeric_limits<double>::quiet_NaN(), false};
-        return {t, s.value, s.defined, s.gradient.norm()};
+        return {t, s.value, s.defined};
     }
     [[nodiscard]] Vec3d point(double t) const { return p_ + t * d_; }
 
@@ -42,12 +41,12 @@ private:
 };
 
 /// Refines a bracket lo.t < hi.t, lo.value < 0 <= hi.value, by Illinois regula falsi. Returns
-/// the sample at the crossing, or nullopt if the located point is not a defined sample.
-std::optional<LineSample> refine_bracket(const Line& line, LineSample lo, LineSample hi,
-                                         double tolerance, int max_iterations)
+/// the parameter of the crossing, or nullopt if the located point is not a defined sample.
+std::optional<double> refine_bracket(const Line& line, LineSample lo, LineSample hi,
+                                     double tolerance, int max_iterations)
 {
     if (hi.value == 0.0 && hi.defined)
-        return hi;
+        return hi.t;
     double flo = lo.value;
     double fhi = hi.value;
     int side = 0; // which end was replaced last time: -1 lo, +1 hi
@@ -66,7 +65,7 @@ std::optional<LineSample> refine_bracket(const Line& line, LineSample lo, LineSa
         if (std::abs(s.value) <= tolerance)
         {
             if (s.defined)
-                return s;
+                return t;
         }
         if (s.value < 0.0)
         {
@@ -91,9 +90,9 @@ std::optional<LineSample> refine_bracket(const Line& line, LineSample lo, LineSa
     const LineSample& a = std::abs(lo.value) <= std::abs(hi.value) ? lo : hi;
     const LineSample& b = (&a == &lo) ? hi : lo;
     if (a.defined && (b.defined || std::abs(a.value) <= 16.0 * tolerance))
-        return a;
+        return a.t;
     if (b.defined && std::abs(b.value) <= 16.0 * tolerance)
-        return b;
+        return b.t;
     return std::nullopt;
 }
 
@@ -107,11 +106,10 @@ std::optional<Vec3d> project_from(const Field& field, const FieldSample* at_p, c
                                   const ProjectionOptions& options)
 {
     if (options.steps < 1 || options.max_iterations < 1 ||
-        !(options.relative_tolerance > 0.0 && std::isfinite(options.relative_tolerance)) ||
-        !(options.max_slope > 0.0))
+        !(options.relative_tolerance > 0.0 && std::isfinite(options.relative_tolerance)))
         throw InvalidInput(
-            "project_to_zero: steps and max_iterations must be >= 1, the tolerance positive and "
-            "finite and max_slope positive");
+            "project_to_zero: steps and max_iterations must be >= 1 and the "
+            "tolerance positive and finite");
     const double length = direction.norm();
     if (!(length > 0.0) || !std::isfinite(length) || !(max_distance > 0.0) ||
         !std::isfinite(max_distance) || !p.allFinite())
@@ -139,33 +137,22 @@ std::optional<Vec3d> project_from(const Field& field, const FieldSample* at_p, c
         const LineSample pos = line.at(r);
         const LineSample neg = line.at(-r);
 
-        // A crossing where the field is far steeper than a distance (FieldSample's values are
-        // distance-like, |∇f| about 1 on the surface) is no surface: it is the narrow step
-        // between two local surfaces that disagree (a blend across a crease, rim or noise),
-        // which the line happens to cross (ProjectionOptions::max_slope).
-        const auto steep = [&](const std::optional<LineSample>& s) {
-            return s && !(s->slope <= options.max_slope);
-        };
-        std::optional<LineSample> best;
+        std::optional<double> best;
         // Positive side: interval [pos_prev.t, pos.t], crossing when pos_prev < 0 <= pos.
         // Undefined samples still carry the sign (field.h), so a band of definition thinner than
         // a step is not jumped over; the located point must be defined.
         if (pos_prev.value < 0.0 && pos.value >= 0.0)
-        {
             best = refine_bracket(line, pos_prev, pos, tolerance, options.max_iterations);
-            if (steep(best))
-                best.reset();
-        }
         // Negative side: interval [neg.t, neg_prev.t], crossing when neg < 0 <= neg_prev.
         if (neg.value < 0.0 && neg_prev.value >= 0.0)
         {
-            const std::optional<LineSample> s =
+            const std::optional<double> t =
                 refine_bracket(line, neg, neg_prev, tolerance, options.max_iterations);
-            if (s && !steep(s) && (!best || std::abs(s->t) < std::abs(best->t)))
-                best = s;
+            if (t && (!best || std::abs(*t) < std::abs(*best)))
+                best = t;
         }
         if (best)
-            return line.point(best->t);
+            return line.point(*best);
         pos_prev = pos;
         neg_prev = neg;
     }

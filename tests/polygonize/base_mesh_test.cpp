@@ -160,7 +160,7 @@ TEST(BaseMesh, SampledSphereReachesTheTargetOnTheSurface)
 TEST(BaseMesh, ShapeRoundsStopWhenTheyGainLittle)
 {
     // Noisy samples leave triangles under the target after every round: asked to stop once a
-    // round removes less than a third of them, the rounds end earlier than by default (until none
+    // round removes less than a tenth of them, the rounds end earlier than by default (until none
     // goes), with the same topology and still few thin triangles. Decimated as a whole: the
     // blocks' mesh leaves fewer thin triangles to the rounds.
     PointCloud samples = sample_shape(Shape::Sphere, {.count = 50000, .seed = 6, .noise = 0.002});
@@ -169,7 +169,7 @@ TEST(BaseMesh, ShapeRoundsStopWhenTheyGainLittle)
     const TriMesh mc =
         marching_cubes(field, grid_over(field.bounds(), default_cell_size(field))).mesh;
     const BaseMeshResult some = build_base_mesh(
-        mc, field, {.target_faces = 6000, .min_round_gain = 0.3, .block_decimation_faces = 0});
+        mc, field, {.target_faces = 6000, .min_round_gain = 0.1, .block_decimation_faces = 0});
     const BaseMeshResult all =
         build_base_mesh(mc, field, {.target_faces = 6000, .block_decimation_faces = 0});
     EXPECT_GE(some.stats.smoothing_rounds, 2);

@@ -172,68 +172,6 @@ TEST(Projection, FindsTheNearestOutwardCrossing)
                  InvalidInput);
 }
 
-TEST(Projection, AStepBetweenDisagreeingSurfacesIsNoCrossing)
-{
-    // g(z) = z - 0.6 + 0.4 H((z - 0.3) / w): inside below z = 0.3, then a step of 0.4 over a
-    // width w = 0.002 to the surface z = 0.2, which lies below the step: g changes sign only on
-    // the step, where it is 200 times as steep as a distance. As a blend jumps between two
-    // local surfaces that disagree, that is no point of either.
-    struct Step : Field
-    {
-        using Field::evaluate;
-        [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override
-        {
-            constexpr double width = 0.002;
-            const double u = (p.z() - 0.3) / width;
-            const double h = 0.5 * (1.0 + std::tanh(u));
-            const double dh = 0.5 / (std::cosh(u) * std::cosh(u)) / width;
-            return {.value = p.z() - 0.6 + 0.4 * h,
-                    .gradient = Vec3d(0.0, 0.0, 1.0 + 0.4 * dh),
-                    .defined = true};
-        }
-        [[nodiscard]] Aabb bounds() const override
-        {
-            return {Vec3d::Constant(-1.0), Vec3d::Constant(1.0)};
-        }
-    };
-    const Step step;
-    EXPECT_FALSE(project_to_zero(step, Vec3d::Zero(), Vec3d::UnitZ(), 1.0));
-    // Accepting any slope finds the step.
-    const auto on_step = project_to_zero(step, Vec3d::Zero(), Vec3d::UnitZ(), 1.0,
-                                         {.max_slope = std::numeric_limits<double>::infinity()});
-    ASSERT_TRUE(on_step);
-    EXPECT_NEAR(on_step->z(), 0.3, 0.002);
-    // The march goes on past a rejected step: h(z) = z - 0.8 + 0.6 (H((z - 0.3) / w) -
-    // H((z - 0.35) / w)) steps out at 0.3 and back in at 0.35; its surface is z = 0.8.
-    struct Bump : Field
-    {
-        using Field::evaluate;
-        [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override
-        {
-            constexpr double width = 0.002;
-            double value = p.z() - 0.8;
-            double slope = 1.0;
-            for (const auto& [at, sign] : {std::pair(0.3, 1.0), std::pair(0.35, -1.0)})
-            {
-                const double u = (p.z() - at) / width;
-                value += sign * 0.3 * (1.0 + std::tanh(u));
-                slope += sign * 0.3 / (std::cosh(u) * std::cosh(u)) / width;
-            }
-            return {.value = value, .gradient = Vec3d(0.0, 0.0, slope), .defined = true};
-        }
-        [[nodiscard]] Aabb bounds() const override
-        {
-            return {Vec3d::Constant(-1.0), Vec3d::Constant(1.0)};
-        }
-    };
-    const auto beyond = project_to_zero(Bump{}, Vec3d::Zero(), Vec3d::UnitZ(), 1.0);
-    ASSERT_TRUE(beyond);
-    EXPECT_NEAR(beyond->z(), 0.8, 1e-6);
-    EXPECT_THROW(
-        (void)project_to_zero(step, Vec3d::Zero(), Vec3d::UnitZ(), 1.0, {.max_slope = 0.0}),
-        InvalidInput);
-}
-
 TEST(Projection, TheCallersSampleAtTheStartGivesTheSamePoint)
 {
     // A counting field: the caller's sample at p saves the evaluations at p, nothing else.

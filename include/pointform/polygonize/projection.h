@@ -21,15 +21,6 @@ struct ProjectionOptions
     double relative_tolerance = 1e-7;
     /// Most field evaluations spent refining one bracket (Illinois regula falsi).
     int max_iterations = 64;
-    /// A located crossing where |∇f| exceeds this is no crossing (the march goes on): the
-    /// fields here are distance-like, |∇f| about 1 on their surface, and a point field's is
-    /// far steeper only across the narrow step between two local surfaces that disagree (a
-    /// blend across a concave crease or a noisy rim), where a new vertex projected onto the
-    /// step stands off the surface as a spike (0.16% of the diagonal on a clean 1M-sample
-    /// blobby of bench/peers). On the 100k inputs of bench/peers over 98% of the crossings
-    /// that `reconstruct` locates measure |∇f| 0.7-1.4, and 0.01-0.3% over 2.8. Positive;
-    /// infinity accepts every crossing.
-    double max_slope = 3.0;
 };
 
 /// \brief Zero crossing of the field on the segment p + t·direction, |t| <= max_distance, nearest
@@ -44,8 +35,7 @@ struct ProjectionOptions
 /// The nearest bracket (ties: the positive side) is refined by Illinois regula falsi to
 /// options.relative_tolerance · max_distance; the located point must be a defined sample, and a
 /// sign change at the border between defined and undefined space (the rim of a hole in a point
-/// field, where the surface ends) is no crossing, nor one steeper than options.max_slope. A
-/// rejected bracket lets the march go on.
+/// field, where the surface ends) is no crossing. A rejected bracket lets the march go on.
 /// Deterministic: the same input gives the same point.
 /// \param direction  need not be unit length; a zero or non-finite direction, a non-positive or
 ///                   non-finite max_distance or a non-finite p give nullopt
@@ -53,8 +43,8 @@ struct ProjectionOptions
                                                    const Vec3d& direction, double max_distance);
 
 /// \brief project_to_zero() with explicit options.
-/// \throw InvalidInput if options.steps < 1, options.max_iterations < 1, the tolerance is not
-///        positive and finite or max_slope is not positive
+/// \throw InvalidInput if options.steps < 1, options.max_iterations < 1 or the tolerance is not
+///        positive and finite
 [[nodiscard]] std::optional<Vec3d> project_to_zero(const Field& field, const Vec3d& p,
                                                    const Vec3d& direction, double max_distance,
                                                    const ProjectionOptions& options);
