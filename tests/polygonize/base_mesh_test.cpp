@@ -15,6 +15,7 @@
 #include "pointform/polygonize/marching_cubes.h"
 #include "pointform/spatial/kd_tree.h"
 
+#include "support/test_meshes.h"
 #include "support/test_support.h"
 #include "support/thread_counts.h"
 
@@ -155,6 +156,56 @@ TEST(BaseMesh, SampledSphereReachesTheTargetOnTheSurface)
         ASSERT_GT(n.norm(), 1e-6);
         ASSERT_GT(n.normalized().dot(centre.normalized()), 0.5);
     }
+}
+
+TEST(BaseMesh, ADentOnAFoldOfTheFieldIsPutBackOnTheSurface)
+{
+    // The unit sphere's distance with a pocket of "outside" under the surface, the shell
+    // 0.9 < |p| < 0.905 (a noisy rim's field can fold so): a vertex of valence 3 dented onto
+    // the pocket's wall lies on f = 0, and its own projection holds it there. Its neighbours lie
+    // on the sphere, and so does the projection of their centroid: the base mesh's rounds put it
+    // back on the sphere.
+    struct Pocket : Field
+    {
+        using Field::evaluate;
+        [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override
+        {
+            const double r = p.norm();
+            const Vec3d radial = r > 0.0 ? Vec3d(p / r) : Vec3d::UnitZ();
+            const double sphere = r - 1.0;
+            const double pocket = 0.0025 - std::abs(r - 0.9025);
+            if (sphere >= pocket)
+                return {.value = sphere, .gradient = radial, .defined = true};
+            return {.value = pocket,
+                    .gradient = r < 0.9025 ? Vec3d(radial) : Vec3d(-radial),
+                    .defined = true};
+        }
+        [[nodiscard]] Aabb bounds() const override
+        {
+            return {Vec3d::Constant(-1.5), Vec3d::Constant(1.5)};
+        }
+    };
+    const Pocket field;
+    TriMesh mesh = test::icosphere(2);
+    // Face 0 split at its centre, pushed in to the pocket's inner wall.
+    const Triangle split = mesh.triangles[0];
+    Vec3d centre = Vec3d::Zero();
+    for (const std::uint32_t v : split)
+        centre += mesh.vertices.positions[v].cast<double>();
+    const Vec3d dent = 0.9 * centre.normalized();
+    const auto d = static_cast<std::uint32_t>(mesh.vertices.positions.size());
+    mesh.vertices.positions.push_back(dent.cast<float>());
+    mesh.triangles[0] = {split[0], split[1], d};
+    mesh.triangles.push_back({split[1], split[2], d});
+    mesh.triangles.push_back({split[2], split[0], d});
+    ASSERT_NEAR(field.evaluate(dent).value, 0.0, 1e-6);
+    const BaseMeshResult result = build_base_mesh(
+        mesh, field, {.target_faces = mesh.triangles.size(), .block_decimation_faces = 0});
+    ASSERT_EQ(result.mesh.triangles.size(), mesh.triangles.size());
+    double farthest = 0.0;
+    for (const Vec3f& p : result.mesh.vertices.positions)
+        farthest = std::max(farthest, std::abs(p.cast<double>().norm() - 1.0));
+    EXPECT_LT(farthest, 1e-4);
 }
 
 TEST(BaseMesh, ShapeRoundsStopWhenTheyGainLittle)
