@@ -93,6 +93,10 @@ void print_refinement(const SemiRegularReport& r)
                                       " rounds of Taubin smoothing of the finest level (its "
                                       "details were noise); farthest move " +
                                       format_number(r.refinement.denoise_max_move));
+        if (r.refinement.spikes > 0)
+            print_row("spikes", std::to_string(r.refinement.spikes) +
+                                    " vertices that stood off their neighbours' surface alone, "
+                                    "put back on the field from the neighbours' centroid");
         if (r.refinement.unsupported.regions > 0)
             print_row("faired", std::to_string(r.refinement.unsupported.regions) +
                                     " regions no sample supports (filled holes and their "

@@ -1434,6 +1434,15 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
                                                  report.field_residual, faired);
         moved = true;
     }
+    if (automatic)
+    {
+        const Rings spike_rings =
+            fair || denoise ? Rings{} : vertex_rings(faces, mesh.vertex_count());
+        const Rings& r = fair || denoise ? rings : spike_rings;
+        report.spikes = detail::despike(mesh.mutable_positions(), mesh.origin(), field, r.offsets,
+                                        r.adjacent, r.boundary);
+        moved = moved || report.spikes > 0;
+    }
     if (moved || unmeasured)
         measure(unmeasured);
     return report;

@@ -4,10 +4,15 @@
 #include "relax.h"
 
 #include "pointform/core/parallel.h"
+#include "pointform/polygonize/projection.h"
 #include "pointform/spatial/triangle_bvh.h"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
+#include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 namespace pointform::detail {
@@ -101,6 +106,88 @@ void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces,
         for (std::size_t i = 0; i < free.size(); ++i)
             x[free[i]] = next[i];
     }
+}
+
+/// despike_finest(): a vertex is a spike when it stands farther than this share of its mean
+/// edge from the plane of its neighbours (their least-squares plane) ...
+constexpr double spike_offset = 0.25;
+/// ... and farther than this many times as far as the second farthest of its neighbours from
+/// theirs (each neighbour's ring holds the spike, which raises its own offset; along a crease
+/// two neighbours stand as far as the vertex, at a corner three).
+constexpr double spike_isolation = 2.5;
+
+std::size_t despike(std::span<Vec3d> x, const Vec3d& origin, const Field& field,
+                    std::span<const std::uint32_t> ring_offsets,
+                    std::span<const std::uint32_t> ring_adjacent,
+                    std::span<const std::uint8_t> boundary)
+{
+    const std::size_t n = x.size();
+    std::vector<Vec3d> centre(n, Vec3d::Zero());
+    std::vector<double> offset(n, 0.0);
+    std::vector<double> edge(n, 0.0);
+    const auto ring = [&](std::size_t v) {
+        return ring_adjacent.subspan(ring_offsets[v], ring_offsets[v + 1] - ring_offsets[v]);
+    };
+    parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t v = begin; v < end; ++v)
+        {
+            const auto r = ring(v);
+            if (r.size() < 3)
+                continue;
+            Vec3d c = Vec3d::Zero();
+            double length = 0.0;
+            for (const std::uint32_t w : r)
+            {
+                c += x[w];
+                length += (x[w] - x[v]).norm();
+            }
+            c /= static_cast<double>(r.size());
+            Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+            for (const std::uint32_t w : r)
+                scatter += (x[w] - c) * (x[w] - c).transpose();
+            const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+            centre[v] = c;
+            offset[v] = std::abs((x[v] - c).dot(eigen.eigenvectors().col(0)));
+            edge[v] = length / static_cast<double>(r.size());
+        }
+    });
+    std::vector<Vec3d> next(n);
+    std::vector<char> moved(n, 0);
+    parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t v = begin; v < end; ++v)
+        {
+            const auto r = ring(v);
+            if (r.size() < 3 || boundary[v] != 0 || !(offset[v] > spike_offset * edge[v]))
+                continue;
+            double most = 0.0;
+            double second = 0.0;
+            for (const std::uint32_t w : r)
+            {
+                second = std::max(second, std::min(most, offset[w]));
+                most = std::max(most, offset[w]);
+            }
+            if (!(offset[v] > spike_isolation * second))
+                continue;
+            const FieldSample at = field.evaluate(origin + centre[v]);
+            if (!at.defined || !(std::abs(at.value) < 0.25 * offset[v]) ||
+                !at.gradient.allFinite() || !(at.gradient.squaredNorm() > 0.0))
+                continue;
+            const std::optional<Vec3d> hit =
+                project_to_zero(field, at, origin + centre[v], at.gradient.normalized(), edge[v]);
+            if (!hit)
+                continue;
+            next[v] = *hit - origin;
+            moved[v] = 1;
+        }
+    });
+    std::size_t count = 0;
+    for (std::size_t v = 0; v < n; ++v)
+        if (moved[v] != 0)
+        {
+            x[v] = next[v];
+            ++count;
+        }
+    return count;
 }
 
 } // namespace pointform::detail

@@ -5,7 +5,9 @@
 
 #include "pointform/core/types.h"
 #include "pointform/geometry/tri_mesh.h"
+#include "pointform/implicit/field.h"
 
+#include <cstddef>
 #include <cstdint>
 #include <span>
 
@@ -34,5 +36,24 @@ void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces,
                         std::span<const std::uint32_t> ring_offsets,
                         std::span<const std::uint32_t> ring_adjacent,
                         std::span<const std::uint32_t> free, int rounds);
+
+/// Puts back the finest level's isolated spikes and dents: vertices that stand off their
+/// neighbours' plane (spike_offset, spike_isolation) while the field at their neighbours'
+/// centroid is within a quarter of that offset of zero (the neighbours lie on a smooth piece
+/// of the surface; at a crease the centroid lies off it as the vertex does) go to the
+/// projection of the centroid along the gradient there, Jacobi style (every test on the same
+/// positions). A new vertex can land on a narrow step of the field (the blend between two local
+/// fits that disagree, at a concave crease: on the clean 1M blobby of bench/peers one stood
+/// 0.16% of the diagonal off the truth, the output's largest distance, where marching cubes at
+/// the same count measure 0.135%; 0.124% after). Boundary vertices stay. Returns how many
+/// moved.
+/// \param x  every vertex's position, relative to `origin` (the field's world is origin + x)
+/// \param ring_offsets, ring_adjacent  each vertex v's neighbours,
+///        ring_adjacent[ring_offsets[v] .. ring_offsets[v + 1])
+/// \param boundary  per vertex, nonzero on the mesh's boundary
+std::size_t despike(std::span<Vec3d> x, const Vec3d& origin, const Field& field,
+                    std::span<const std::uint32_t> ring_offsets,
+                    std::span<const std::uint32_t> ring_adjacent,
+                    std::span<const std::uint8_t> boundary);
 
 } // namespace pointform::detail

@@ -217,6 +217,7 @@ nlohmann::json report_json(const SemiRegularReport& r, const SemiRegularOptions&
         out["detail_threshold"] = r.refinement.detail_threshold;
         out["denoise_rounds"] = r.refinement.denoise_rounds;
         out["denoise_max_move"] = r.refinement.denoise_max_move;
+        out["spikes"] = r.refinement.spikes;
         out["unsupported_regions"] = r.refinement.unsupported.regions;
         out["unsupported_vertices"] = r.refinement.unsupported.vertices;
         out["unsupported_max_move"] = r.refinement.unsupported.max_move;

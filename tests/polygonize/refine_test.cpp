@@ -13,6 +13,7 @@
 #include "pointform/polygonize/projection.h"
 #include "pointform/spatial/kd_tree.h"
 
+#include "relax.h"
 #include "support/test_meshes.h"
 #include "support/thread_counts.h"
 
@@ -527,6 +528,71 @@ TEST(RefineAutomaticStop, CleanSphereRefinesToTheVertexBudget)
     EXPECT_EQ(mesh.finest_level(), 5U);
     EXPECT_LT(sphere_error(mesh), 0.2 * report.sampling_density);
     EXPECT_FALSE(report.dropped);
+}
+
+/// The vertex rings of a mesh as detail::despike() takes them.
+struct TestRings
+{
+    std::vector<std::uint32_t> offsets;
+    std::vector<std::uint32_t> adjacent;
+    std::vector<std::uint8_t> boundary;
+};
+
+TestRings rings_of(const TriMesh& mesh)
+{
+    std::vector<std::set<std::uint32_t>> sets(mesh.vertex_count());
+    for (const Triangle& t : mesh.triangles)
+        for (std::size_t c = 0; c < 3; ++c)
+        {
+            sets[t[c]].insert(t[(c + 1) % 3]);
+            sets[t[(c + 1) % 3]].insert(t[c]);
+        }
+    TestRings rings;
+    rings.offsets.push_back(0);
+    for (const auto& set : sets)
+    {
+        rings.adjacent.insert(rings.adjacent.end(), set.begin(), set.end());
+        rings.offsets.push_back(static_cast<std::uint32_t>(rings.adjacent.size()));
+    }
+    rings.boundary.assign(mesh.vertex_count(), 0);
+    return rings;
+}
+
+TEST(Despike, ALoneSpikeGoesBackOnTheSurfaceAndCreasesStay)
+{
+    // An icosphere on the unit sphere's field with one vertex pushed out by 0.2 (its edges are
+    // about 0.15): back on the sphere, from its neighbours' centroid; nothing else moves.
+    const auto sphere = make_sphere(Vec3d::Zero(), 1.0);
+    const TriMesh ball = test::icosphere(3);
+    std::vector<Vec3d> x(ball.vertex_count());
+    for (std::size_t v = 0; v < x.size(); ++v)
+        x[v] = ball.vertices.positions[v].cast<double>();
+    const std::vector<Vec3d> before = x;
+    x[100] *= 1.2;
+    const TestRings rings = rings_of(ball);
+    EXPECT_EQ(
+        detail::despike(x, Vec3d::Zero(), *sphere, rings.offsets, rings.adjacent, rings.boundary),
+        1U);
+    EXPECT_NEAR(x[100].norm(), 1.0, 1e-6);
+    for (std::size_t v = 0; v < x.size(); ++v)
+        if (v != 100)
+            EXPECT_EQ(x[v], before[v]) << v;
+    // A dent of 0.05 is under a quarter of an edge: it stays.
+    x[100] = 0.95 * before[100];
+    EXPECT_EQ(
+        detail::despike(x, Vec3d::Zero(), *sphere, rings.offsets, rings.adjacent, rings.boundary),
+        0U);
+    // A box's corners and edges stand off their neighbours' planes too, with neighbours along
+    // the crease as far, and the field at their centroids is as far from zero: none moves.
+    const auto box = make_box(Vec3d(-1, -1, -1), Vec3d(1, 1, 1));
+    const TriMesh cube = test::box_mesh(Vec3d(-1, -1, -1), Vec3d(1, 1, 1));
+    std::vector<Vec3d> y(cube.vertex_count());
+    for (std::size_t v = 0; v < y.size(); ++v)
+        y[v] = cube.vertices.positions[v].cast<double>();
+    const TestRings cube_rings = rings_of(cube);
+    EXPECT_EQ(detail::despike(y, Vec3d::Zero(), *box, cube_rings.offsets, cube_rings.adjacent,
+                              cube_rings.boundary),
+              0U);
 }
 
 /// Mean distance from the true unit sphere over the centroids of the finest level's faces: the

@@ -281,6 +281,11 @@ struct RefineReport
     std::size_t denoise_rounds = 0;
     /// The farthest the smoothing moved a vertex, world units.
     double denoise_max_move = 0.0;
+    /// Vertices of the finest level that stood off their neighbours' surface alone (a spike or
+    /// dent on a narrow step of the field, such as the blend between two local fits at a
+    /// concave crease) and were put back on the field from their neighbours' centroid, after
+    /// the fairing and the smoothing (automatic stop only); the finest level is measured after.
+    std::size_t spikes = 0;
     /// The regions of the finest level that no sample supports, faired
     /// (RefineOptions::fair_unsupported); the finest level is measured after.
     UnsupportedFairing unsupported;
