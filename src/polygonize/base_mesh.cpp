@@ -919,10 +919,8 @@ constexpr int spike_max_valence = 4;
 /// noisy 100k sphere of bench/peers one of valence 3 stood 0.0165 = 2 spacings inside, the
 /// output's largest distance from the truth, 0.45% of the diagonal against marching cubes'
 /// 0.39%). nullopt unless the vertex has at most spike_max_valence neighbours, stands farther
-/// than a quarter of its mean edge `reach` from the plane of its ring, and the field at the
-/// centroid is within a quarter of that distance of the surface (at a crease the centroid lies
-/// off the surface as the vertex does); then the projection of the centroid along the gradient
-/// there.
+/// than a quarter of its mean edge `reach` from the plane of its ring, and
+/// detail::project_from_centroid() puts it back.
 std::optional<Vec3d> project_spike(const OmMesh& mesh, OmMesh::VertexHandle v, const Field& field,
                                    const std::vector<Vec3d>& pos, double reach)
 {
@@ -953,11 +951,7 @@ std::optional<Vec3d> project_spike(const OmMesh& mesh, OmMesh::VertexHandle v, c
     const double off = std::abs((pos[static_cast<std::size_t>(v.idx())] - centre).dot(ring_normal));
     if (!(off > 0.25 * reach))
         return std::nullopt;
-    const FieldSample at_centre = field.evaluate(centre);
-    if (!at_centre.defined || !(std::abs(at_centre.value) < 0.25 * off) ||
-        !at_centre.gradient.allFinite() || !(at_centre.gradient.squaredNorm() > 0.0))
-        return std::nullopt;
-    return project_to_zero(field, at_centre, centre, at_centre.gradient.normalized(), reach);
+    return detail::project_from_centroid(field, centre, off, reach);
 }
 
 /// One round: every interior vertex moved tangentially to the average of its neighbours (when

@@ -1418,8 +1418,9 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
     bool moved = false;
     const bool fair = automatic && options.fair_unsupported;
     const bool denoise = report.stop == RefineStop::NoisyDetails && options.denoise_rounds > 0;
-    // The finest level's vertex rings, for the fairing and the smoothing both.
-    const Rings rings = fair || denoise ? vertex_rings(faces, mesh.vertex_count()) : Rings{};
+    // The finest level's vertex rings, for the fairing, the smoothing and the spikes (all of
+    // them under the automatic stop only).
+    const Rings rings = automatic ? vertex_rings(faces, mesh.vertex_count()) : Rings{};
     std::vector<char> faired(mesh.vertex_count(), 0);
     if (fair)
     {
@@ -1436,11 +1437,8 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
     }
     if (automatic)
     {
-        const Rings spike_rings =
-            fair || denoise ? Rings{} : vertex_rings(faces, mesh.vertex_count());
-        const Rings& r = fair || denoise ? rings : spike_rings;
-        report.spikes = detail::despike(mesh.mutable_positions(), mesh.origin(), field, r.offsets,
-                                        r.adjacent, r.boundary);
+        report.spikes = detail::despike(mesh.mutable_positions(), mesh.origin(), field,
+                                        rings.offsets, rings.adjacent, rings.boundary);
         moved = moved || report.spikes > 0;
     }
     if (moved || unmeasured)

@@ -108,7 +108,17 @@ void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces,
     }
 }
 
-/// despike_finest(): a vertex is a spike when it stands farther than this share of its mean
+std::optional<Vec3d> project_from_centroid(const Field& field, const Vec3d& centre, double offset,
+                                           double reach)
+{
+    const FieldSample at = field.evaluate(centre);
+    if (!at.defined || !(std::abs(at.value) < 0.25 * offset) || !at.gradient.allFinite() ||
+        !(at.gradient.squaredNorm() > 0.0))
+        return std::nullopt;
+    return project_to_zero(field, at, centre, at.gradient.normalized(), reach);
+}
+
+/// despike(): a vertex is a spike when it stands farther than this share of its mean
 /// edge from the plane of its neighbours (their least-squares plane) ...
 constexpr double spike_offset = 0.25;
 /// ... and farther than this many times as far as the second farthest of its neighbours from
@@ -168,12 +178,8 @@ std::size_t despike(std::span<Vec3d> x, const Vec3d& origin, const Field& field,
             }
             if (!(offset[v] > spike_isolation * second))
                 continue;
-            const FieldSample at = field.evaluate(origin + centre[v]);
-            if (!at.defined || !(std::abs(at.value) < 0.25 * offset[v]) ||
-                !at.gradient.allFinite() || !(at.gradient.squaredNorm() > 0.0))
-                continue;
             const std::optional<Vec3d> hit =
-                project_to_zero(field, at, origin + centre[v], at.gradient.normalized(), edge[v]);
+                project_from_centroid(field, origin + centre[v], offset[v], edge[v]);
             if (!hit)
                 continue;
             next[v] = *hit - origin;

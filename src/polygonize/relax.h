@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 
 namespace pointform::detail {
@@ -36,6 +37,15 @@ void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces,
                         std::span<const std::uint32_t> ring_offsets,
                         std::span<const std::uint32_t> ring_adjacent,
                         std::span<const std::uint32_t> free, int rounds);
+
+/// \brief A vertex that stands `offset` off the plane of its neighbours, put back on the field
+/// from their centroid `centre` (world coordinates): the projection of the centroid along the
+/// gradient there, within `reach`; nullopt unless the field at the centroid is defined and
+/// within a quarter of `offset` of zero (the neighbours lie on a smooth piece of the surface;
+/// at a crease the centroid lies off it as the vertex does). despike() and the base mesh's
+/// shape rounds both use it.
+[[nodiscard]] std::optional<Vec3d> project_from_centroid(const Field& field, const Vec3d& centre,
+                                                         double offset, double reach);
 
 /// Puts back the finest level's isolated spikes and dents: vertices that stand off their
 /// neighbours' plane (spike_offset, spike_isolation) while the field at their neighbours'
