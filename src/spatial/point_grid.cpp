@@ -44,6 +44,11 @@ constexpr int coord_bits = 20;
 constexpr std::int64_t max_cells = std::int64_t{1} << coord_bits;
 constexpr std::size_t max_k = 64;
 constexpr std::uint32_t group = 4; ///< slots per vector
+/// The wider grid's cells against this one's (PointGrid::wider()): four times the reach, so
+/// that a point eight times as sparse as the cell was sized for is still answered in its cells.
+constexpr float wider_factor = 4.0F;
+/// Below this many points the kd-tree answers far queries alone.
+constexpr std::size_t wider_min_points = 256;
 
 /// Spreads the low 21 bits of v so that two zero bits follow each.
 std::uint64_t spread(std::uint64_t v)
@@ -758,7 +763,14 @@ std::atomic<std::uint64_t> next_grid_id{1};
 } // namespace
 
 PointGrid::PointGrid(std::span<const Vec3f> points, float cell, const KdTree& fallback)
-    : fallback_(&fallback), id_(next_grid_id.fetch_add(1))
+    : PointGrid(points, cell, fallback, 1)
+{}
+
+PointGrid::~PointGrid() = default;
+
+PointGrid::PointGrid(std::span<const Vec3f> points, float cell, const KdTree& fallback,
+                     int wider_levels)
+    : fallback_(&fallback), wider_levels_(wider_levels), id_(next_grid_id.fetch_add(1))
 {
     if (!(cell > 0.0F) || !std::isfinite(cell))
     {
@@ -930,8 +942,13 @@ std::size_t PointGrid::knn_nearby(const Vec3f& query, std::size_t k, std::span<s
     if (k <= max_k && has_avx2())
     {
         // Each thread keeps its lookups from query to query (coherent queries, such as the
-        // steps of a projection along a line, come back to the same cells).
-        thread_local std::unique_ptr<Lookup> lookup;
+        // steps of a projection along a line, come back to the same cells), for two grids (a
+        // grid and its wider one take turns where the points thin out); a third takes the
+        // place of the one used less recently.
+        thread_local std::array<std::unique_ptr<Lookup>, 2> lookups;
+        thread_local std::size_t recent = 0;
+        std::size_t which = lookups[recent] && lookups[recent]->grid == id_ ? recent : 1 - recent;
+        std::unique_ptr<Lookup>& lookup = lookups[which];
         if (!lookup)
         {
             lookup = std::make_unique_for_overwrite<Lookup>(); // grid 0: no grid's, reset below
@@ -940,6 +957,7 @@ std::size_t PointGrid::knn_nearby(const Vec3f& query, std::size_t k, std::span<s
         {
             lookup->reset(id_);
         }
+        recent = which;
         Placement place;
         return placed(query, place)
                    ? wide_nearby(query, place, k, *lookup, slots.data(), squared_distances.data())
@@ -1079,10 +1097,37 @@ void PointGrid::knn_nearby(std::span<const Vec3f> queries, std::size_t k,
 #endif
 }
 
+const PointGrid* PointGrid::wider() const
+{
+    if (wider_levels_ <= 0 || count_ < wider_min_points)
+    {
+        return nullptr;
+    }
+    std::call_once(wider_once_, [this] {
+        wider_ = std::unique_ptr<const PointGrid>(new PointGrid(
+            fallback_->positions(), cell_ * wider_factor, *fallback_, wider_levels_ - 1));
+    });
+    return wider_.get();
+}
+
 std::size_t PointGrid::knn_far(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
                                std::span<float> squared_distances) const
 {
     k = std::min(k, count_);
+    // Where the points are sparse, the wider grid finds them in a few of its cells; its slots
+    // are mapped to this grid's.
+    if (const PointGrid* wide = wider())
+    {
+        const std::size_t found = wide->knn_nearby(query, k, slots, squared_distances);
+        for (std::size_t i = 0; i < found; ++i)
+        {
+            slots[i] = slot_of_[wide->order_[slots[i]]];
+        }
+        if (found > 0)
+        {
+            return found;
+        }
+    }
     // Far from the points: the kd-tree, its indices mapped to slots.
     std::array<std::uint32_t, max_k> index_buffer{};
     std::array<float, max_k> d2_buffer{};

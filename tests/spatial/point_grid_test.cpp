@@ -80,6 +80,41 @@ TEST(PointGrid, KnnOnASurfaceMatchesBruteForceNearAndFar)
     }
 }
 
+TEST(PointGrid, SparseRegionsAndGridsQueriedInTurnStayExact)
+{
+    // A plane sampled densely on one half and 8 times as sparsely on the other (a scan's near
+    // and far sides), with cells sized for the dense half: queries over the sparse half are
+    // beyond the cells around them (the wider grid or the kd-tree answers). Three grids are
+    // queried in turn, so each thread's cached lookups change hands on every query.
+    std::vector<Vec3f> points;
+    for (int y = 0; y < 40; ++y)
+    {
+        for (int x = 0; x < 80; ++x)
+        {
+            const float spacing = x < 40 ? 0.01F : 0.08F;
+            const float px = x < 40 ? 0.01F * static_cast<float>(x)
+                                    : 0.4F + 0.08F * static_cast<float>(x - 40);
+            points.emplace_back(px, spacing * static_cast<float>(y), 0.0F);
+        }
+    }
+    const KdTree tree(points);
+    const PointGrid fine(points, 0.02F, tree);
+    const PointGrid mid(points, 0.05F, tree);
+    const PointGrid coarse(points, 0.2F, tree);
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<float> x(-0.2F, 3.8F);
+    std::uniform_real_distribution<float> y(-0.2F, 3.3F);
+    std::uniform_real_distribution<float> z(-0.3F, 0.3F);
+    for (int q = 0; q < 400; ++q)
+    {
+        const Vec3f query(x(rng), y(rng), z(rng));
+        for (const PointGrid* grid : {&fine, &mid, &coarse})
+        {
+            expect_exact(*grid, points, query, q % 2 == 0 ? 9U : 17U);
+        }
+    }
+}
+
 TEST(PointGrid, TiesAreExactAndRepeatable)
 {
     // A lattice queried at cell corners and centres: many neighbours at equal distances.
