@@ -92,8 +92,8 @@ TEST(PointGrid, SparseRegionsAndGridsQueriedInTurnStayExact)
         for (int x = 0; x < 80; ++x)
         {
             const float spacing = x < 40 ? 0.01F : 0.08F;
-            const float px = x < 40 ? 0.01F * static_cast<float>(x)
-                                    : 0.4F + 0.08F * static_cast<float>(x - 40);
+            const float px =
+                x < 40 ? 0.01F * static_cast<float>(x) : 0.4F + 0.08F * static_cast<float>(x - 40);
             points.emplace_back(px, spacing * static_cast<float>(y), 0.0F);
         }
     }
