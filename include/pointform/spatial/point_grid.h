@@ -112,8 +112,7 @@ private:
     /// \return false for queries that no cell can answer (non-finite, or too far out)
     [[nodiscard]] bool placed(const Vec3f& query, Placement& place) const;
 
-    PointGrid(std::span<const Vec3f> points, float cell, const KdTree& fallback,
-              int wider_levels);
+    PointGrid(std::span<const Vec3f> points, float cell, const KdTree& fallback, int wider_levels);
     /// The grid with cells wider_factor times as large, built on first use; null for the
     /// widest.
     [[nodiscard]] const PointGrid* wider() const;
