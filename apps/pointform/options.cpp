@@ -182,7 +182,9 @@ std::vector<CLI::Option*> add_level_options(CLI::App& cmd, SemiRegularCommandOpt
     added.push_back(
         cmd.add_option("--relax", semi.relax_iterations,
                        "Rounds of tangential relaxation of the new vertices per level (§5.2.3), "
-                       "each followed by their re-projection; 0 keeps the projected predictions")
+                       "each followed by their re-projection, then two more of the new vertices "
+                       "of thin triangles (an angle under 20°) only; 0 keeps the projected "
+                       "predictions")
             ->capture_default_str()
             ->check(CLI::Range(0, 10)));
     added.push_back(add_enum_option(

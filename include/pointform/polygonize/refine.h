@@ -101,6 +101,11 @@ struct RefineOptions
     /// 0 = none.
     int relax_iterations = 1;
     Relaxation relaxation = Relaxation::AcrossEdge;
+    /// After the relax_iterations rounds (when there are any), this many more of the new
+    /// vertices of thin child faces only (an angle under 20°), so that the base mesh's thin
+    /// triangles, which 1-to-4 splits copy at every level, are opened where relaxation can open
+    /// them, at the cost of a round of a few vertices. 0 = none.
+    int thin_relax_iterations = 2;
     /// A child face is folded when the cosine between its normal and its parent face's normal is
     /// at most this (0: the child faces away from its parent, or is degenerate), and so is the
     /// cosine with the field's gradient at the child's centroid (where the field is defined).
@@ -315,7 +320,9 @@ struct RefineReport
 ///    new vertex towards the average of its 1-ring in M^(J+1) (on the boundary: of its two
 ///    boundary neighbours; tangent plane: the vertex's area-weighted normal; by default only
 ///    the part across the parent edge, see Relaxation), each followed by re-projection along
-///    that normal; moves that fold a face or lose the surface are undone.
+///    that normal; moves that fold a face or lose the surface are undone. Then
+///    thin_relax_iterations rounds of the same move for the new vertices of child faces with an
+///    angle under 20° only.
 /// Old vertices never move. Where no crossing is found (the field undefined: a hole), the new
 /// vertex keeps its prediction and is counted in `unprojected`. Every per-vertex step runs in
 /// parallel into its own slot (Jacobi style), so the result does not depend on the thread
@@ -323,7 +330,8 @@ struct RefineReport
 /// \param samples  optional; when given, the stats carry the one-sided Hausdorff distance from
 ///                 them to M^(J+1)
 /// \throw InvalidInput if the hierarchy is empty, an option is out of range (search_scale not
-///        positive and finite, fold_cosine outside [-1, 1), relax_iterations < 0,
+///        positive and finite, fold_cosine outside [-1, 1), relax_iterations or
+///        thin_relax_iterations < 0,
 ///        sampling_density negative or not finite, min_improvement outside [0, 1),
 ///        detail_factor outside (0, 1], noise_decay outside (0, 1)) or the new
 ///        level would overflow 32-bit indices
