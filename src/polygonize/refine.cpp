@@ -104,6 +104,16 @@ std::optional<Vec3d> field_orientation(const Field& field, const Vec3d& point)
     return s.gradient;
 }
 
+/// The four children of face f of `level`: (a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca).
+std::array<Triangle, 4> child_triangles(const Level& level, std::size_t f)
+{
+    const auto [a, b, c] = level.faces[f];
+    const std::uint32_t ab = level.edge_vertex[3 * f];
+    const std::uint32_t bc = level.edge_vertex[3 * f + 1];
+    const std::uint32_t ca = level.edge_vertex[3 * f + 2];
+    return {Triangle{a, ab, ca}, Triangle{ab, b, bc}, Triangle{ca, bc, c}, Triangle{ab, bc, ca}};
+}
+
 /// Marks, per child face of level i + 1 (4f + c), whether it is folded: its normal is against
 /// its parent face's (cosine <= fold_cosine) and against the field's gradient at its centroid as
 /// well (or it is degenerate, or the field is undefined there). A parent face that straddles a
@@ -122,12 +132,7 @@ void find_folds(const Level& level, std::span<const Vec3d> x, std::span<const Ve
             const double n_norm = n.norm();
             if (!(n_norm > 0.0))
                 continue; // a degenerate parent gives no reference
-            const auto [a, b, c] = level.faces[f];
-            const std::uint32_t ab = level.edge_vertex[3 * f];
-            const std::uint32_t bc = level.edge_vertex[3 * f + 1];
-            const std::uint32_t ca = level.edge_vertex[3 * f + 2];
-            const std::array<Triangle, 4> children = {Triangle{a, ab, ca}, Triangle{ab, b, bc},
-                                                      Triangle{ca, bc, c}, Triangle{ab, bc, ca}};
+            const std::array<Triangle, 4> children = child_triangles(level, f);
             for (std::size_t k = 0; k < 4; ++k)
             {
                 const Triangle& t = children[k];
@@ -330,14 +335,9 @@ std::vector<Triangle> child_faces(const Level& level)
     std::vector<Triangle> out(4 * level.faces.size());
     for (std::size_t f = 0; f < level.faces.size(); ++f)
     {
-        const auto [a, b, c] = level.faces[f];
-        const std::uint32_t ab = level.edge_vertex[3 * f];
-        const std::uint32_t bc = level.edge_vertex[3 * f + 1];
-        const std::uint32_t ca = level.edge_vertex[3 * f + 2];
-        out[4 * f] = {a, ab, ca};
-        out[4 * f + 1] = {ab, b, bc};
-        out[4 * f + 2] = {ca, bc, c};
-        out[4 * f + 3] = {ab, bc, ca};
+        const std::array<Triangle, 4> children = child_triangles(level, f);
+        std::copy(children.begin(), children.end(),
+                  out.begin() + static_cast<std::ptrdiff_t>(4 * f));
     }
     return out;
 }
@@ -350,23 +350,40 @@ constexpr double thin_degrees = 20.0;
 std::vector<char> thin_vertices(const Level& level, std::span<const Vec3d> x, std::size_t added)
 {
     const double bound = std::cos(thin_degrees * std::numbers::pi / 180.0);
-    std::vector<char> thin(added, 0);
-    const std::vector<Triangle> children = child_faces(level);
-    for (const Triangle& t : children)
-    {
-        bool below = false;
-        for (std::size_t c = 0; c < 3 && !below; ++c)
+    const auto thin_child = [&x, bound](const Triangle& t) {
+        for (std::size_t c = 0; c < 3; ++c)
         {
             const Vec3d u = x[t[(c + 1) % 3]] - x[t[c]];
             const Vec3d w = x[t[(c + 2) % 3]] - x[t[c]];
             const double lengths = u.norm() * w.norm();
-            below = lengths > 0.0 && u.dot(w) > bound * lengths;
+            if (lengths > 0.0 && u.dot(w) > bound * lengths)
+                return true;
         }
-        if (!below)
+        return false;
+    };
+    // Per parent face, a bit per thin child (in parallel), then their new vertices marked.
+    std::vector<std::uint8_t> thin_children(level.faces.size(), 0);
+    parallel_blocks(level.faces.size(), 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t f = begin; f < end; ++f)
+        {
+            const std::array<Triangle, 4> children = child_triangles(level, f);
+            std::uint8_t bits = 0;
+            for (std::size_t k = 0; k < 4; ++k)
+                bits |= thin_child(children[k]) ? std::uint8_t(1U << k) : std::uint8_t{0};
+            thin_children[f] = bits;
+        }
+    });
+    std::vector<char> thin(added, 0);
+    for (std::size_t f = 0; f < level.faces.size(); ++f)
+    {
+        if (thin_children[f] == 0)
             continue;
-        for (const std::uint32_t v : t)
-            if (v >= level.first_new && v - level.first_new < added)
-                thin[v - level.first_new] = 1;
+        const std::array<Triangle, 4> children = child_triangles(level, f);
+        for (std::size_t k = 0; k < 4; ++k)
+            if ((thin_children[f] >> k) & 1U)
+                for (const std::uint32_t v : children[k])
+                    if (v >= level.first_new && v - level.first_new < added)
+                        thin[v - level.first_new] = 1;
     }
     return thin;
 }

@@ -4,6 +4,7 @@
 #include "pointform/spatial/point_grid.h"
 
 #include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
 #include "pointform/spatial/kd_tree.h"
 
 #include <algorithm>
@@ -44,11 +45,8 @@ constexpr int coord_bits = 20;
 constexpr std::int64_t max_cells = std::int64_t{1} << coord_bits;
 constexpr std::size_t max_k = 64;
 constexpr std::uint32_t group = 4; ///< slots per vector
-/// The wider grid's cells against this one's (PointGrid::wider()): four times the reach, so
-/// that a point eight times as sparse as the cell was sized for is still answered in its cells.
-constexpr float wider_factor = 4.0F;
-/// Below this many points the kd-tree answers far queries alone.
-constexpr std::size_t wider_min_points = 256;
+/// Points per block of the grid's parallel construction.
+constexpr std::size_t build_block = 65536;
 
 /// Spreads the low 21 bits of v so that two zero bits follow each.
 std::uint64_t spread(std::uint64_t v)
@@ -763,14 +761,7 @@ std::atomic<std::uint64_t> next_grid_id{1};
 } // namespace
 
 PointGrid::PointGrid(std::span<const Vec3f> points, float cell, const KdTree& fallback)
-    : PointGrid(points, cell, fallback, 1)
-{}
-
-PointGrid::~PointGrid() = default;
-
-PointGrid::PointGrid(std::span<const Vec3f> points, float cell, const KdTree& fallback,
-                     int wider_levels)
-    : fallback_(&fallback), wider_levels_(wider_levels), id_(next_grid_id.fetch_add(1))
+    : fallback_(&fallback), id_(next_grid_id.fetch_add(1))
 {
     if (!(cell > 0.0F) || !std::isfinite(cell))
     {
@@ -802,37 +793,51 @@ PointGrid::PointGrid(std::span<const Vec3f> points, float cell, const KdTree& fa
     dims_ = max_cells;
     count_ = n;
 
-    std::vector<std::uint64_t> keys(n);    // Morton codes: the order of cells in memory
-    std::vector<std::uint64_t> cell_of(n); // packed coordinates: the hash key
-    for (std::size_t i = 0; i < n; ++i)
+    // Each point's cell: its Morton code (the order of cells in memory) and packed coordinates
+    // (the hash key), sorted by code and then index (a strict order: the same for any thread
+    // count), all in parallel.
+    struct Keyed
     {
-        const Vec3f c = ((points[i] - min_) * inv_cell_).array().floor().matrix();
-        const auto x = std::clamp<std::int64_t>(static_cast<std::int64_t>(c.x()), 0, dims_ - 1);
-        const auto y = std::clamp<std::int64_t>(static_cast<std::int64_t>(c.y()), 0, dims_ - 1);
-        const auto z = std::clamp<std::int64_t>(static_cast<std::int64_t>(c.z()), 0, dims_ - 1);
-        keys[i] = morton(x, y, z);
-        cell_of[i] = packed(x, y, z);
-    }
-    std::vector<std::uint32_t> sorted(n);
-    std::iota(sorted.begin(), sorted.end(), 0U);
-    std::sort(sorted.begin(), sorted.end(), [&](std::uint32_t a, std::uint32_t b) {
-        return keys[a] < keys[b] || (keys[a] == keys[b] && a < b);
+        std::uint64_t morton;
+        std::uint64_t cell;
+        std::uint32_t index;
+    };
+    std::vector<Keyed> sorted(n);
+    parallel_blocks(n, build_block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            const Vec3f c = ((points[i] - min_) * inv_cell_).array().floor().matrix();
+            const auto x = std::clamp<std::int64_t>(static_cast<std::int64_t>(c.x()), 0, dims_ - 1);
+            const auto y = std::clamp<std::int64_t>(static_cast<std::int64_t>(c.y()), 0, dims_ - 1);
+            const auto z = std::clamp<std::int64_t>(static_cast<std::int64_t>(c.z()), 0, dims_ - 1);
+            sorted[i] = Keyed{morton(x, y, z), packed(x, y, z), static_cast<std::uint32_t>(i)};
+        }
+    });
+    parallel_sort(sorted, [](const Keyed& a, const Keyed& b) {
+        return a.morton < b.morton || (a.morton == b.morton && a.index < b.index);
     });
 
     // Each cell's points take a whole number of groups of four slots, the rest padded with
     // points at infinity, so that a scan runs whole vectors.
-    std::vector<std::pair<std::uint64_t, Range>> cells;
+    struct Cell
+    {
+        std::uint64_t key;
+        Range range;
+        std::uint32_t first; ///< its first point in `sorted`
+    };
+    std::vector<Cell> cells;
     std::uint32_t slots = 0;
     for (std::size_t s = 0; s < n;)
     {
         std::size_t e = s + 1;
-        while (e < n && keys[sorted[e]] == keys[sorted[s]])
+        while (e < n && sorted[e].morton == sorted[s].morton)
         {
             ++e;
         }
         const auto length = static_cast<std::uint32_t>(e - s);
         const std::uint32_t padded = (length + group - 1) / group * group;
-        cells.emplace_back(cell_of[sorted[s]], Range{slots, slots + padded});
+        cells.push_back(
+            Cell{sorted[s].cell, Range{slots, slots + padded}, static_cast<std::uint32_t>(s)});
         slots += padded;
         s = e;
     }
@@ -843,33 +848,36 @@ PointGrid::PointGrid(std::span<const Vec3f> points, float cell, const KdTree& fa
     xs_.assign(slots + group, far);
     ys_.assign(slots + group, far);
     zs_.assign(slots + group, far);
-    std::size_t next = 0;
-    for (const auto& [key, range] : cells)
-    {
-        for (std::uint32_t slot = range.begin;
-             next < n && cell_of[sorted[next]] == key && slot < range.end; ++slot, ++next)
+    parallel_blocks(cells.size(), build_block / 8, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t c = begin; c < end; ++c)
         {
-            const std::uint32_t i = sorted[next];
-            order_[slot] = i;
-            slot_of_[i] = slot;
-            xs_[slot] = points[i].x();
-            ys_[slot] = points[i].y();
-            zs_[slot] = points[i].z();
+            const Cell& run = cells[c];
+            std::uint32_t next = run.first;
+            for (std::uint32_t slot = run.range.begin;
+                 next < n && sorted[next].cell == run.key && slot < run.range.end; ++slot, ++next)
+            {
+                const std::uint32_t i = sorted[next].index;
+                order_[slot] = i;
+                slot_of_[i] = slot;
+                xs_[slot] = points[i].x();
+                ys_[slot] = points[i].y();
+                zs_[slot] = points[i].z();
+            }
         }
-    }
+    });
 
     const std::size_t capacity = std::bit_ceil(std::max<std::size_t>(2 * cells.size(), 16));
     table_.assign(capacity, Entry{});
     table_mask_ = capacity - 1;
     table_shift_ = 64 - std::countr_zero(capacity);
-    for (const auto& [key, range] : cells)
+    for (const Cell& run : cells)
     {
-        std::uint64_t h = hash_of(key, table_shift_);
+        std::uint64_t h = hash_of(run.key, table_shift_);
         while (table_[h].key != ~std::uint64_t{0})
         {
             h = (h + 1) & table_mask_;
         }
-        table_[h] = Entry{key, range};
+        table_[h] = Entry{run.key, run.range};
     }
 }
 
@@ -942,13 +950,8 @@ std::size_t PointGrid::knn_nearby(const Vec3f& query, std::size_t k, std::span<s
     if (k <= max_k && has_avx2())
     {
         // Each thread keeps its lookups from query to query (coherent queries, such as the
-        // steps of a projection along a line, come back to the same cells), for two grids (a
-        // grid and its wider one take turns where the points thin out); a third takes the
-        // place of the one used less recently.
-        thread_local std::array<std::unique_ptr<Lookup>, 2> lookups;
-        thread_local std::size_t recent = 0;
-        std::size_t which = lookups[recent] && lookups[recent]->grid == id_ ? recent : 1 - recent;
-        std::unique_ptr<Lookup>& lookup = lookups[which];
+        // steps of a projection along a line, come back to the same cells).
+        thread_local std::unique_ptr<Lookup> lookup;
         if (!lookup)
         {
             lookup = std::make_unique_for_overwrite<Lookup>(); // grid 0: no grid's, reset below
@@ -957,7 +960,6 @@ std::size_t PointGrid::knn_nearby(const Vec3f& query, std::size_t k, std::span<s
         {
             lookup->reset(id_);
         }
-        recent = which;
         Placement place;
         return placed(query, place)
                    ? wide_nearby(query, place, k, *lookup, slots.data(), squared_distances.data())
@@ -1097,37 +1099,10 @@ void PointGrid::knn_nearby(std::span<const Vec3f> queries, std::size_t k,
 #endif
 }
 
-const PointGrid* PointGrid::wider() const
-{
-    if (wider_levels_ <= 0 || count_ < wider_min_points)
-    {
-        return nullptr;
-    }
-    std::call_once(wider_once_, [this] {
-        wider_ = std::unique_ptr<const PointGrid>(new PointGrid(
-            fallback_->positions(), cell_ * wider_factor, *fallback_, wider_levels_ - 1));
-    });
-    return wider_.get();
-}
-
 std::size_t PointGrid::knn_far(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
                                std::span<float> squared_distances) const
 {
     k = std::min(k, count_);
-    // Where the points are sparse, the wider grid finds them in a few of its cells; its slots
-    // are mapped to this grid's.
-    if (const PointGrid* wide = wider())
-    {
-        const std::size_t found = wide->knn_nearby(query, k, slots, squared_distances);
-        for (std::size_t i = 0; i < found; ++i)
-        {
-            slots[i] = slot_of_[wide->order_[slots[i]]];
-        }
-        if (found > 0)
-        {
-            return found;
-        }
-    }
     // Far from the points: the kd-tree, its indices mapped to slots.
     std::array<std::uint32_t, max_k> index_buffer{};
     std::array<float, max_k> d2_buffer{};

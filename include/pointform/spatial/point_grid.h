@@ -7,8 +7,6 @@
 
 #include <array>
 #include <cstdint>
-#include <memory>
-#include <mutex>
 #include <span>
 #include <vector>
 
@@ -22,10 +20,7 @@ class KdTree;
 /// through a hash table, so a query reads a few short runs of contiguous memory instead of
 /// walking a tree. A query first scans the 2 × 2 × 2 cells around it, then 3 × 3 × 3, then
 /// 5 × 5 × 5, and stops as soon as the k-th nearest point found is closer than every point it
-/// has not scanned; a query farther from the points than that goes to a grid of the same points
-/// with cells four times as large (built on the first such query: where the points are sparse,
-/// as on a scan's far side or across a hole, it answers in a few cells too), and only beyond
-/// that one's reach to the kd-tree. With a cell
+/// has not scanned; a query farther from the points than that goes to the kd-tree. With a cell
 /// about twice the k-th neighbour distance of the points, queries near the surface they sample
 /// (as fields and polygonization ask) stop after the first 8 cells.
 ///
@@ -39,9 +34,6 @@ public:
     /// \param fallback a kd-tree over the same points, for queries far from them; must outlive
     ///                 the grid
     PointGrid(std::span<const Vec3f> points, float cell, const KdTree& fallback);
-    PointGrid(const PointGrid&) = delete;
-    PointGrid& operator=(const PointGrid&) = delete;
-    ~PointGrid();
 
     /// \brief The k nearest points to `query`, nearest first, as slots (positions in grid
     /// order; original_index() maps them back).
@@ -112,11 +104,6 @@ private:
     /// \return false for queries that no cell can answer (non-finite, or too far out)
     [[nodiscard]] bool placed(const Vec3f& query, Placement& place) const;
 
-    PointGrid(std::span<const Vec3f> points, float cell, const KdTree& fallback, int wider_levels);
-    /// The grid with cells wider_factor times as large, built on first use; null for the
-    /// widest.
-    [[nodiscard]] const PointGrid* wider() const;
-    /// knn() beyond knn_nearby()'s reach: the wider grid's, else the kd-tree's.
     std::size_t knn_far(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
                         std::span<float> squared_distances) const;
     /// knn_nearby() by Within alone (k at most the point count).
@@ -129,9 +116,6 @@ private:
     [[nodiscard]] Range cell_range(std::int64_t x, std::int64_t y, std::int64_t z) const;
 
     const KdTree* fallback_;
-    int wider_levels_ = 0; ///< how many wider grids may follow this one
-    mutable std::once_flag wider_once_;
-    mutable std::unique_ptr<const PointGrid> wider_;
     std::uint64_t id_; ///< unique per grid ever built, so thread caches never mix grids
     float cell_ = 0.0F;
     float inv_cell_ = 0.0F;
