@@ -84,8 +84,8 @@ TEST(PointGrid, SparseRegionsAndGridsQueriedInTurnStayExact)
 {
     // A plane sampled densely on one half and 8 times as sparsely on the other (a scan's near
     // and far sides), with cells sized for the dense half: queries over the sparse half are
-    // beyond the cells around them (the wider grid or the kd-tree answers). Three grids are
-    // queried in turn, so each thread's cached lookups change hands on every query.
+    // beyond the cells around them (the kd-tree answers). Three grids are queried in turn, so
+    // each thread's cached lookups of cells change grids on every query.
     std::vector<Vec3f> points;
     for (int y = 0; y < 40; ++y)
     {
