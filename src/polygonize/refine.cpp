@@ -6,6 +6,7 @@
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 #include "pointform/geometry/level_topology.h"
+#include "pointform/metrics/quality.h"
 #include "pointform/polygonize/projection.h"
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/spatial_sort.h"
@@ -346,20 +347,13 @@ std::vector<Triangle> child_faces(const Level& level)
 constexpr double thin_degrees = 20.0;
 
 /// Per new vertex of `level` (0 ... added - 1): 1 where it is a corner of a child face with an
-/// angle under thin_degrees, at positions x.
+/// angle under thin_degrees (triangle_min_angle(), as the quality report measures), at
+/// positions x.
 std::vector<char> thin_vertices(const Level& level, std::span<const Vec3d> x, std::size_t added)
 {
-    const double bound = std::cos(thin_degrees * std::numbers::pi / 180.0);
+    const double bound = thin_degrees * std::numbers::pi / 180.0;
     const auto thin_child = [&x, bound](const Triangle& t) {
-        for (std::size_t c = 0; c < 3; ++c)
-        {
-            const Vec3d u = x[t[(c + 1) % 3]] - x[t[c]];
-            const Vec3d w = x[t[(c + 2) % 3]] - x[t[c]];
-            const double lengths = u.norm() * w.norm();
-            if (lengths > 0.0 && u.dot(w) > bound * lengths)
-                return true;
-        }
-        return false;
+        return triangle_min_angle(x[t[0]], x[t[1]], x[t[2]]) < bound;
     };
     // Per parent face, a bit per thin child (in parallel), then their new vertices marked.
     std::vector<std::uint8_t> thin_children(level.faces.size(), 0);
