@@ -33,6 +33,7 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -357,6 +358,9 @@ void check_options(const BaseMeshOptions& options)
         throw InvalidInput("base mesh: the boundary tolerance must be finite and >= 0, got " +
                            std::to_string(*options.boundary_tolerance));
     }
+    if (!(options.chord_split_share >= 0.0 && options.chord_split_share <= 0.5))
+        throw InvalidInput("base mesh: chord_split_share must be in [0, 0.5], got " +
+                           std::to_string(options.chord_split_share));
     if (!(options.min_round_gain >= 0.0 && options.min_round_gain < 1.0))
     {
         throw InvalidInput("base mesh: the least gain of a shape round must be in [0, 1), got " +
@@ -1352,6 +1356,150 @@ std::optional<TriMesh> decimate_in_blocks(const TriMesh& intermediate, std::size
     return joined;
 }
 
+/// split_long_chords(): an edge is split when it is longer than this many times the median
+/// edge ...
+constexpr double chord_split_length = 1.5;
+/// ... one of its faces' centroids lies farther than this many times the median face's from
+/// f = 0 ...
+constexpr double chord_split_error = 2.0;
+/// ... and its two faces meet at a dihedral angle under this, degrees (a smooth, curved spot,
+/// not a crease, whose faces the shape rounds align with it).
+constexpr double chord_split_dihedral = 10.0;
+/// A split must leave each of its new triangles an angle of at least this, degrees, or at least
+/// the smallest angle of the two faces it splits.
+constexpr double chord_split_min_angle = 20.0;
+
+/// Splits the base mesh's longest chords (BaseMeshOptions::chord_split_share): the edges longer
+/// than chord_split_length times the median edge, across which the faces meet at less than
+/// chord_split_dihedral and next to a face whose centroid lies more than chord_split_error
+/// times the median face's off f = 0, the farthest first. Each edge's midpoint is projected
+/// onto f = 0 (project_vertex()) and the edge split there when the projection succeeds and the
+/// new triangles keep their shape (chord_split_min_angle) and their side. Returns the splits;
+/// the new vertices come last, in `state` (on the surface), `filled` (0) and `start` (the
+/// midpoint, for the report's largest move).
+std::size_t split_long_chords(OmMesh& mesh, const Field& field, double max_share,
+                              VertexState& state, std::vector<char>& filled,
+                              std::vector<Vec3d>& start)
+{
+    const std::size_t faces = mesh.n_faces();
+    const auto cap = static_cast<std::size_t>(max_share * static_cast<double>(faces));
+    if (cap == 0 || faces == 0)
+        return 0;
+    const auto at = [&](OmMesh::VertexHandle v) -> const Vec3d& {
+        return state.position[static_cast<std::size_t>(v.idx())];
+    };
+    // Each face's chord error: |f| at its centroid (0 where the field is undefined).
+    std::vector<double> error(faces, 0.0);
+    parallel_blocks(faces, 256, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            const OmMesh::FaceHandle f(static_cast<int>(i));
+            Vec3d centre = Vec3d::Zero();
+            for (const auto v : mesh.fv_range(f))
+                centre += at(v);
+            const FieldSample sample = field.evaluate(centre / 3.0);
+            if (sample.defined && std::isfinite(sample.value))
+                error[i] = std::abs(sample.value);
+        }
+    });
+    std::vector<double> sorted(error);
+    const auto middle = sorted.begin() + static_cast<std::ptrdiff_t>(faces / 2);
+    std::nth_element(sorted.begin(), middle, sorted.end());
+    const double error_limit = chord_split_error * *middle;
+    std::vector<double> lengths;
+    lengths.reserve(mesh.n_edges());
+    for (const auto e : mesh.edges())
+        lengths.push_back((at(mesh.to_vertex_handle(mesh.halfedge_handle(e, 0))) -
+                           at(mesh.from_vertex_handle(mesh.halfedge_handle(e, 0))))
+                              .norm());
+    std::vector<double> sorted_lengths(lengths);
+    const auto middle_length =
+        sorted_lengths.begin() + static_cast<std::ptrdiff_t>(sorted_lengths.size() / 2);
+    std::nth_element(sorted_lengths.begin(), middle_length, sorted_lengths.end());
+    const double length_limit = chord_split_length * *middle_length;
+    const double cos_dihedral = std::cos(chord_split_dihedral * degrees);
+    const auto normal_of = [&](OmMesh::FaceHandle f) {
+        std::array<Vec3d, 3> p;
+        int i = 0;
+        for (const auto v : mesh.fv_range(f))
+            p[static_cast<std::size_t>(i++)] = at(v);
+        return area_normal(p);
+    };
+    // Candidates: (error, edge), the largest error first, ties by edge index.
+    std::vector<std::pair<double, int>> candidates;
+    for (const auto e : mesh.edges())
+    {
+        const auto h0 = mesh.halfedge_handle(e, 0);
+        const auto h1 = mesh.halfedge_handle(e, 1);
+        if (mesh.is_boundary(e) || !(lengths[static_cast<std::size_t>(e.idx())] > length_limit))
+            continue;
+        const auto f0 = mesh.face_handle(h0);
+        const auto f1 = mesh.face_handle(h1);
+        const double worst = std::max(error[static_cast<std::size_t>(f0.idx())],
+                                      error[static_cast<std::size_t>(f1.idx())]);
+        if (!(worst > error_limit))
+            continue;
+        const Vec3d n0 = normal_of(f0);
+        const Vec3d n1 = normal_of(f1);
+        if (!(n0.dot(n1) > cos_dihedral * n0.norm() * n1.norm()))
+            continue;
+        candidates.emplace_back(worst, e.idx());
+    }
+    std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
+        return a.first != b.first ? a.first > b.first : a.second < b.second;
+    });
+    std::size_t splits = 0;
+    for (const auto& [worst, index] : candidates)
+    {
+        if (splits >= cap)
+            break;
+        const OmMesh::EdgeHandle e(index);
+        const auto h = mesh.halfedge_handle(e, 0);
+        const auto a = mesh.from_vertex_handle(h);
+        const auto b = mesh.to_vertex_handle(h);
+        if (state.on_surface[static_cast<std::size_t>(a.idx())] == 0 ||
+            state.on_surface[static_cast<std::size_t>(b.idx())] == 0)
+            continue;
+        // The two faces as (a, b, c) and (b, a, d), each in its own orientation.
+        const auto c = mesh.to_vertex_handle(mesh.next_halfedge_handle(h));
+        const auto d =
+            mesh.to_vertex_handle(mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h)));
+        const Vec3d n0 = area_normal({at(a), at(b), at(c)});
+        const Vec3d n1 = area_normal({at(b), at(a), at(d)});
+        const Vec3d middle_point = 0.5 * (at(a) + at(b));
+        const double length = (at(b) - at(a)).norm();
+        const Vec3d normal = (n0.normalized() + n1.normalized()).normalized();
+        if (!normal.allFinite())
+            continue;
+        const std::optional<Vec3d> p = project_vertex(field, middle_point, normal, length);
+        if (!p)
+            continue;
+        const double bound =
+            std::min(chord_split_min_angle * degrees,
+                     std::min(min_angle(at(a), at(b), at(c)), min_angle(at(b), at(a), at(d))));
+        const std::array<std::array<Vec3d, 3>, 4> parts{
+            {{at(a), *p, at(c)}, {*p, at(b), at(c)}, {at(b), *p, at(d)}, {*p, at(a), at(d)}}};
+        bool keeps = true;
+        for (std::size_t k = 0; k < parts.size() && keeps; ++k)
+        {
+            const std::array<Vec3d, 3>& t = parts[k];
+            keeps =
+                min_angle(t[0], t[1], t[2]) >= bound && area_normal(t).dot(k < 2 ? n0 : n1) > 0.0;
+        }
+        if (!keeps)
+            continue;
+        mesh.split(e, to_om(*p));
+        state.position.push_back(*p);
+        state.on_surface.push_back(1);
+        filled.push_back(0);
+        start.push_back(middle_point);
+        ++splits;
+    }
+    if (splits > 0)
+        mesh.update_face_normals();
+    return splits;
+}
+
 } // namespace
 
 BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
@@ -1450,7 +1598,7 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
     {
         state.position[static_cast<std::size_t>(v.idx())] = to_eigen(mesh.point(v));
     }
-    const std::vector<Vec3d> decimated = state.position;
+    std::vector<Vec3d> decimated = state.position;
     const double bound = options.min_angle_degrees * degrees;
     const auto below_bound = [&mesh, bound]() {
         std::size_t count = 0;
@@ -1503,6 +1651,10 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
             }
             reporter.update(round + 1, std::max(options.max_smoothing_rounds, 1));
         }
+        // The longest chords split where the surface curves (BaseMeshOptions::chord_split_share).
+        if (options.project && options.chord_split_share > 0.0)
+            stats.chord_splits =
+                split_long_chords(mesh, field, options.chord_split_share, state, filled, decimated);
         // The vertices of a patch left off the surface (beyond the field), and those of the
         // decimated mesh that are off it next to them (the coarse marching cubes put them
         // between defined and undefined corners at the hole's rim), were moved only tangentially

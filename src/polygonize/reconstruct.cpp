@@ -208,9 +208,11 @@ SemiRegularReport semi_regular_mesh(const TriMesh& intermediate, const Field& fi
         options, intermediate, share, samples != nullptr ? samples->size() : 0, coarsening);
     if (options.levels)
         check_refinement_memory(target, *options.levels);
-    BaseMeshResult built = build_base_mesh(
-        intermediate, field,
-        {.target_faces = target, .fill_holes = options.fill_holes, .progress = progress});
+    BaseMeshResult built = build_base_mesh(intermediate, field,
+                                           {.target_faces = target,
+                                            .chord_split_share = options.chord_split_share,
+                                            .fill_holes = options.fill_holes,
+                                            .progress = progress});
     if (!options.base_faces && !options.levels && options.stop_rule == StopRule::Automatic &&
         samples != nullptr && !samples->empty())
     {
@@ -221,9 +223,11 @@ SemiRegularReport semi_regular_mesh(const TriMesh& intermediate, const Field& fi
             std::min(intermediate.face_count(),
                      target_for_affordable_levels(built.stats.topology_after, samples->size()));
         if (2 * refit > 3 * built.mesh.face_count())
-            built = build_base_mesh(
-                intermediate, field,
-                {.target_faces = refit, .fill_holes = options.fill_holes, .progress = progress});
+            built = build_base_mesh(intermediate, field,
+                                    {.target_faces = refit,
+                                     .chord_split_share = options.chord_split_share,
+                                     .fill_holes = options.fill_holes,
+                                     .progress = progress});
     }
     const double base_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

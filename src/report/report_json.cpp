@@ -144,6 +144,7 @@ nlohmann::json report_json(const BaseMeshStats& stats)
     out["share_below_20_degrees_off_boundary"] = stats.share_below_20_degrees_off_boundary;
     out["smoothing_rounds"] = stats.smoothing_rounds;
     out["flips"] = stats.flips;
+    out["chord_splits"] = stats.chord_splits;
     out["boundary_tolerance"] = stats.boundary_tolerance;
     out["unprojected"] = stats.unprojected;
     out["max_vertex_move"] = stats.max_vertex_move;

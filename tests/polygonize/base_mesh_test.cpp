@@ -13,6 +13,7 @@
 #include "pointform/implicit/primitives.h"
 #include "pointform/metrics/hausdorff.h"
 #include "pointform/polygonize/marching_cubes.h"
+#include "pointform/polygonize/reconstruct.h"
 #include "pointform/spatial/kd_tree.h"
 
 #include "support/test_meshes.h"
@@ -440,7 +441,7 @@ TEST(BaseMesh, DecimationInBlocksKeepsTheTorusAndItsShape)
         EXPECT_EQ(topo.components, 1U);
         EXPECT_EQ(topo.euler_characteristic, 0);
         EXPECT_TRUE(result.stats.topology_kept) << result.stats.topology_change;
-        EXPECT_EQ(result.stats.faces, 800U);
+        EXPECT_EQ(result.stats.faces, 800U + 2 * result.stats.chord_splits);
         EXPECT_LT(share_below_20(result.mesh), 0.02) << "blocks from " << from;
         for (std::size_t v = 0; v < result.mesh.vertex_count(); ++v)
         {
@@ -449,6 +450,77 @@ TEST(BaseMesh, DecimationInBlocksKeepsTheTorusAndItsShape)
             ASSERT_NEAR(ring, 0.35, 0.25 * scene.spacing) << "blocks from " << from;
         }
     }
+}
+
+/// Largest distance from the true torus (R = 1, r = 0.35) of the points of the mesh's faces (a
+/// barycentric grid of 28 points a face).
+double largest_torus_chord(const TriMesh& mesh)
+{
+    double largest = 0.0;
+    for (const Triangle& t : mesh.triangles)
+    {
+        const Vec3d a = mesh.vertices.world(t[0]);
+        const Vec3d b = mesh.vertices.world(t[1]);
+        const Vec3d c = mesh.vertices.world(t[2]);
+        for (int i = 0; i <= 6; ++i)
+            for (int j = 0; i + j <= 6; ++j)
+            {
+                const Vec3d p = (i * a + j * b + (6 - i - j) * c) / 6.0;
+                const double ring = std::hypot(std::hypot(p.x(), p.y()) - 1.0, p.z());
+                largest = std::max(largest, std::abs(ring - 0.35));
+            }
+    }
+    return largest;
+}
+
+TEST(BaseMesh, LongChordsAreSplitWhereTheSurfaceCurves)
+{
+    // Quadric-error decimation leaves long triangles along the torus's top and bottom circles
+    // (flat along the circle, curved across it), and refinement copies their proportions:
+    // reconstructed from 100k samples (its default base mesh and levels), the finest level of
+    // the base mesh with its longest chords split lies closer to the torus, with the topology
+    // kept and two faces more a split.
+    const PointCloud samples = sample_shape(Shape::Torus, {.count = 100000, .seed = 3});
+    const PointCloud surfels =
+        compute_surfels(samples, {.radius_scale = default_field_radius_scale}).surfels;
+    ReconstructOptions without;
+    without.semi_regular.chord_split_share = 0.0;
+    const ReconstructReport kept = reconstruct(surfels, without);
+    const ReconstructReport split = reconstruct(surfels);
+    ASSERT_TRUE(kept.semi_regular.base && split.semi_regular.base);
+    const BaseMeshStats& before_stats = *kept.semi_regular.base;
+    const BaseMeshStats& after_stats = *split.semi_regular.base;
+    EXPECT_EQ(before_stats.chord_splits, 0U);
+    ASSERT_GT(after_stats.chord_splits, 0U);
+    EXPECT_LE(static_cast<double>(after_stats.chord_splits),
+              BaseMeshOptions{}.chord_split_share * static_cast<double>(before_stats.faces));
+    EXPECT_EQ(after_stats.faces, before_stats.faces + 2 * after_stats.chord_splits);
+    EXPECT_TRUE(after_stats.topology_kept) << after_stats.topology_change;
+    const MultiresMesh& kept_levels = kept.semi_regular.hierarchy;
+    const MultiresMesh& split_levels = split.semi_regular.hierarchy;
+    ASSERT_EQ(kept_levels.finest_level(), split_levels.finest_level());
+    const TriMesh before = kept_levels.level_mesh(kept_levels.finest_level());
+    const TriMesh after = split_levels.level_mesh(split_levels.finest_level());
+    const MeshTopology topo = analyze_topology(after);
+    EXPECT_TRUE(topo.is_oriented_manifold());
+    EXPECT_TRUE(topo.is_closed());
+    EXPECT_EQ(topo.euler_characteristic, 0);
+    const double farthest_before = largest_torus_chord(before);
+    const double farthest_after = largest_torus_chord(after);
+    EXPECT_LT(farthest_after, 0.8 * farthest_before)
+        << "before " << farthest_before << ", after " << farthest_after << ", "
+        << after_stats.chord_splits << " splits";
+    EXPECT_LE(share_below_20(after), share_below_20(before) + 0.002);
+}
+
+TEST(BaseMesh, ChordSplitShareOutOfRangeIsRefused)
+{
+    const Scene scene = sampled(Shape::Sphere, 3000, sphere_area);
+    for (const double share : {-0.1, 0.6, std::numeric_limits<double>::quiet_NaN()})
+        EXPECT_THROW((void)build_base_mesh(scene.mc, *scene.field,
+                                           {.target_faces = 300, .chord_split_share = share}),
+                     InvalidInput)
+            << share;
 }
 
 TEST(BaseMesh, DecimationInBlocksKeepsARimAndDoesNotDependOnThreads)

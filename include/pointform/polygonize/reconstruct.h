@@ -57,6 +57,8 @@ struct SemiRegularOptions
     bool fair_unsupported = RefineOptions{}.fair_unsupported;
     /// Holes of the automatic base mesh filled (BaseMeshOptions::fill_holes); 0 = none.
     double fill_holes = 0.0;
+    /// Long chords of the automatic base mesh split (BaseMeshOptions::chord_split_share).
+    double chord_split_share = BaseMeshOptions{}.chord_split_share;
 };
 
 /// \brief A semi-regular mesh and how it was made.
