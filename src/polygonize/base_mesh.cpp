@@ -33,7 +33,6 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -1356,6 +1355,15 @@ std::optional<TriMesh> decimate_in_blocks(const TriMesh& intermediate, std::size
     return joined;
 }
 
+/// The value at index size / 2 of `values` in order (the upper median). \pre !values.empty()
+double middle_value(std::vector<double> values)
+{
+    PF_ASSERT(!values.empty());
+    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    return *middle;
+}
+
 /// split_long_chords(): an edge is split when it is longer than this many times the median
 /// edge ...
 constexpr double chord_split_length = 1.5;
@@ -1402,21 +1410,14 @@ std::size_t split_long_chords(OmMesh& mesh, const Field& field, double max_share
                 error[i] = std::abs(sample.value);
         }
     });
-    std::vector<double> sorted(error);
-    const auto middle = sorted.begin() + static_cast<std::ptrdiff_t>(faces / 2);
-    std::nth_element(sorted.begin(), middle, sorted.end());
-    const double error_limit = chord_split_error * *middle;
+    const double error_limit = chord_split_error * middle_value(error);
     std::vector<double> lengths;
     lengths.reserve(mesh.n_edges());
     for (const auto e : mesh.edges())
         lengths.push_back((at(mesh.to_vertex_handle(mesh.halfedge_handle(e, 0))) -
                            at(mesh.from_vertex_handle(mesh.halfedge_handle(e, 0))))
                               .norm());
-    std::vector<double> sorted_lengths(lengths);
-    const auto middle_length =
-        sorted_lengths.begin() + static_cast<std::ptrdiff_t>(sorted_lengths.size() / 2);
-    std::nth_element(sorted_lengths.begin(), middle_length, sorted_lengths.end());
-    const double length_limit = chord_split_length * *middle_length;
+    const double length_limit = chord_split_length * middle_value(lengths);
     const double cos_dihedral = std::cos(chord_split_dihedral * degrees);
     const auto normal_of = [&](OmMesh::FaceHandle f) {
         std::array<Vec3d, 3> p;
@@ -1543,9 +1544,7 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
                 lengths.push_back(static_cast<double>((x[t[k]] - x[t[(k + 1) % 3]]).norm()));
             }
         }
-        auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
-        std::nth_element(lengths.begin(), middle, lengths.end());
-        stats.boundary_tolerance = 0.5 * *middle;
+        stats.boundary_tolerance = 0.5 * middle_value(std::move(lengths));
     }
 
     // 1. Simplify by edge collapses: a large mesh first in blocks at once (decimate_in_blocks()),
