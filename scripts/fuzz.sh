@@ -7,6 +7,10 @@
 #   bash scripts/fuzz.sh [SECONDS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# ccache (CMakeLists.txt uses it where installed): paths relative to this checkout and the
+# working directory left out of the hash, so that a fresh clone of the same sources (as CI builds)
+# compiles from the cache.
+export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
 seconds="${1:-60}"
 readers_seconds=$(( (seconds + 1) / 2 ))
 other_seconds=$(( (seconds - readers_seconds) / 4 ))

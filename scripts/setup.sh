@@ -13,7 +13,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake ninja-build pkg-config git
+  build-essential cmake ninja-build pkg-config git ccache
   libeigen3-dev libnanoflann-dev libcli11-dev nlohmann-json3-dev
   libembree-dev libpng-dev libopenmesh-dev libcpp-httplib-dev
   libgtest-dev libgmock-dev libbenchmark-dev

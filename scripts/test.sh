@@ -11,6 +11,10 @@
 # (an instrumented extension cannot load into an uninstrumented interpreter).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# ccache (CMakeLists.txt uses it where installed): paths relative to this checkout and the
+# working directory left out of the hash, so that a fresh clone of the same sources (as CI builds)
+# compiles from the cache.
+export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
 preset="${1:-release}"
 
 bash scripts/setup.sh
