@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace pointform {
 
@@ -134,27 +135,37 @@ std::optional<Vec3d> project_from(const Field& field, const FieldSample* at_p, c
     for (int k = 1; k <= options.steps; ++k)
     {
         const double r = k == options.steps ? max_distance : k * h;
-        const LineSample pos = line.at(r);
-        const LineSample neg = line.at(-r);
-
+        // A side can close a bracket in this step only from an inner sample of the right sign;
+        // the other side's sample is taken only if the march goes on (at the first step one
+        // side alone can, by the sign at p: a crossing there costs one evaluation fewer).
+        std::optional<LineSample> pos;
+        std::optional<LineSample> neg;
         std::optional<double> best;
         // Positive side: interval [pos_prev.t, pos.t], crossing when pos_prev < 0 <= pos.
         // Undefined samples still carry the sign (field.h), so a band of definition thinner than
         // a step is not jumped over; the located point must be defined.
-        if (pos_prev.value < 0.0 && pos.value >= 0.0)
-            best = refine_bracket(line, pos_prev, pos, tolerance, options.max_iterations);
-        // Negative side: interval [neg.t, neg_prev.t], crossing when neg < 0 <= neg_prev.
-        if (neg.value < 0.0 && neg_prev.value >= 0.0)
+        if (pos_prev.value < 0.0)
         {
-            const std::optional<double> t =
-                refine_bracket(line, neg, neg_prev, tolerance, options.max_iterations);
-            if (t && (!best || std::abs(*t) < std::abs(*best)))
-                best = t;
+            pos = line.at(r);
+            if (pos->value >= 0.0)
+                best = refine_bracket(line, pos_prev, *pos, tolerance, options.max_iterations);
+        }
+        // Negative side: interval [neg.t, neg_prev.t], crossing when neg < 0 <= neg_prev.
+        if (neg_prev.value >= 0.0)
+        {
+            neg = line.at(-r);
+            if (neg->value < 0.0)
+            {
+                const std::optional<double> t =
+                    refine_bracket(line, *neg, neg_prev, tolerance, options.max_iterations);
+                if (t && (!best || std::abs(*t) < std::abs(*best)))
+                    best = t;
+            }
         }
         if (best)
             return line.point(*best);
-        pos_prev = pos;
-        neg_prev = neg;
+        pos_prev = pos ? *pos : line.at(r);
+        neg_prev = neg ? *neg : line.at(-r);
     }
     return std::nullopt;
 }
