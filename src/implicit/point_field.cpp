@@ -1360,7 +1360,9 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
             out.gradient = nearest.normal.cast<double>();
             return out;
         }
-        found = m.grid->knn(query, want, std::span(slot, want), std::span(dist2, want));
+        // The grid has already turned the query down (found == 0: its cells were scanned for
+        // want, or the query lies beyond their reach): straight to the kd-tree.
+        found = m.grid->knn_far(query, want, std::span(slot, want), std::span(dist2, want));
     }
     const PackedSurfel& nearest = m.packed[slot[0]];
     // Defined inside the union of the blended samples' influence balls, so that a gap next to

@@ -1103,6 +1103,8 @@ std::size_t PointGrid::knn_far(const Vec3f& query, std::size_t k, std::span<std:
                                std::span<float> squared_distances) const
 {
     k = std::min(k, count_);
+    check_buffer_size("PointGrid::knn_far", "slots", slots.size(), k);
+    check_buffer_size("PointGrid::knn_far", "squared_distances", squared_distances.size(), k);
     // Far from the points: the kd-tree, its indices mapped to slots.
     std::array<std::uint32_t, max_k> index_buffer{};
     std::array<float, max_k> d2_buffer{};

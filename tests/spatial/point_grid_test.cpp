@@ -80,6 +80,46 @@ TEST(PointGrid, KnnOnASurfaceMatchesBruteForceNearAndFar)
     }
 }
 
+TEST(PointGrid, KnnFarAnswersWhatTheCellsTurnDown)
+{
+    // knn_far() is the kd-tree's exact answer anywhere: where knn_nearby() turns a query down
+    // it is knn()'s answer bit for bit, and near the points the same distances.
+    const PointCloud cloud = sample_shape(Shape::Sphere, {.count = 3000, .seed = 6});
+    const KdTree tree(cloud.positions);
+    const PointGrid grid(cloud.positions, 0.05F, tree);
+    std::mt19937_64 rng(12);
+    std::normal_distribution<float> gauss;
+    std::uniform_real_distribution<float> radius(0.5F, 2.0F);
+    int turned_down = 0;
+    for (int q = 0; q < 400; ++q)
+    {
+        const Vec3f query = Vec3f(gauss(rng), gauss(rng), gauss(rng)).normalized() * radius(rng);
+        for (const std::size_t k : {1U, 9U})
+        {
+            std::vector<std::uint32_t> near_slots(k), far_slots(k), slots(k);
+            std::vector<float> near_d2(k), far_d2(k), d2(k);
+            const std::size_t near = grid.knn_nearby(query, k, near_slots, near_d2);
+            ASSERT_EQ(grid.knn_far(query, k, far_slots, far_d2), k);
+            ASSERT_EQ(grid.knn(query, k, slots, d2), k);
+            for (std::size_t j = 0; j < k; ++j)
+            {
+                EXPECT_FLOAT_EQ(far_d2[j], d2[j]);
+                if (near == 0)
+                {
+                    EXPECT_EQ(far_slots[j], slots[j]);
+                    EXPECT_EQ(far_d2[j], d2[j]);
+                }
+            }
+            turned_down += near == 0 ? 1 : 0;
+        }
+    }
+    EXPECT_GT(turned_down, 100);
+    std::vector<std::uint32_t> short_slots(2);
+    std::vector<float> short_d2(2);
+    EXPECT_THROW(static_cast<void>(grid.knn_far(Vec3f::Zero(), 9, short_slots, short_d2)),
+                 InvalidInput);
+}
+
 TEST(PointGrid, SparseRegionsAndGridsQueriedInTurnStayExact)
 {
     // A plane sampled densely on one half and 8 times as sparsely on the other (a scan's near

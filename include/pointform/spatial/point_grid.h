@@ -49,6 +49,12 @@ public:
     std::size_t knn_nearby(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
                            std::span<float> squared_distances) const;
 
+    /// \brief knn() of a query that knn_nearby() has already turned down (returned 0 for at
+    /// least k): the kd-tree's answer, without scanning the grid's cells again.
+    /// \param slots, squared_distances  caller buffers of size >= min(k, point count)
+    std::size_t knn_far(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
+                        std::span<float> squared_distances) const;
+
     /// \brief knn_nearby() for many queries at once: query i's answer (the same neighbours, in
     /// the same order, with the same distances, bit for bit) goes to found[i] (the count, or 0)
     /// and to slots and squared_distances from i · k on.
@@ -104,8 +110,6 @@ private:
     /// \return false for queries that no cell can answer (non-finite, or too far out)
     [[nodiscard]] bool placed(const Vec3f& query, Placement& place) const;
 
-    std::size_t knn_far(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
-                        std::span<float> squared_distances) const;
     /// knn_nearby() by Within alone (k at most the point count).
     std::size_t knn_within(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
                            std::span<float> squared_distances) const;
