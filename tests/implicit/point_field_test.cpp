@@ -12,7 +12,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -334,6 +336,73 @@ TEST(PointField, CreaseFitsMeetTheFacesAtCreasesAndLeaveSmoothSurfacesAlone)
     });
     EXPECT_EQ(runs[0], runs[1]);
     EXPECT_EQ(runs[0], runs[2]);
+}
+
+TEST(PointField, ConcaveCreasesAreNotFilled)
+{
+    // The inner corner of an L (a floor z = 0 for x >= 0 and a wall x = 0 for z >= 0, the solid
+    // behind both), sampled uniformly with normals estimated (tilted toward the other face next
+    // to the crease) and oriented as the solid's. Along the bisector of the corner the field's
+    // zero stays within a fraction of the sample spacing of the crease: the samples next to the
+    // crease fit their own face (from their neighbours' normals, where the principal normal lies
+    // between the faces) and count as the union of their face and the other's. Before, the
+    // zero filled the groove by 0.39 spacings at the median and 0.79 at most here.
+    constexpr int per_face = 10000;
+    constexpr double side = 0.5;
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(0.0, side);
+    PointCloud raw;
+    std::vector<Vec3f> truth;
+    for (int i = 0; i < per_face; ++i)
+    {
+        raw.positions.emplace_back(static_cast<float>(u(rng)), static_cast<float>(u(rng) - 0.25),
+                                   0.0F);
+        truth.emplace_back(0.0F, 0.0F, 1.0F);
+        raw.positions.emplace_back(0.0F, static_cast<float>(u(rng) - 0.25),
+                                   static_cast<float>(u(rng)));
+        truth.emplace_back(1.0F, 0.0F, 0.0F);
+    }
+    PointCloud surfels = compute_surfels(raw).surfels;
+    ASSERT_EQ(surfels.size(), raw.size());
+    std::size_t flipped = 0;
+    for (std::size_t i = 0; i < surfels.size(); ++i)
+    {
+        if (surfels.normals[i].dot(truth[i]) < 0.0F)
+        {
+            surfels.normals[i] = -surfels.normals[i];
+            ++flipped;
+        }
+    }
+    EXPECT_TRUE(flipped == 0 || flipped == surfels.size()) << flipped << " flipped";
+    const PointField field(surfels);
+    const double spacing = side / std::sqrt(static_cast<double>(per_face));
+    const Vec3d bisector = Vec3d(1.0, 0.0, 1.0).normalized();
+    std::vector<double> offsets;
+    for (int k = -20; k <= 20; ++k)
+    {
+        const Vec3d on_crease(0.0, 0.005 * k, 0.0);
+        // The crossing nearest the crease along the bisector, within 6 spacings.
+        double best = std::numeric_limits<double>::infinity();
+        double previous = field.evaluate(on_crease - 6.0 * spacing * bisector).value;
+        for (int step = -119; step <= 120; ++step)
+        {
+            const double t0 = 0.05 * (step - 1) * spacing;
+            const double t1 = 0.05 * step * spacing;
+            const double value = field.evaluate(on_crease + t1 * bisector).value;
+            if ((previous < 0.0) != (value < 0.0))
+            {
+                const double t = t0 + (t1 - t0) * previous / (previous - value);
+                if (std::abs(t) < std::abs(best))
+                    best = t;
+            }
+            previous = value;
+        }
+        ASSERT_TRUE(std::isfinite(best)) << "no zero near the crease at y = " << on_crease.y();
+        offsets.push_back(best);
+    }
+    std::sort(offsets.begin(), offsets.end());
+    EXPECT_LT(std::abs(offsets[offsets.size() / 2]), 0.3 * spacing);
+    EXPECT_LT(std::max(std::abs(offsets.front()), std::abs(offsets.back())), 0.6 * spacing);
 }
 
 TEST(PointField, EndsSoonAfterARimAndSpansHolesWhereRadiiAreRaised)
