@@ -90,8 +90,10 @@ void bind_implicit(py::module_& m)
              "rim of the samples (a hole's edge, a scan's border) the field reaches, as a "
              "fraction of an automatic influence radius, in (0, 1]; 1 = a whole radius, the "
              "paper's field. crease_fit (quadric only): each sample's surface fitted to its own "
-             "face of a crease, and left out of the blend past the crease line, so that faces "
-             "meet there instead of being rounded off or running past it; False = the principal "
+             "face of a crease, and left out of the blend past the crease line (at a concave "
+             "crease of a clean cloud, the union of its face and the other face's plane), so "
+             "that faces meet there instead of being rounded off or running past it; False = "
+             "the principal "
              "normal's quadric everywhere. Raises InvalidInput for a cloud without normals or "
              "radii, or non-finite or non-positive ones, or rim_reach out of range.")
         .def("evaluate", &evaluate, py::arg("points"), py::kw_only(), py::arg("defined") = false,
