@@ -513,7 +513,8 @@ struct CreaseFit
 /// face's surface reaches beyond it. The line itself is the limit: on the 100k clean part of
 /// bench/peers, with a margin of 0.25 / 0.1 / 0 of the farthest neighbour's distance beyond
 /// it, Hausdorff 1.17 / 0.91 / 0.80 % of the diagonal (0.93 with no limit), Chamfer 0.0102 /
-/// 0.0102 / 0.0101 %; the plate 1.15 / 0.88 / 0.89 (0.98).
+/// 0.0102 / 0.0101 %; the plate 1.15 / 0.88 / 0.89 (0.98). `other_plane`, unless null, gets
+/// the other face's plane at a concave crease (CreaseFit::other).
 Eigen::Vector4f crease_limit(const CreaseNeighbourhood& hood,
                              std::span<const std::uint32_t> neighbors,
                              std::span<const Vec3f> normals, const Vec3f& normal, double cut,
@@ -589,7 +590,8 @@ Eigen::Vector4f crease_limit(const CreaseNeighbourhood& hood,
             // it (evaluate_with()), where the line's placement, pulled into the sample's own
             // face by the min above, put points of the groove "past" it and inside.
             const double facing = m.dot(outlier_normal);
-            if (outlier_height > 0.0 && t >= 0.0 && t <= inlier_far && facing != 0.0)
+            if (other_plane != nullptr && outlier_height > 0.0 && t >= 0.0 && t <= inlier_far &&
+                facing != 0.0)
             {
                 const Vec3d outward = facing > 0.0 ? m : Vec3d(-m);
                 *other_plane = {static_cast<float>(outward.x()), static_cast<float>(outward.y()),
@@ -727,39 +729,34 @@ CreaseFit crease_normal(std::span<const Vec3f> positions, std::span<const Vec3f>
     const auto principal = hood.principal_axes([](std::size_t) { return 1.0; });
     const Vec3d e0 = principal->eigenvectors().col(0);
     const Vec3d e1 = principal->eigenvectors().col(1);
-    // Two more starts from the neighbours' own normals, which away from the crease are their
-    // faces': the one turned furthest from the sample's (the other face, or this one where the
-    // principal normal leans to the other), and the one turned furthest from that.
-    std::size_t far_one = 0;
-    float far_cosine = 2.0F;
-    for (std::size_t j = 1; j < hood.count; ++j)
-    {
-        const float cosine = normals[neighbors[j]].dot(normal);
-        if (cosine > -0.5F && cosine < far_cosine)
+    // In clean clouds, two more starts from the neighbours' own normals, which away from the
+    // crease are their faces': the one turned furthest from the sample's (the other face, or
+    // this one where the principal normal leans to the other), and the one turned furthest from
+    // that.
+    const auto furthest_turned = [&](const Vec3f& from) {
+        std::size_t furthest = 0;
+        float furthest_cosine = 2.0F;
+        for (std::size_t j = 1; j < hood.count; ++j)
         {
-            far_cosine = cosine;
-            far_one = j;
+            const float cosine = normals[neighbors[j]].dot(from);
+            if (cosine > -0.5F && cosine < furthest_cosine)
+            {
+                furthest_cosine = cosine;
+                furthest = j;
+            }
         }
-    }
-    const Vec3f first_face = normals[neighbors[far_one]];
-    std::size_t far_two = 0;
-    far_cosine = 2.0F;
-    for (std::size_t j = 1; j < hood.count; ++j)
+        return normals[neighbors[furthest]];
+    };
+    Vec3d first_face = Vec3d::Constant(std::numeric_limits<double>::quiet_NaN());
+    Vec3d second_face = first_face;
+    if (clean)
     {
-        const float cosine = normals[neighbors[j]].dot(first_face);
-        if (cosine > -0.5F && cosine < far_cosine)
-        {
-            far_cosine = cosine;
-            far_two = j;
-        }
+        const Vec3f first = furthest_turned(normal);
+        first_face = first.cast<double>();
+        second_face = furthest_turned(first).cast<double>();
     }
-    const Vec3d unset = Vec3d::Constant(std::numeric_limits<double>::quiet_NaN());
-    std::array<Vec3d, 6> starts = {original,
-                                   e1,
-                                   (e0 + e1).normalized(),
-                                   (e0 - e1).normalized(),
-                                   clean ? first_face.cast<double>() : unset,
-                                   clean ? normals[neighbors[far_two]].cast<double>() : unset};
+    std::array<Vec3d, 6> starts = {
+        original, e1, (e0 + e1).normalized(), (e0 - e1).normalized(), first_face, second_face};
     std::array<std::optional<Vec3d>, 6> fits;
     std::array<double, 6> cuts{};
     double tightest = std::numeric_limits<double>::infinity();
@@ -796,9 +793,8 @@ CreaseFit crease_normal(std::span<const Vec3f> positions, std::span<const Vec3f>
         return {normal};
     const Vec3d fitted = fits[*best]->normalized();
     CreaseFit out{fitted.cast<float>()};
-    out.crease = crease_limit(hood, neighbors, normals, out.normal, cuts[*best], &out.other);
-    if (!clean)
-        out.other = Eigen::Vector4f::Zero();
+    out.crease = crease_limit(hood, neighbors, normals, out.normal, cuts[*best],
+                              clean ? &out.other : nullptr);
     return out;
 }
 
