@@ -95,6 +95,9 @@ const browser = await chromium.launch({
 });
 try {
   const page = await browser.newPage({ viewport: { width: 960, height: 640 }, acceptDownloads: true });
+  // Actions wait for the page to draw stable frames; software WebGL next to the rest of the
+  // suite on two cores has taken over 30 s (Playwright's default) for one click.
+  page.setDefaultTimeout(120000);
   const errors = [];
   page.on('pageerror', (error) => errors.push(String(error)));
   page.on('console', (message) => { if (message.type() === 'error') errors.push(message.text()); });
