@@ -299,9 +299,12 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
         report.coarsening = intermediate.coarsening;
         const CellGrid grid = grid_over(field.bounds(), cell);
         check_marching_cubes_memory(field, cell);
+        // The intermediate mesh's vertex normals are not used (the base mesh is made from its
+        // positions): not asked for, which saves a field evaluation a vertex.
         MarchingCubesResult mc =
             marching_cubes(field, grid,
-                           {.min_defined_corners = intermediate.min_defined_corners,
+                           {.vertex_normals = false,
+                            .min_defined_corners = intermediate.min_defined_corners,
                             .progress = options.progress});
         clock.lap("marching cubes");
         if (mc.mesh.face_count() == 0)
