@@ -64,7 +64,7 @@ using OmBase = OpenMesh::TriMesh_ArrayKernelT<OmTraits>;
 
 /// The halfedge mesh. It hides TriConnectivity::is_collapse_ok, which the Decimater calls for
 /// every candidate collapse, with the same test minus that function's per-call allocations
-/// (which made it 70% of the decimation time).
+/// (which made it 70% of the decimation time), the one-rings compared through a mark per vertex.
 class OmMesh : public OmBase
 {
 public:
@@ -114,14 +114,21 @@ public:
         {
             return false;
         }
-        ring_.clear();
+        // v1's ring marked with a fresh stamp, then v0's looked up in it.
+        if (mark_.size() < n_vertices())
+            mark_.resize(n_vertices(), 0);
+        if (++stamp_ == 0)
+        {
+            std::fill(mark_.begin(), mark_.end(), 0U);
+            stamp_ = 1;
+        }
         for (const VertexHandle w : vv_range(v1))
         {
-            ring_.push_back(w);
+            mark_[static_cast<std::size_t>(w.idx())] = stamp_;
         }
         for (const VertexHandle w : vv_range(v0))
         {
-            if (w != vl && w != vr && std::find(ring_.begin(), ring_.end(), w) != ring_.end())
+            if (w != vl && w != vr && mark_[static_cast<std::size_t>(w.idx())] == stamp_)
             {
                 return false;
             }
@@ -135,7 +142,8 @@ public:
     [[nodiscard]] bool keeps_locked() const { return keep_locked_; }
 
 private:
-    std::vector<VertexHandle> ring_;
+    std::vector<std::uint32_t> mark_; ///< per vertex: the stamp of the last ring it was in
+    std::uint32_t stamp_ = 0;
     bool keep_locked_ = false;
 };
 
@@ -1336,9 +1344,11 @@ private:
     void enqueue(OmMesh::VertexHandle v)
     {
         gather(v, scratch_);
-        std::stable_sort(
-            scratch_.begin(), scratch_.end(),
-            [](const Candidate& a, const Candidate& b) { return a.priority < b.priority; });
+        // By error, ties in halfedge order (an insertion sort: a handful of candidates, and
+        // std::stable_sort would allocate).
+        for (std::size_t i = 1; i < scratch_.size(); ++i)
+            for (std::size_t j = i; j > 0 && scratch_[j].priority < scratch_[j - 1].priority; --j)
+                std::swap(scratch_[j], scratch_[j - 1]);
         Slot& slot = slot_[static_cast<std::size_t>(v.idx())];
         for (const Candidate& c : scratch_)
         {
