@@ -223,9 +223,10 @@ MeshTopology check_intermediate_mesh(const TriMesh& intermediate);
 /// simplified by topology-safe edge collapses to a target face count, its triangles shaped, and
 /// every vertex moved onto f = 0.
 ///
-/// 1. Collapses go through OpenMesh's Decimater: priority by quadric error (ModQuadricT),
-///    refused when they break the link condition (so genus, components and boundary loops stay)
-///    or turn a face by more than max_normal_deviation_degrees (ModNormalFlippingT). A collapse
+/// 1. Collapses in the order of OpenMesh's Decimater (the same collapses, by a loop of our own
+///    on its heap and halfedge mesh): priority by quadric error, refused when they break the
+///    link condition (so genus, components and boundary loops stay) or turn a face by more than
+///    max_normal_deviation_degrees. A collapse
 ///    keeps the surviving vertex's position. Boundary loops (holes in the samples) are kept: a
 ///    boundary vertex only collapses along its boundary, a loop never shrinks below three
 ///    edges, and the boundary stays within boundary_tolerance of the removed rim vertices (so
