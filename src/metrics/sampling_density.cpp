@@ -22,6 +22,18 @@ SamplingDensity measure_sampling_density(const PointCloudView& samples,
         throw InvalidInput("sampling density: need at least 2 samples, got " +
                            std::to_string(samples.size()));
     const KdTree tree(samples.positions);
+    return measure_sampling_density(tree, samples, progress);
+}
+
+SamplingDensity measure_sampling_density(const KdTree& tree, const PointCloudView& samples,
+                                         const ProgressCallback& progress)
+{
+    if (samples.size() < 2)
+        throw InvalidInput("sampling density: need at least 2 samples, got " +
+                           std::to_string(samples.size()));
+    if (tree.size() != samples.size())
+        throw InvalidInput("sampling density: a k-d tree of " + std::to_string(tree.size()) +
+                           " points for " + std::to_string(samples.size()) + " samples");
     // At most max_sampling_density_queries, evenly spread over the samples (fixed stride).
     const std::size_t stride =
         std::max<std::size_t>(1, samples.size() / max_sampling_density_queries);

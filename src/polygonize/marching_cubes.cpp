@@ -423,6 +423,14 @@ public:
         return {&b.value[i], &b.state[i]};
     }
 
+    /// The value stored at grid point c, which must have been evaluated (0 if not).
+    [[nodiscard]] float value_at(const Coord& c) const
+    {
+        const Slot s = find(c);
+        PF_ASSERT(s.value != nullptr);
+        return s.value != nullptr ? *s.value : 0.0F;
+    }
+
 private:
     static std::uint64_t block_key(const Coord& c)
     {
@@ -459,7 +467,8 @@ bool in_grid(const CellGrid& grid, const Coord& c)
 
 void sort_unique(std::vector<std::uint64_t>& keys)
 {
-    std::sort(keys.begin(), keys.end());
+    // Equal keys are equal values: any sort gives the same sequence.
+    parallel_sort(keys);
     keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
 }
 
@@ -939,6 +948,9 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
                     for (int c = 0; c < 8; ++c)
                     {
                         const SparseGrid::Slot s = store.find(corner_of(cell, c));
+                        PF_ASSERT(s.state != nullptr);
+                        if (s.state == nullptr)
+                            continue;
                         defined_corners += (*s.state & defined) != 0 ? 1 : 0;
                         mask |= (*s.value < 0.0F ? 1 : 0) << c;
                     }
@@ -1050,35 +1062,38 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
     std::vector<double> lo_f(nv);
     std::vector<double> hi_f(nv);
     std::vector<double> vertex_t(nv);
-    for (std::size_t v = 0; v < nv; ++v)
-    {
-        const Coord base = unpack(edges[v] >> 2);
-        const auto axis = static_cast<std::size_t>(edges[v] & 3);
-        Coord tip = base;
-        if (axis == 3)
+    parallel_blocks(nv, 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t v = begin; v < end; ++v)
         {
-            // A cell's own vertex: on the segment between two of its corners.
-            std::array<float, 8> value{};
-            for (int c = 0; c < 8; ++c)
+            const Coord base = unpack(edges[v] >> 2);
+            const auto axis = static_cast<std::size_t>(edges[v] & 3);
+            Coord tip = base;
+            if (axis == 3)
             {
-                value[static_cast<std::size_t>(c)] = *store.find(corner_of(base, c)).value;
+                // A cell's own vertex: on the segment between two of its corners.
+                std::array<float, 8> value{};
+                for (int c = 0; c < 8; ++c)
+                {
+                    value[static_cast<std::size_t>(c)] = store.value_at(corner_of(base, c));
+                }
+                const auto [from, to] = cell_vertex_corners(value);
+                const Coord a = corner_of(base, from);
+                const Coord b = corner_of(base, to);
+                a_point[v] = grid_point(grid, a);
+                b_point[v] = grid_point(grid, b);
+                lo_f[v] = value[static_cast<std::size_t>(from)];
+                hi_f[v] = value[static_cast<std::size_t>(to)];
+                continue;
             }
-            const auto [from, to] = cell_vertex_corners(value);
-            const Coord a = corner_of(base, from);
-            const Coord b = corner_of(base, to);
-            a_point[v] = grid_point(grid, a);
-            b_point[v] = grid_point(grid, b);
-            lo_f[v] = value[static_cast<std::size_t>(from)];
-            hi_f[v] = value[static_cast<std::size_t>(to)];
-            ++stats.cell_vertices;
-            continue;
+            tip[axis] += 1;
+            a_point[v] = grid_point(grid, base);
+            b_point[v] = grid_point(grid, tip);
+            lo_f[v] = store.value_at(base);
+            hi_f[v] = store.value_at(tip);
         }
-        tip[axis] += 1;
-        a_point[v] = grid_point(grid, base);
-        b_point[v] = grid_point(grid, tip);
-        lo_f[v] = *store.find(base).value;
-        hi_f[v] = *store.find(tip).value;
-    }
+    });
+    stats.cell_vertices += static_cast<std::size_t>(std::count_if(
+        edges.begin(), edges.end(), [](std::uint64_t key) { return (key & 3) == 3; }));
     auto interpolate = [&](std::size_t v) {
         const double denominator = lo_f[v] - hi_f[v];
         const double s = denominator != 0.0 ? lo_f[v] / denominator : 0.5;
@@ -1225,29 +1240,48 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
 
     // Triangles, all of them: dropping one would open a hole.
     mesh.triangles.resize(corners_of_triangles.size() / 3);
-    for (std::size_t f = 0; f < mesh.triangles.size(); ++f)
-    {
-        for (std::size_t j = 0; j < 3; ++j)
+    parallel_blocks(mesh.triangles.size(), 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t f = begin; f < end; ++f)
         {
-            const auto it =
-                std::lower_bound(edges.begin(), edges.end(), corners_of_triangles[3 * f + j]);
-            mesh.triangles[f][j] = static_cast<std::uint32_t>(it - edges.begin());
+            for (std::size_t j = 0; j < 3; ++j)
+            {
+                const auto it =
+                    std::lower_bound(edges.begin(), edges.end(), corners_of_triangles[3 * f + j]);
+                mesh.triangles[f][j] = static_cast<std::uint32_t>(it - edges.begin());
+            }
         }
-    }
+    });
     if (options.min_defined_corners < 8 && nv > 0)
     {
         // Cells with undefined corners reach past the field's defined region (a hole's rim):
         // there the triangles with a vertex where the field is undefined are dropped, so holes
         // stay as the field has them, and the vertices left unused are removed.
-        std::vector<FieldSample> at_vertices(nv);
-        evaluate_near_zero(field, exact_range, points, at_vertices);
-        stats.field_evaluations += nv;
+        // A settled vertex that the margin left where it is was last evaluated there, defined;
+        // the others are evaluated now.
+        std::vector<std::uint8_t> defined_at(nv, 1);
+        std::vector<std::size_t> unsettled;
+        for (std::size_t v = 0; v < nv; ++v)
+        {
+            if (settled[v] == 0 ||
+                std::clamp(vertex_t[v], corner_margin, 1.0 - corner_margin) != vertex_t[v])
+            {
+                unsettled.push_back(v);
+            }
+        }
+        const std::vector<FieldSample> at_vertices = evaluate_subset(
+            points, unsettled, [&](std::span<const Vec3d> at, std::span<FieldSample> out) {
+                evaluate_near_zero(field, exact_range, at, out);
+            });
+        stats.field_evaluations += unsettled.size();
+        for (std::size_t i = 0; i < unsettled.size(); ++i)
+        {
+            defined_at[unsettled[i]] = at_vertices[i].defined ? 1 : 0;
+        }
         std::vector<std::uint8_t> keep(mesh.face_count());
         for (std::size_t f = 0; f < mesh.face_count(); ++f)
         {
             const Triangle& tri = mesh.triangles[f];
-            keep[f] = at_vertices[tri[0]].defined && at_vertices[tri[1]].defined &&
-                              at_vertices[tri[2]].defined
+            keep[f] = defined_at[tri[0]] != 0 && defined_at[tri[1]] != 0 && defined_at[tri[2]] != 0
                           ? 1
                           : 0;
         }

@@ -1154,8 +1154,8 @@ constexpr double unsupported_band = 1.5;
 /// fairing as the base mesh's hole patches (Σ ‖L x‖² least over the region and its neighbours,
 /// L the uniform Laplacian, every other vertex held). Vertices on the mesh's boundary are held.
 UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle> faces,
-                                    const Rings& rings, const PointCloud& samples, double spacing,
-                                    std::vector<char>& faired)
+                                    const Rings& rings, const PointCloud& samples,
+                                    const KdTree& tree, double spacing, std::vector<char>& faired)
 {
     faired.assign(mesh.vertex_count(), 0);
     UnsupportedFairing out;
@@ -1172,7 +1172,6 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
         if (*middle > 0.0F && std::isfinite(*middle))
             radius_scale = spacing / static_cast<double>(*middle);
     }
-    const KdTree tree(samples.positions);
     const Vec3d shift = mesh.origin() - samples.origin;
     const std::span<Vec3d> x = mesh.mutable_positions();
     // Distance to the nearest sample in local spacings.
@@ -1347,8 +1346,17 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
         report.stop = RefineStop::LevelCap;
         return report;
     }
-    report.sampling_density = options.sampling_density > 0.0 ? options.sampling_density
-                                                             : estimate_sampling_density(samples);
+    // One k-d tree of the samples, for their sampling density and for the fairing's distances
+    // from the vertices to them.
+    const bool fair = options.stop_rule == StopRule::Automatic && options.fair_unsupported;
+    std::optional<KdTree> sample_tree;
+    if (!(options.sampling_density > 0.0) || fair)
+        sample_tree.emplace(samples.positions);
+    report.sampling_density = options.sampling_density > 0.0
+                                  ? options.sampling_density
+                                  : measure_sampling_density(*sample_tree, samples).median;
+    if (!fair)
+        sample_tree.reset();
     // Every level is measured from the same samples: sorted along the Morton curve once.
     const std::vector<std::uint32_t> order = spatial_order(samples.positions);
     const ProgressCallback distance_progress = [&](std::string_view, double fraction) {
@@ -1473,7 +1481,6 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
         report.levels.push_back(stats);
     }
     bool moved = false;
-    const bool fair = automatic && options.fair_unsupported;
     const bool denoise = report.stop == RefineStop::NoisyDetails && options.denoise_rounds > 0;
     // The finest level's vertex rings, for the fairing, the smoothing and the spikes (all of
     // them under the automatic stop only).
@@ -1481,8 +1488,8 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
     std::vector<char> faired(mesh.vertex_count(), 0);
     if (fair)
     {
-        report.unsupported =
-            fair_unsupported(mesh, faces, rings, samples, report.sampling_density, faired);
+        report.unsupported = fair_unsupported(mesh, faces, rings, samples, *sample_tree,
+                                              report.sampling_density, faired);
         moved = report.unsupported.vertices > 0;
     }
     if (denoise)

@@ -5,6 +5,7 @@
 
 #include "pointform/core/error.h"
 #include "pointform/metrics/sampling_density.h"
+#include "pointform/spatial/kd_tree.h"
 
 #include "support/test_meshes.h"
 
@@ -126,6 +127,33 @@ TEST(SamplingDensity, LargeCloudsAreMeasuredOnAFixedStride)
     const SamplingDensity d = measure_sampling_density(line);
     EXPECT_EQ(d.measured, 125000U);
     EXPECT_NEAR(d.median, 0.01, 1e-5);
+}
+
+TEST(SamplingDensity, ACallersTreeGivesTheSameFigures)
+{
+    // Samples of a unit sphere at random: with the caller's tree of the same positions, every
+    // figure is the one the function's own tree gives, bit for bit.
+    std::mt19937 rng(7);
+    std::normal_distribution<float> normal;
+    PointCloud sphere;
+    for (int i = 0; i < 3000; ++i)
+    {
+        const Vec3f p(normal(rng), normal(rng), normal(rng));
+        sphere.positions.push_back(p.normalized());
+    }
+    const SamplingDensity own = measure_sampling_density(sphere);
+    const KdTree tree(sphere.positions);
+    const SamplingDensity given = measure_sampling_density(tree, sphere);
+    EXPECT_EQ(given.median, own.median);
+    EXPECT_EQ(given.mean, own.mean);
+    EXPECT_EQ(given.measured, own.measured);
+    // About the spacing of 3000 points on the sphere's area 4π.
+    EXPECT_GT(own.median, 0.2 * std::sqrt(4.0 * std::numbers::pi / 3000.0));
+    EXPECT_LT(own.median, 2.0 * std::sqrt(4.0 * std::numbers::pi / 3000.0));
+    // A tree of other points is refused.
+    PointCloud fewer = sphere;
+    fewer.positions.resize(100);
+    EXPECT_THROW((void)measure_sampling_density(tree, fewer), InvalidInput);
 }
 
 } // namespace

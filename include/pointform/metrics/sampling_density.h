@@ -10,6 +10,8 @@
 
 namespace pointform {
 
+class KdTree;
+
 /// \brief The sampling density of a point set: how far a sample is from its nearest other
 /// sample. The one definition the library and the CLI use (`pointform info`, and the threshold
 /// of the refinement's stop, §5.2.4).
@@ -34,6 +36,12 @@ inline constexpr std::size_t max_sampling_density_queries = 100000;
 /// The result does not depend on the thread count.
 /// \throw InvalidInput if the cloud has fewer than 2 points, or all are coincident
 [[nodiscard]] SamplingDensity measure_sampling_density(const PointCloudView& samples,
+                                                       const ProgressCallback& progress = {});
+
+/// \brief measure_sampling_density() with a k-d tree of the samples' positions that the caller
+/// has built (KdTree(samples.positions)), for a caller that queries it for more: the same result.
+[[nodiscard]] SamplingDensity measure_sampling_density(const KdTree& tree,
+                                                       const PointCloudView& samples,
                                                        const ProgressCallback& progress = {});
 
 /// \brief measure_sampling_density(samples).median.
