@@ -1206,11 +1206,18 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
         points[v] = a_point[v] + s * (b_point[v] - a_point[v]);
         mesh.vertices.positions[v] = (points[v] - mesh.vertices.origin).cast<float>();
     }
-    if (options.vertex_normals)
-    {
-        // The gradient where each vertex is: a settled vertex's sample, unless the margin moved
-        // it; the others evaluated here.
-        std::vector<std::size_t> unsettled;
+    // The field at the vertices that no settled sample speaks for (a settled vertex that the
+    // corner margin left where it is took its last sample there, defined): evaluated once, for
+    // the normals and for the definedness, whichever is asked.
+    std::vector<std::size_t> unsettled;
+    std::vector<FieldSample> at_unsettled;
+    bool unsettled_evaluated = false;
+    const auto evaluate_unsettled = [&]() {
+        if (unsettled_evaluated)
+        {
+            return;
+        }
+        unsettled_evaluated = true;
         for (std::size_t v = 0; v < nv; ++v)
         {
             const double s = std::clamp(vertex_t[v], corner_margin, 1.0 - corner_margin);
@@ -1219,14 +1226,19 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
                 unsettled.push_back(v);
             }
         }
-        const std::vector<FieldSample> at_vertices = evaluate_subset(
-            points, unsettled, [&](std::span<const Vec3d> at, std::span<FieldSample> out) {
-                evaluate_near_zero(field, exact_range, at, out);
-            });
+        at_unsettled = evaluate_subset(points, unsettled,
+                                       [&](std::span<const Vec3d> at, std::span<FieldSample> out) {
+                                           evaluate_near_zero(field, exact_range, at, out);
+                                       });
         stats.field_evaluations += unsettled.size();
+    };
+    if (options.vertex_normals)
+    {
+        // The gradient where each vertex is: a settled vertex's sample, the others'.
+        evaluate_unsettled();
         for (std::size_t i = 0; i < unsettled.size(); ++i)
         {
-            vertex_gradient[unsettled[i]] = at_vertices[i].gradient;
+            vertex_gradient[unsettled[i]] = at_unsettled[i].gradient;
         }
         mesh.vertices.normals.resize(nv);
         for (std::size_t v = 0; v < nv; ++v)
@@ -1256,26 +1268,11 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
         // Cells with undefined corners reach past the field's defined region (a hole's rim):
         // there the triangles with a vertex where the field is undefined are dropped, so holes
         // stay as the field has them, and the vertices left unused are removed.
-        // A settled vertex that the margin left where it is was last evaluated there, defined;
-        // the others are evaluated now.
+        evaluate_unsettled();
         std::vector<std::uint8_t> defined_at(nv, 1);
-        std::vector<std::size_t> unsettled;
-        for (std::size_t v = 0; v < nv; ++v)
-        {
-            if (settled[v] == 0 ||
-                std::clamp(vertex_t[v], corner_margin, 1.0 - corner_margin) != vertex_t[v])
-            {
-                unsettled.push_back(v);
-            }
-        }
-        const std::vector<FieldSample> at_vertices = evaluate_subset(
-            points, unsettled, [&](std::span<const Vec3d> at, std::span<FieldSample> out) {
-                evaluate_near_zero(field, exact_range, at, out);
-            });
-        stats.field_evaluations += unsettled.size();
         for (std::size_t i = 0; i < unsettled.size(); ++i)
         {
-            defined_at[unsettled[i]] = at_vertices[i].defined ? 1 : 0;
+            defined_at[unsettled[i]] = at_unsettled[i].defined ? 1 : 0;
         }
         std::vector<std::uint8_t> keep(mesh.face_count());
         for (std::size_t f = 0; f < mesh.face_count(); ++f)
