@@ -292,9 +292,13 @@ Distances distances_from(const PointCloud& samples, const MultiresMesh& mesh,
         bounds.assign(samples.size(), std::numeric_limits<double>::infinity());
         const std::size_t per_hint = hint.children ? 4 : 1;
         const auto& x = surface.vertices.positions;
+        // In the samples' spatial order where the caller has it: neighbouring samples then read
+        // the same faces and corners while they are in cache.
+        const bool ordered = order.size() == samples.size();
         parallel_blocks(samples.size(), 4096, [&](std::size_t begin, std::size_t end) {
-            for (std::size_t i = begin; i < end; ++i)
+            for (std::size_t k = begin; k < end; ++k)
             {
+                const std::size_t i = ordered ? order[k] : k;
                 const std::uint32_t f = hint.faces[i];
                 if (f == none || per_hint * f + per_hint > faces.size())
                     continue;
