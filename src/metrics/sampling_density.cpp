@@ -18,9 +18,6 @@ namespace pointform {
 SamplingDensity measure_sampling_density(const PointCloudView& samples,
                                          const ProgressCallback& progress)
 {
-    if (samples.size() < 2)
-        throw InvalidInput("sampling density: need at least 2 samples, got " +
-                           std::to_string(samples.size()));
     const KdTree tree(samples.positions);
     return measure_sampling_density(tree, samples, progress);
 }

@@ -1209,15 +1209,11 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
     // The field at the vertices that no settled sample speaks for (a settled vertex that the
     // corner margin left where it is took its last sample there, defined): evaluated once, for
     // the normals and for the definedness, whichever is asked.
+    const bool drop_undefined = options.min_defined_corners < 8 && nv > 0;
     std::vector<std::size_t> unsettled;
     std::vector<FieldSample> at_unsettled;
-    bool unsettled_evaluated = false;
-    const auto evaluate_unsettled = [&]() {
-        if (unsettled_evaluated)
-        {
-            return;
-        }
-        unsettled_evaluated = true;
+    if (options.vertex_normals || drop_undefined)
+    {
         for (std::size_t v = 0; v < nv; ++v)
         {
             const double s = std::clamp(vertex_t[v], corner_margin, 1.0 - corner_margin);
@@ -1231,11 +1227,10 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
                                            evaluate_near_zero(field, exact_range, at, out);
                                        });
         stats.field_evaluations += unsettled.size();
-    };
+    }
     if (options.vertex_normals)
     {
         // The gradient where each vertex is: a settled vertex's sample, the others'.
-        evaluate_unsettled();
         for (std::size_t i = 0; i < unsettled.size(); ++i)
         {
             vertex_gradient[unsettled[i]] = at_unsettled[i].gradient;
@@ -1263,12 +1258,11 @@ MarchingCubesResult marching_cubes(const Field& field, const CellGrid& grid,
             }
         }
     });
-    if (options.min_defined_corners < 8 && nv > 0)
+    if (drop_undefined)
     {
         // Cells with undefined corners reach past the field's defined region (a hole's rim):
         // there the triangles with a vertex where the field is undefined are dropped, so holes
         // stay as the field has them, and the vertices left unused are removed.
-        evaluate_unsettled();
         std::vector<std::uint8_t> defined_at(nv, 1);
         for (std::size_t i = 0; i < unsettled.size(); ++i)
         {
