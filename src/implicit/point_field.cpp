@@ -224,19 +224,32 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
     const double inv_scale = 1.0 / std::sqrt(scale2);
     using Mat6 = Eigen::Matrix<double, 6, 6>;
     using Vec6 = Eigen::Matrix<double, 6, 1>;
-    Mat6 normal_matrix = Mat6::Zero();
-    Vec6 rhs = Vec6::Zero();
-    double heights2 = 0.0;
-    std::size_t count = 0;
-    struct Fit
+    // The normal matrix of the monomials (1, u, v, u², uv, v²) holds the 15 moments Σ uᵃ vᵇ,
+    // a + b ≤ 4, which are summed instead of its 21 distinct products.
+    struct Sums
     {
-        Mat6 matrix;
-        Vec6 rhs;
-        double heights2;
-        std::size_t count;
-        double reach; ///< the farthest neighbour's distance, scaled
+        std::array<double, 15> moment{}; ///< Σ uᵃ vᵇ: 1, u, v, u², uv, v², u³, u²v, uv², v³,
+                                         ///< u⁴, u³v, u²v², uv³, v⁴
+        Vec6 rhs = Vec6::Zero(); ///< Σ h (1, u, v, u², uv, v²)
+        double heights2 = 0.0;   ///< Σ h²
+        std::size_t count = 0;
+        double reach = 0.0; ///< the farthest neighbour's distance, scaled (at the narrow scale)
+
+        [[nodiscard]] Mat6 matrix() const
+        {
+            const auto& m = moment;
+            Mat6 out;
+            out << m[0], m[1], m[2], m[3], m[4], m[5], //
+                m[1], m[3], m[4], m[6], m[7], m[8],    //
+                m[2], m[4], m[5], m[7], m[8], m[9],    //
+                m[3], m[6], m[7], m[10], m[11], m[12], //
+                m[4], m[7], m[8], m[11], m[12], m[13], //
+                m[5], m[8], m[9], m[12], m[13], m[14];
+            return out;
+        }
     };
-    std::optional<Fit> small;
+    Sums sums;
+    std::optional<Sums> small;
     for (const std::uint32_t j : neighbors)
     {
         if (!(normals[j].dot(out.normal) > 0.5F))
@@ -246,18 +259,38 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
         const Vec3d x = (positions[j].cast<double>() - s) * inv_scale;
         const double u = x.dot(t1);
         const double v = x.dot(t2);
-        Vec6 row;
-        row << 1.0, u, v, u * u, u * v, v * v;
-        normal_matrix.selfadjointView<Eigen::Lower>().rankUpdate(row);
         const double h = x.dot(n);
-        rhs += row * h;
-        heights2 += h * h;
-        ++count;
-        if (count == narrow_k)
-            small = Fit{normal_matrix, rhs, heights2, count, x.norm()};
+        const double uu = u * u;
+        const double uv = u * v;
+        const double vv = v * v;
+        auto& m = sums.moment;
+        m[0] += 1.0;
+        m[1] += u;
+        m[2] += v;
+        m[3] += uu;
+        m[4] += uv;
+        m[5] += vv;
+        m[6] += uu * u;
+        m[7] += uu * v;
+        m[8] += u * vv;
+        m[9] += vv * v;
+        m[10] += uu * uu;
+        m[11] += uu * uv;
+        m[12] += uu * vv;
+        m[13] += uv * vv;
+        m[14] += vv * vv;
+        sums.rhs += Vec6(1.0, u, v, uu, uv, vv) * h;
+        sums.heights2 += h * h;
+        ++sums.count;
+        if (sums.count == narrow_k)
+        {
+            small = sums;
+            small->reach = x.norm();
+        }
     }
+    const std::size_t count = sums.count;
     const auto solve = [](const Mat6& m, const Vec6& r) -> std::optional<std::pair<Vec6, double>> {
-        const Eigen::LDLT<Mat6> solver(m.selfadjointView<Eigen::Lower>());
+        const Eigen::LDLT<Mat6> solver(m);
         const auto pivots = solver.vectorD();
         if (solver.info() != Eigen::Success || !(pivots.minCoeff() > 1e-6 * pivots.maxCoeff()))
             return std::nullopt;
@@ -269,7 +302,7 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
             return std::nullopt;
         return std::pair{coef, leverage};
     };
-    const auto wide = solve(normal_matrix, rhs);
+    const auto wide = solve(sums.matrix(), sums.rhs);
     if (!wide || (on_rim && !plausible_fit(wide->first, 1.0)))
     {
         // Neighbours on a line, or too few spread, or on a rim a quadric that is no surface over
@@ -281,7 +314,7 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
     Vec6 coef = wide->first;
     if (small && small->count < count)
     {
-        if (const auto narrow = solve(small->matrix, small->rhs))
+        if (const auto narrow = solve(small->matrix(), small->rhs))
         {
             // The intersection of confidence intervals: the wide fit unless its height at the
             // sample differs from the narrow fit's by more than their noise explains.
