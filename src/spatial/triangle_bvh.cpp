@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -29,28 +30,263 @@ constexpr std::size_t query_block = 1024;
 /// its width is then under 1e-8 of its size, below what the plane projection resolves reliably.
 constexpr double degenerate_sin2 = 1e-16;
 
-float round_down(double x)
-{
-    float f = static_cast<float>(x);
-    if (static_cast<double>(f) > x)
-        f = std::nextafter(f, -std::numeric_limits<float>::infinity());
-    return f;
-}
-
-float round_up(double x)
-{
-    float f = static_cast<float>(x);
-    if (static_cast<double>(f) < x)
-        f = std::nextafter(f, std::numeric_limits<float>::infinity());
-    return f;
-}
-
 double half_area(const Aabb& box)
 {
     if (box.is_empty())
         return 0.0;
     const Vec3d s = box.size();
     return s.x() * s.y() + s.y() * s.z() + s.z() * s.x();
+}
+
+/// Triangles binned, partitioned and boxed in blocks of this many (a fixed count, so that the
+/// tree does not depend on the thread count).
+constexpr std::size_t ref_block = 16384;
+/// Ranges of at least this many triangles are binned and partitioned in parallel blocks.
+constexpr std::size_t parallel_split_refs = 4 * ref_block;
+/// Ranges of at most this many triangles are split by the surface-area heuristic at every
+/// position along each axis (their boxes' centres sorted) instead of by bins: most nodes are
+/// this small, and filling and sweeping 3 × 16 bins cost them more than the sort.
+constexpr std::size_t small_split_refs = 16;
+
+using Lanes = Eigen::Array4f; ///< x, y, z and a lane the build ignores
+
+constexpr float float_max = std::numeric_limits<float>::max();
+
+/// A triangle as the build sorts it: its box, exact in float as its corners are float
+/// positions, and its index in the mesh. The build places triangles by their boxes' centres
+/// (lo + hi, at twice the scale).
+struct BuildRef
+{
+    Lanes lo;
+    Lanes hi;
+    std::uint32_t face;
+
+    [[nodiscard]] Lanes centre2() const { return lo + hi; }
+};
+
+/// The box of some triangles and the box of their centres (at twice the scale); empty: lo
+/// above hi.
+struct BuildBox
+{
+    Lanes lo = Lanes::Constant(float_max);
+    Lanes hi = Lanes::Constant(-float_max);
+    Lanes centre_lo = Lanes::Constant(float_max);
+    Lanes centre_hi = Lanes::Constant(-float_max);
+
+    void add(const BuildRef& r)
+    {
+        lo = lo.min(r.lo);
+        hi = hi.max(r.hi);
+        const Lanes c = r.centre2();
+        centre_lo = centre_lo.min(c);
+        centre_hi = centre_hi.max(c);
+    }
+
+    void merge(const BuildBox& b)
+    {
+        lo = lo.min(b.lo);
+        hi = hi.max(b.hi);
+        centre_lo = centre_lo.min(b.centre_lo);
+        centre_hi = centre_hi.max(b.centre_hi);
+    }
+
+    /// The extent of the centres along an axis (0 where empty).
+    [[nodiscard]] double centre_extent(std::size_t axis) const
+    {
+        const auto a = static_cast<Eigen::Index>(axis);
+        return std::max(0.0, static_cast<double>(centre_hi[a]) - static_cast<double>(centre_lo[a]));
+    }
+
+    [[nodiscard]] double half_area() const
+    {
+        if (lo[0] > hi[0])
+            return 0.0;
+        const double x = static_cast<double>(hi[0]) - static_cast<double>(lo[0]);
+        const double y = static_cast<double>(hi[1]) - static_cast<double>(lo[1]);
+        const double z = static_cast<double>(hi[2]) - static_cast<double>(lo[2]);
+        return x * y + y * z + z * x;
+    }
+};
+
+BuildBox range_box(const std::vector<BuildRef>& refs, std::size_t begin, std::size_t end)
+{
+    BuildBox box;
+    for (std::size_t i = begin; i < end; ++i)
+        box.add(refs[i]);
+    return box;
+}
+
+/// The cheapest split of a small range (more than one and at most small_split_refs triangles)
+/// by the surface-area heuristic over every position along each axis, applied: the range
+/// reordered along the best axis, the children's boxes written. Ties go to the first axis and
+/// the first position.
+std::size_t split_small(std::vector<BuildRef>& refs, std::size_t begin, std::size_t end,
+                        BuildBox& left, BuildBox& right)
+{
+    const std::size_t n = end - begin;
+    std::array<Lanes, small_split_refs> centre;
+    for (std::size_t i = 0; i < n; ++i)
+        centre[i] = refs[begin + i].centre2();
+    std::array<std::array<std::uint8_t, small_split_refs>, 3> order{};
+    double best_cost = std::numeric_limits<double>::infinity();
+    std::size_t best_axis = 0;
+    std::size_t best_at = n / 2;
+    for (std::size_t ax = 0; ax < 3; ++ax)
+    {
+        auto& o = order[ax];
+        const auto a = static_cast<Eigen::Index>(ax);
+        const auto before = [&](std::uint8_t x, std::uint8_t y) {
+            return centre[x][a] < centre[y][a] ||
+                   (centre[x][a] == centre[y][a] && refs[begin + x].face < refs[begin + y].face);
+        };
+        for (std::size_t i = 0; i < n; ++i)
+        {
+            o[i] = static_cast<std::uint8_t>(i);
+            for (std::size_t j = i; j > 0 && before(o[j], o[j - 1]); --j)
+                std::swap(o[j], o[j - 1]);
+        }
+        std::array<double, small_split_refs> right_cost{};
+        BuildBox acc;
+        for (std::size_t k = n - 1; k > 0; --k)
+        {
+            acc.add(refs[begin + o[k]]);
+            right_cost[k] = static_cast<double>(n - k) * acc.half_area();
+        }
+        acc = BuildBox{};
+        for (std::size_t k = 0; k + 1 < n; ++k)
+        {
+            acc.add(refs[begin + o[k]]);
+            const double cost = static_cast<double>(k + 1) * acc.half_area() + right_cost[k + 1];
+            if (cost < best_cost)
+            {
+                best_cost = cost;
+                best_axis = ax;
+                best_at = k + 1;
+            }
+        }
+    }
+    std::array<BuildRef, small_split_refs> copy;
+    std::copy(refs.begin() + static_cast<std::ptrdiff_t>(begin),
+              refs.begin() + static_cast<std::ptrdiff_t>(end), copy.begin());
+    for (std::size_t k = 0; k < n; ++k)
+        refs[begin + k] = copy[order[best_axis][k]];
+    left = range_box(refs, begin, begin + best_at);
+    right = range_box(refs, begin + best_at, end);
+    return begin + best_at;
+}
+
+/// The surface-area heuristic's bins of a range, along each axis.
+struct Bins
+{
+    std::array<std::array<BuildBox, sah_bins>, 3> box;
+    std::array<std::array<std::uint32_t, sah_bins>, 3> count{};
+
+    void merge(const Bins& b)
+    {
+        for (std::size_t a = 0; a < 3; ++a)
+            for (std::size_t k = 0; k < sah_bins; ++k)
+            {
+                box[a][k].merge(b.box[a][k]);
+                count[a][k] += b.count[a][k];
+            }
+    }
+
+    /// The boxes of bins [from, to) along `axis`, merged.
+    [[nodiscard]] BuildBox side(std::size_t axis, std::size_t from, std::size_t to) const
+    {
+        BuildBox out;
+        for (std::size_t k = from; k < to; ++k)
+            out.merge(box[axis][k]);
+        return out;
+    }
+};
+
+/// A range's bins of a triangle along the three axes (by its box's centre), and the bins.
+class Binner
+{
+public:
+    explicit Binner(const BuildBox& box) : lo_(box.centre_lo), scale_(Lanes::Zero())
+    {
+        for (std::size_t a = 0; a < 3; ++a)
+        {
+            const double extent = box.centre_extent(a);
+            used_[a] = extent > 0.0;
+            if (used_[a])
+                scale_[static_cast<Eigen::Index>(a)] =
+                    static_cast<float>(static_cast<double>(sah_bins) / extent);
+        }
+    }
+
+    [[nodiscard]] bool used(std::size_t axis) const { return used_[axis]; }
+
+    /// The bins of r along the three axes (lane 3 unused).
+    [[nodiscard]] Eigen::Array4i bins(const BuildRef& r) const
+    {
+        const Lanes t = ((r.centre2() - lo_) * scale_).max(0.0F).min(last_bin);
+        return t.cast<int>();
+    }
+
+    void add(const BuildRef& r, Bins& bins) const
+    {
+        const Eigen::Array4i b = this->bins(r);
+        for (std::size_t a = 0; a < 3; ++a)
+        {
+            const auto k = static_cast<std::size_t>(b[static_cast<Eigen::Index>(a)]);
+            ++bins.count[a][k];
+            bins.box[a][k].add(r);
+        }
+    }
+
+private:
+    static constexpr float last_bin = static_cast<float>(sah_bins - 1);
+    Lanes lo_;
+    Lanes scale_;
+    std::array<bool, 3> used_{};
+};
+
+struct BestSplit
+{
+    std::size_t axis;
+    std::size_t bin; ///< the last bin on the left
+};
+
+/// The cheapest split by the surface-area heuristic (bins up to `bin` on the left), or none
+/// where every split leaves a side empty.
+std::optional<BestSplit> best_split(const Bins& bins, std::size_t count, const Binner& binner)
+{
+    double best_cost = std::numeric_limits<double>::infinity();
+    std::optional<BestSplit> best;
+    for (std::size_t ax = 0; ax < 3; ++ax)
+    {
+        if (!binner.used(ax))
+            continue;
+        std::array<double, sah_bins> right_cost{};
+        BuildBox acc;
+        std::size_t acc_count = 0;
+        for (std::size_t b = sah_bins - 1; b > 0; --b)
+        {
+            acc.merge(bins.box[ax][b]);
+            acc_count += bins.count[ax][b];
+            right_cost[b] = static_cast<double>(acc_count) * acc.half_area();
+        }
+        acc = BuildBox{};
+        acc_count = 0;
+        for (std::size_t b = 0; b + 1 < sah_bins; ++b)
+        {
+            acc.merge(bins.box[ax][b]);
+            acc_count += bins.count[ax][b];
+            if (acc_count == 0 || acc_count == count)
+                continue;
+            const double cost =
+                static_cast<double>(acc_count) * acc.half_area() + right_cost[b + 1];
+            if (cost < best_cost)
+            {
+                best_cost = cost;
+                best = BestSplit{ax, b};
+            }
+        }
+    }
+    return best;
 }
 
 /// Closest point on segment [a, b] to p, as the weight t of b (point = a + t (b - a)).
@@ -183,159 +419,155 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
     face_count_ = f_count;
     const std::size_t leaf_size = options.leaf_size == 0 ? 4 : options.leaf_size;
 
-    // Each triangle's box and centroid (the corners are read again, in leaf order, at the end).
-    const auto corners_of = [&mesh](std::size_t f) {
-        const auto& t = mesh.triangles[f];
-        return Corners{mesh.vertices.positions[t[0]].cast<double>(),
-                       mesh.vertices.positions[t[1]].cast<double>(),
-                       mesh.vertices.positions[t[2]].cast<double>()};
-    };
-    std::vector<Aabb> boxes(f_count);
-    std::vector<Vec3d> centroids(f_count);
-    parallel_blocks(f_count, 16384, [&](std::size_t first, std::size_t last) {
+    // Each triangle's box, in one array that the build partitions in place, so that every pass
+    // over a range streams.
+    std::vector<BuildRef> refs(f_count);
+    std::vector<BuildBox> block_box((f_count + ref_block - 1) / ref_block);
+    parallel_blocks(f_count, ref_block, [&](std::size_t first, std::size_t last) {
+        BuildBox& box = block_box[first / ref_block];
         for (std::size_t f = first; f < last; ++f)
         {
-            const Corners k = corners_of(f);
-            boxes[f].extend(k.a);
-            boxes[f].extend(k.b);
-            boxes[f].extend(k.c);
-            centroids[f] = (k.a + k.b + k.c) / 3.0;
+            const auto& t = mesh.triangles[f];
+            const Vec3f& a = mesh.vertices.positions[t[0]];
+            const Vec3f& b = mesh.vertices.positions[t[1]];
+            const Vec3f& c = mesh.vertices.positions[t[2]];
+            BuildRef& r = refs[f];
+            r.lo << a.cwiseMin(b).cwiseMin(c), 0.0F;
+            r.hi << a.cwiseMax(b).cwiseMax(c), 0.0F;
+            r.face = static_cast<std::uint32_t>(f);
+            box.add(r);
         }
     });
+    BuildBox root;
+    for (const BuildBox& box : block_box)
+        root.merge(box);
+    std::vector<BuildRef> scratch; // the parallel partitions' output, then copied back
 
-    std::vector<std::uint32_t> order(f_count);
-    for (std::size_t f = 0; f < f_count; ++f)
-        order[f] = static_cast<std::uint32_t>(f);
-    nodes_.reserve(2 * f_count / leaf_size + 1);
-
-    const auto make_node = [&](std::size_t begin, std::size_t end, std::vector<Node>& out) {
-        Aabb box;
-        for (std::size_t i = begin; i < end; ++i)
-        {
-            box.extend(boxes[order[i]].min);
-            box.extend(boxes[order[i]].max);
-        }
-        Node node{};
-        for (int axis = 0; axis < 3; ++axis)
-        {
-            const auto slot = static_cast<std::size_t>(axis);
-            node.lo[slot] = round_down(box.min[axis]);
-            node.hi[slot] = round_up(box.max[axis]);
-        }
-        out.push_back(node);
-    };
-
-    // Returns the split position in [begin, end), or begin if the range should be a leaf.
-    const auto split = [&](std::size_t begin, std::size_t end, int depth) {
+    // Splits [begin, end) (of node box `box`) into two children, writing their boxes, or
+    // returns begin for a leaf. Large ranges are binned and partitioned in fixed blocks in
+    // parallel (the same tree for any thread count: the bins' boxes and counts merge exactly).
+    const auto split = [&](std::size_t begin, std::size_t end, int depth, const BuildBox& box,
+                           BuildBox& left, BuildBox& right) -> std::size_t {
         const std::size_t count = end - begin;
         if (count <= leaf_size)
             return begin;
-        Aabb centroid_box;
-        for (std::size_t i = begin; i < end; ++i)
-            centroid_box.extend(centroids[order[i]]);
-        const Vec3d extent = centroid_box.size();
-        Eigen::Index axis = 0;
-        extent.maxCoeff(&axis);
-        const auto middle = begin + count / 2;
-        const auto by_axis = [&](Eigen::Index ax) {
-            return [&centroids, ax](std::uint32_t x, std::uint32_t y) {
-                return centroids[x][ax] < centroids[y][ax] ||
-                       (centroids[x][ax] == centroids[y][ax] && x < y);
-            };
+        const auto by_boxes = [&](std::size_t mid) {
+            left = range_box(refs, begin, mid);
+            right = range_box(refs, mid, end);
+            return mid;
         };
-        if (!(extent[axis] > 0.0))
-            return middle; // all centroids coincide: any split is as good
+        std::size_t axis = 0;
+        for (std::size_t a = 1; a < 3; ++a)
+            if (box.centre_extent(a) > box.centre_extent(axis))
+                axis = a;
+        const std::size_t middle = begin + count / 2;
+        if (!(box.centre_extent(axis) > 0.0))
+            return by_boxes(middle); // all centres coincide: any split is as good
+        const auto median = [&]() {
+            std::nth_element(
+                refs.begin() + static_cast<std::ptrdiff_t>(begin),
+                refs.begin() + static_cast<std::ptrdiff_t>(middle),
+                refs.begin() + static_cast<std::ptrdiff_t>(end),
+                [a = static_cast<Eigen::Index>(axis)](const BuildRef& x, const BuildRef& y) {
+                    const float cx = x.lo[a] + x.hi[a];
+                    const float cy = y.lo[a] + y.hi[a];
+                    return cx < cy || (cx == cy && x.face < y.face);
+                });
+            return by_boxes(middle);
+        };
         if (depth >= max_sah_depth)
-        {
-            std::nth_element(order.begin() + static_cast<std::ptrdiff_t>(begin),
-                             order.begin() + static_cast<std::ptrdiff_t>(middle),
-                             order.begin() + static_cast<std::ptrdiff_t>(end), by_axis(axis));
-            return middle;
-        }
+            return median();
+        if (count <= small_split_refs)
+            return split_small(refs, begin, end, left, right);
 
-        // Binned surface-area heuristic over all three axes.
-        double best_cost = std::numeric_limits<double>::infinity();
-        Eigen::Index best_axis = -1;
-        std::size_t best_bin = 0;
-        for (Eigen::Index ax = 0; ax < 3; ++ax)
+        // Binned surface-area heuristic over all three axes, in one pass.
+        const Binner binner(box);
+        Bins bins;
+        const bool in_blocks = count >= parallel_split_refs;
+        if (in_blocks)
         {
-            if (!(extent[ax] > 0.0))
-                continue;
-            std::array<Aabb, sah_bins> bin_box{};
-            std::array<std::size_t, sah_bins> bin_count{};
-            const double scale = static_cast<double>(sah_bins) / extent[ax];
-            for (std::size_t i = begin; i < end; ++i)
-            {
-                const std::uint32_t f = order[i];
-                const auto b = std::min(
-                    sah_bins - 1,
-                    static_cast<std::size_t>((centroids[f][ax] - centroid_box.min[ax]) * scale));
-                bin_count[b]++;
-                bin_box[b].extend(boxes[f].min);
-                bin_box[b].extend(boxes[f].max);
-            }
-            std::array<double, sah_bins> right_cost{};
-            Aabb acc;
-            std::size_t acc_count = 0;
-            for (std::size_t b = sah_bins - 1; b > 0; --b)
-            {
-                acc.extend(bin_box[b].min);
-                acc.extend(bin_box[b].max);
-                acc_count += bin_count[b];
-                right_cost[b] = static_cast<double>(acc_count) * half_area(acc);
-            }
-            acc = Aabb{};
-            acc_count = 0;
-            for (std::size_t b = 0; b + 1 < sah_bins; ++b)
-            {
-                acc.extend(bin_box[b].min);
-                acc.extend(bin_box[b].max);
-                acc_count += bin_count[b];
-                if (acc_count == 0 || acc_count == count)
-                    continue;
-                const double cost =
-                    static_cast<double>(acc_count) * half_area(acc) + right_cost[b + 1];
-                if (cost < best_cost)
-                {
-                    best_cost = cost;
-                    best_axis = ax;
-                    best_bin = b;
-                }
-            }
-        }
-        if (best_axis < 0)
-        {
-            std::nth_element(order.begin() + static_cast<std::ptrdiff_t>(begin),
-                             order.begin() + static_cast<std::ptrdiff_t>(middle),
-                             order.begin() + static_cast<std::ptrdiff_t>(end), by_axis(axis));
-            return middle;
-        }
-        const double scale = static_cast<double>(sah_bins) / extent[best_axis];
-        const double lo = centroid_box.min[best_axis];
-        const auto it = std::partition(
-            order.begin() + static_cast<std::ptrdiff_t>(begin),
-            order.begin() + static_cast<std::ptrdiff_t>(end), [&](std::uint32_t f) {
-                const auto b = std::min(
-                    sah_bins - 1, static_cast<std::size_t>((centroids[f][best_axis] - lo) * scale));
-                return b <= best_bin;
+            std::vector<Bins> partial((count + ref_block - 1) / ref_block);
+            parallel_blocks(count, ref_block, [&](std::size_t first, std::size_t last) {
+                Bins& mine = partial[first / ref_block];
+                for (std::size_t i = begin + first; i < begin + last; ++i)
+                    binner.add(refs[i], mine);
             });
-        return static_cast<std::size_t>(it - order.begin());
+            for (const Bins& p : partial)
+                bins.merge(p);
+        }
+        else
+        {
+            for (std::size_t i = begin; i < end; ++i)
+                binner.add(refs[i], bins);
+        }
+        const std::optional<BestSplit> best = best_split(bins, count, binner);
+        if (!best)
+            return median();
+        left = bins.side(best->axis, 0, best->bin + 1);
+        right = bins.side(best->axis, best->bin + 1, sah_bins);
+        const auto goes_left = [&](const BuildRef& r) {
+            return static_cast<std::size_t>(
+                       binner.bins(r)[static_cast<Eigen::Index>(best->axis)]) <= best->bin;
+        };
+        if (!in_blocks)
+        {
+            const auto it =
+                std::partition(refs.begin() + static_cast<std::ptrdiff_t>(begin),
+                               refs.begin() + static_cast<std::ptrdiff_t>(end), goes_left);
+            return static_cast<std::size_t>(it - refs.begin());
+        }
+        // A stable partition in fixed blocks: each block's left and right refs go to offsets
+        // from the counts of the blocks before it.
+        const std::size_t blocks = (count + ref_block - 1) / ref_block;
+        std::vector<std::size_t> lefts(blocks + 1, 0);
+        parallel_blocks(count, ref_block, [&](std::size_t first, std::size_t last) {
+            std::size_t n = 0;
+            for (std::size_t i = begin + first; i < begin + last; ++i)
+                n += goes_left(refs[i]) ? 1U : 0U;
+            lefts[first / ref_block + 1] = n;
+        });
+        for (std::size_t b = 0; b < blocks; ++b)
+            lefts[b + 1] += lefts[b];
+        const std::size_t left_count = lefts[blocks];
+        scratch.resize(std::max(scratch.size(), count));
+        parallel_blocks(count, ref_block, [&](std::size_t first, std::size_t last) {
+            const std::size_t b = first / ref_block;
+            std::size_t l = lefts[b];
+            std::size_t r = left_count + first - lefts[b];
+            for (std::size_t i = begin + first; i < begin + last; ++i)
+                scratch[goes_left(refs[i]) ? l++ : r++] = refs[i];
+        });
+        parallel_blocks(count, ref_block, [&](std::size_t first, std::size_t last) {
+            std::copy(scratch.begin() + static_cast<std::ptrdiff_t>(first),
+                      scratch.begin() + static_cast<std::ptrdiff_t>(last),
+                      refs.begin() + static_cast<std::ptrdiff_t>(begin + first));
+        });
+        return begin + left_count;
+    };
+    const auto node_of = [](const BuildBox& box) {
+        Node node{};
+        node.lo = {box.lo[0], box.lo[1], box.lo[2]};
+        node.hi = {box.hi[0], box.hi[1], box.hi[2]};
+        return node;
     };
 
     // Depth-first build of the range's subtree into `out` (a right child's index relative to
     // out's start), with an explicit stack of pending right children.
     const auto build_subtree = [&](std::size_t first, std::size_t last, int first_depth,
-                                   std::vector<Node>& out) {
+                                   const BuildBox& first_box, std::vector<Node>& out) {
         struct Pending
         {
             std::size_t begin;
             std::size_t end;
             int depth;
             std::size_t parent; ///< node whose right child this range becomes; npos for the root
+            BuildBox box;
         };
         constexpr std::size_t no_parent = std::numeric_limits<std::size_t>::max();
         std::vector<Pending> pending;
-        pending.push_back({first, last, first_depth, no_parent});
+        pending.push_back({first, last, first_depth, no_parent, first_box});
+        BuildBox left;
+        BuildBox right;
         while (!pending.empty())
         {
             Pending range = pending.back();
@@ -349,8 +581,9 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
                     out[range.parent].index = static_cast<std::uint32_t>(node_index);
                     range.parent = no_parent;
                 }
-                make_node(range.begin, range.end, out);
-                const std::size_t mid = split(range.begin, range.end, range.depth);
+                out.push_back(node_of(range.box));
+                const std::size_t mid =
+                    split(range.begin, range.end, range.depth, range.box, left, right);
                 if (mid == range.begin || mid == range.end)
                 {
                     out[node_index].index = static_cast<std::uint32_t>(range.begin);
@@ -358,20 +591,22 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
                     break;
                 }
                 out[node_index].count = 0;
-                pending.push_back({mid, range.end, range.depth + 1, node_index});
-                range = {range.begin, mid, range.depth + 1, no_parent};
+                pending.push_back({mid, range.end, range.depth + 1, node_index, right});
+                range = {range.begin, mid, range.depth + 1, no_parent, left};
             }
         }
     };
 
-    // The top levels are split first, one range after another; the subtrees below them are
-    // built in parallel and laid out after their parents in depth-first order. Each range is
-    // split as the sequential build splits it, so the tree is the same whatever the thread count.
+    // The top levels are split first, one range after another (each large one in parallel
+    // blocks); the subtrees below them are built in parallel and laid out after their parents
+    // in depth-first order. Each range is split as the sequential build splits it, so the tree
+    // is the same whatever the thread count.
     struct Top
     {
         std::size_t begin;
         std::size_t end;
         int depth;
+        BuildBox box;
         std::size_t left = 0;    ///< index in `tops`, for an inner node
         std::size_t right = 0;   ///< index in `tops`, for an inner node
         std::size_t subtree = 0; ///< index in `subtrees` + 1, or 0 for an inner node or a leaf
@@ -382,37 +617,41 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
     // Subtrees of at most this many triangles, or below this depth, are built in parallel.
     constexpr std::size_t subtree_triangles = 16384;
     constexpr int top_depth = 6;
-    const auto split_top = [&](const auto& self, std::size_t begin, std::size_t end,
-                               int depth) -> std::size_t {
+    const auto split_top = [&](const auto& self, std::size_t begin, std::size_t end, int depth,
+                               const BuildBox& box) -> std::size_t {
         const std::size_t at = tops.size();
-        tops.push_back({begin, end, depth});
+        tops.push_back({begin, end, depth, box});
         if (end - begin <= subtree_triangles || depth >= top_depth)
         {
             roots.push_back(at);
             tops[at].subtree = roots.size();
             return at;
         }
-        const std::size_t mid = split(begin, end, depth);
+        BuildBox left_box;
+        BuildBox right_box;
+        const std::size_t mid = split(begin, end, depth, box, left_box, right_box);
         if (mid == begin || mid == end)
         {
             tops[at].leaf = true;
             return at;
         }
-        const std::size_t left = self(self, begin, mid, depth + 1);
-        const std::size_t right = self(self, mid, end, depth + 1);
+        const std::size_t left = self(self, begin, mid, depth + 1, left_box);
+        const std::size_t right = self(self, mid, end, depth + 1, right_box);
         tops[at].left = left;
         tops[at].right = right;
         return at;
     };
-    split_top(split_top, 0, f_count, 0);
+    split_top(split_top, 0, f_count, 0, root);
+    std::vector<BuildRef>().swap(scratch);
     std::vector<std::vector<Node>> subtrees(roots.size());
     parallel_blocks(roots.size(), 1, [&](std::size_t first, std::size_t last) {
         for (std::size_t r = first; r < last; ++r)
         {
             const Top& top = tops[roots[r]];
-            build_subtree(top.begin, top.end, top.depth, subtrees[r]);
+            build_subtree(top.begin, top.end, top.depth, top.box, subtrees[r]);
         }
     });
+    nodes_.reserve(2 * f_count / leaf_size + 1);
     const auto emit = [&](const auto& self, std::size_t t) -> void {
         const Top& top = tops[t];
         if (top.subtree != 0)
@@ -429,7 +668,7 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
             return;
         }
         const std::size_t node_index = nodes_.size();
-        make_node(top.begin, top.end, nodes_);
+        nodes_.push_back(node_of(top.box));
         if (top.leaf)
         {
             nodes_[node_index].index = static_cast<std::uint32_t>(top.begin);
@@ -444,10 +683,17 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
     emit(emit, 0);
 
     corners_.resize(f_count);
-    face_ids_ = std::move(order);
-    parallel_blocks(f_count, 16384, [&](std::size_t first, std::size_t last) {
+    face_ids_.resize(f_count);
+    parallel_blocks(f_count, ref_block, [&](std::size_t first, std::size_t last) {
         for (std::size_t i = first; i < last; ++i)
-            corners_[i] = corners_of(face_ids_[i]);
+        {
+            const std::uint32_t f = refs[i].face;
+            face_ids_[i] = f;
+            const auto& t = mesh.triangles[f];
+            corners_[i] = Corners{mesh.vertices.positions[t[0]].cast<double>(),
+                                  mesh.vertices.positions[t[1]].cast<double>(),
+                                  mesh.vertices.positions[t[2]].cast<double>()};
+        }
     });
 }
 

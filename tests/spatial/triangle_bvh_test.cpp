@@ -313,6 +313,51 @@ TEST(TriangleBvh, BatchMatchesSingleWhateverTheThreadCount)
         EXPECT_EQ(distances[i], bvh.distance(cloud.world(i)));
 }
 
+TEST(TriangleBvh, LargeMeshExactAndTheSameTreeForAnyThreadCount)
+{
+    // A wavy 300 x 300 grid (180,000 triangles, in shuffled order): large enough that the top
+    // splits bin and partition in parallel blocks and the subtrees are built in parallel.
+    TriMesh mesh = grid_plane(300);
+    for (Vec3f& p : mesh.vertices.positions)
+        p.z() = 0.1F * std::sin(7.0F * p.x()) * std::cos(5.0F * p.y());
+    std::shuffle(mesh.triangles.begin(), mesh.triangles.end(), std::mt19937_64(41));
+    const auto queries = random_queries(5000, 1.2, 42);
+    struct Built
+    {
+        std::size_t nodes;
+        std::vector<TriangleBvh::Hit> hits;
+    };
+    const auto runs = test::at_thread_counts(
+        [&] {
+            const TriangleBvh bvh(mesh);
+            return Built{bvh.node_count(), closest_points(bvh, queries)};
+        },
+        {.min_multi_block_loops = 4}, {1, 2, 3});
+    for (std::size_t r = 1; r < runs.size(); ++r)
+    {
+        ASSERT_EQ(runs[r].nodes, runs[0].nodes) << r + 1 << " threads";
+        for (std::size_t i = 0; i < queries.size(); ++i)
+        {
+            ASSERT_EQ(runs[r].hits[i].distance, runs[0].hits[i].distance) << r + 1 << " threads";
+            ASSERT_EQ(runs[r].hits[i].face, runs[0].hits[i].face) << r + 1 << " threads";
+        }
+    }
+    // Every 50th query against every triangle, by the same closest-point routine.
+    for (std::size_t i = 0; i < queries.size(); i += 50)
+    {
+        double truth = std::numeric_limits<double>::infinity();
+        for (const Triangle& t : mesh.triangles)
+        {
+            const Vec3d a = mesh.vertices.world(t[0]);
+            const Vec3d b = mesh.vertices.world(t[1]);
+            const Vec3d c = mesh.vertices.world(t[2]);
+            const Vec3d w = closest_point_barycentric(queries[i], a, b, c);
+            truth = std::min(truth, (queries[i] - (w[0] * a + w[1] * b + w[2] * c)).norm());
+        }
+        EXPECT_EQ(runs[0].hits[i].distance, truth) << "query " << i;
+    }
+}
+
 TEST(TriangleBvh, BoundsOnlyPruneTheNearestTriangles)
 {
     const TriMesh mesh = random_mesh(300, 600, 41);
