@@ -1740,6 +1740,11 @@ const PointCloud& PointField::surfels() const
     return impl_->surfels;
 }
 
+const KdTree& PointField::tree() const
+{
+    return impl_->tree;
+}
+
 const PointFieldOptions& PointField::options() const
 {
     return impl_->options;

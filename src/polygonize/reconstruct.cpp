@@ -68,6 +68,7 @@ RefineOptions refine_options_of(const SemiRegularOptions& options, const Progres
     refine_options.denoise_rounds = options.denoise_rounds;
     refine_options.fair_unsupported = options.fair_unsupported;
     refine_options.stop_rule = options.stop_rule;
+    refine_options.sample_tree = options.sample_tree;
     refine_options.progress = progress;
     return refine_options;
 }
@@ -283,8 +284,10 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
                             : read_picked_base_mesh(options.base_mesh, samples, field);
         report.picked_angles = angle_quality(report.picked->mesh);
         const double base_seconds = clock.lap("base mesh (picked)");
+        SemiRegularOptions semi_regular = options.semi_regular;
+        semi_regular.sample_tree = &field.tree();
         report.semi_regular = refine_semi_regular(report.picked->mesh, field, &samples,
-                                                  options.semi_regular, options.progress);
+                                                  semi_regular, options.progress);
         report.semi_regular.base_seconds = base_seconds;
     }
     else
@@ -324,6 +327,7 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
         clock.lap("debris");
         SemiRegularOptions semi_regular = options.semi_regular;
         semi_regular.fill_holes = options.fill_holes;
+        semi_regular.sample_tree = &field.tree();
         report.semi_regular =
             semi_regular_mesh(mc.mesh, field, &samples, semi_regular, default_base_share,
                               options.progress, intermediate.coarsening);

@@ -856,18 +856,30 @@ namespace {
 /// this many (RefineReport::field_residual).
 constexpr std::size_t residual_samples = std::size_t{1} << 18U;
 
-/// The field's own robust distance from the samples: the robust statistic of |f(s)|.
-double field_residual(const Field& field, const PointCloud& samples)
+/// The field's own robust distance from the samples: the robust statistic of |f(s)|. The
+/// samples measured (every stride-th) are evaluated in their spatial `order` (a permutation of
+/// the samples), which the field's batch answers fastest, and their values taken in sample order.
+double field_residual(const Field& field, const PointCloud& samples,
+                      std::span<const std::uint32_t> order)
 {
+    PF_ASSERT(order.size() == samples.size());
     const std::size_t stride = std::max<std::size_t>(1, samples.size() / residual_samples);
-    std::vector<Vec3d> points((samples.size() + stride - 1) / stride);
-    for (std::size_t i = 0; i < points.size(); ++i)
-        points[i] = samples.world(i * stride);
+    std::vector<std::uint32_t> measured; // the samples measured, in spatial order
+    measured.reserve((samples.size() + stride - 1) / stride);
+    for (const std::uint32_t i : order)
+        if (i % stride == 0)
+            measured.push_back(i);
+    std::vector<Vec3d> points(measured.size());
+    for (std::size_t k = 0; k < measured.size(); ++k)
+        points[k] = samples.world(measured[k]);
     std::vector<FieldSample> values(points.size());
     field.evaluate(points, values);
+    std::vector<FieldSample> in_sample_order(values.size());
+    for (std::size_t k = 0; k < measured.size(); ++k)
+        in_sample_order[measured[k] / stride] = values[k];
     std::vector<double> residual;
     residual.reserve(values.size());
-    for (const FieldSample& v : values)
+    for (const FieldSample& v : in_sample_order)
         if (v.defined)
             residual.push_back(std::abs(v.value));
     return robust_stats(residual).robust;
@@ -1351,16 +1363,26 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
         return report;
     }
     // One k-d tree of the samples, for their sampling density and for the fairing's distances
-    // from the vertices to them.
+    // from the vertices to them: the caller's, or one built here.
     const bool fair = options.stop_rule == StopRule::Automatic && options.fair_unsupported;
-    std::optional<KdTree> sample_tree;
-    if (!(options.sampling_density > 0.0) || fair)
-        sample_tree.emplace(samples.positions);
+    if (options.sample_tree != nullptr &&
+        (options.sample_tree->positions().data() != samples.positions.data() ||
+         options.sample_tree->size() != samples.size()))
+        throw InvalidInput("refine: the k-d tree given is not over the samples' positions");
+    std::optional<KdTree> own_tree;
+    if (options.sample_tree == nullptr && (!(options.sampling_density > 0.0) || fair))
+        own_tree.emplace(samples.positions);
+    const KdTree* sample_tree = options.sample_tree != nullptr ? options.sample_tree
+                                : own_tree                     ? &*own_tree
+                                                               : nullptr;
     report.sampling_density = options.sampling_density > 0.0
                                   ? options.sampling_density
                                   : measure_sampling_density(*sample_tree, samples).median;
     if (!fair)
-        sample_tree.reset();
+    {
+        own_tree.reset();
+        sample_tree = nullptr;
+    }
     // Every level is measured from the same samples: sorted along the Morton curve once.
     const std::vector<std::uint32_t> order = spatial_order(samples.positions);
     const ProgressCallback distance_progress = [&](std::string_view, double fraction) {
@@ -1379,7 +1401,7 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
     if (automatic)
     {
         report.vertex_budget = options.vertex_budget > 0 ? options.vertex_budget : samples.size();
-        report.field_residual = field_residual(field, samples);
+        report.field_residual = field_residual(field, samples, order);
         report.detail_threshold =
             std::max(options.detail_factor * report.field_residual, 1e-3 * report.sampling_density);
     }

@@ -695,6 +695,28 @@ TEST(RefineAutomaticStop, VertexBudgetOptionAndChecks)
     EXPECT_EQ(r.stop, RefineStop::LevelCap);
 }
 
+TEST(RefineAutomaticStop, TheCallersSampleTreeGivesTheSameMesh)
+{
+    // The field's own k-d tree of its surfels serves the refinement as one built for it would;
+    // a tree over other storage, even of the same points, is refused.
+    const PointField field(sampled_sphere(20000));
+    const PointCloud& samples = field.surfels();
+    MultiresMesh own(test::icosphere(0));
+    const RefineReport a = refine(own, field, samples, {.vertex_budget = 3000});
+    MultiresMesh given(test::icosphere(0));
+    const RefineReport b =
+        refine(given, field, samples, {.vertex_budget = 3000, .sample_tree = &field.tree()});
+    EXPECT_EQ(a.sampling_density, b.sampling_density);
+    ASSERT_EQ(own.vertex_count(), given.vertex_count());
+    EXPECT_EQ(own.finest_level(), 4U);
+    for (std::size_t v = 0; v < own.vertex_count(); ++v)
+        ASSERT_EQ(own.positions()[v], given.positions()[v]) << "vertex " << v;
+    const std::vector<Vec3f> copy = samples.positions;
+    const KdTree other(copy);
+    MultiresMesh refused(test::icosphere(0));
+    EXPECT_THROW((void)refine(refused, field, samples, {.sample_tree = &other}), InvalidInput);
+}
+
 TEST(Refine, ButterflyOnSampledSphere)
 {
     const PointCloud samples = sampled_sphere(6000);

@@ -5,6 +5,7 @@
 
 #include "pointform/geometry/point_cloud.h"
 #include "pointform/implicit/field.h"
+#include "pointform/spatial/kd_tree.h"
 
 #include <cstddef>
 #include <memory>
@@ -151,6 +152,8 @@ public:
     void append_seeds(std::vector<Vec3d>& seeds) const override;
 
     [[nodiscard]] const PointCloud& surfels() const;
+    /// \brief The k-d tree over surfels()' positions (RefineOptions::sample_tree takes it).
+    [[nodiscard]] const KdTree& tree() const;
     [[nodiscard]] const PointFieldOptions& options() const;
     /// \brief Median influence radius over the samples.
     [[nodiscard]] double median_radius() const;

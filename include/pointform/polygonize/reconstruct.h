@@ -59,6 +59,9 @@ struct SemiRegularOptions
     double fill_holes = 0.0;
     /// Long chords of the automatic base mesh split (BaseMeshOptions::chord_split_share).
     double chord_split_share = BaseMeshOptions{}.chord_split_share;
+    /// A k-d tree over the samples' own positions for the refinement
+    /// (RefineOptions::sample_tree); null = it builds one.
+    const KdTree* sample_tree = nullptr;
 };
 
 /// \brief A semi-regular mesh and how it was made.

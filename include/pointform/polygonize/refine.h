@@ -8,6 +8,7 @@
 #include "pointform/geometry/point_cloud.h"
 #include "pointform/implicit/field.h"
 #include "pointform/metrics/sampling_density.h"
+#include "pointform/spatial/kd_tree.h"
 
 #include <cstddef>
 #include <optional>
@@ -173,6 +174,11 @@ struct RefineOptions
     /// this, in world units (§5.2.4). 0 = estimate_sampling_density(samples)
     /// (pointform/metrics/sampling_density.h).
     double sampling_density = 0.0;
+    /// refine(): a k-d tree over the samples' own positions (built on `samples.positions`, as
+    /// PointField::tree() is on its surfels), which the sampling density and the fairing then
+    /// use instead of building one; null = build one. A tree over other storage is refused
+    /// (InvalidInput).
+    const KdTree* sample_tree = nullptr;
     /// refine(), StopRule::Paper: also stop when a level lowers the Hausdorff distance by less than
     /// this fraction of the previous level's: the samples that stay far are where no refinement
     /// reaches (outliers, noise, samples beyond a hole's rim), and each further level would
