@@ -1190,25 +1190,41 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
     }
     const Vec3d shift = mesh.origin() - samples.origin;
     const std::span<Vec3d> x = mesh.mutable_positions();
-    // Distance to the nearest sample in local spacings.
+    // Distance to the nearest sample in local spacings. Level by level: a base vertex searches
+    // the whole tree, and a later one starts from the nearest sample of its parent edge's first
+    // end (an edge of the level below away), whose distance bounds its search.
     std::vector<float> excess(n, 0.0F);
-    parallel_blocks(n, vertex_block, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t v = begin; v < end; ++v)
-        {
-            float squared = 0.0F;
-            const PointId nearest = tree.nearest((x[v] + shift).cast<float>(), &squared);
-            if (!nearest.is_valid())
-                continue;
-            double local = spacing;
-            if (radius_scale > 0.0)
+    std::vector<std::uint32_t> nearest_sample(n, none);
+    const std::size_t base = mesh.vertex_count(0);
+    const std::span<const ParentEdge> parents = mesh.parent_edges();
+    for (std::size_t level = 0; level <= mesh.finest_level(); ++level)
+    {
+        const std::size_t first = level == 0 ? 0 : mesh.vertex_count(level - 1);
+        const std::size_t last = mesh.vertex_count(level);
+        parallel_blocks(last - first, vertex_block, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t v = first + begin; v < first + end; ++v)
             {
-                const double r = radius_scale * static_cast<double>(samples.radii[nearest.value]);
-                if (r > 0.0 && std::isfinite(r))
-                    local = r;
+                float squared = 0.0F;
+                const Vec3f query = (x[v] + shift).cast<float>();
+                const std::uint32_t start = v < base ? none : nearest_sample[parents[v - base].a];
+                const PointId nearest = start == none ? tree.nearest(query, &squared)
+                                                      : tree.nearest_within_factor(
+                                                            query, 1.0F, PointId{start}, &squared);
+                if (!nearest.is_valid())
+                    continue;
+                nearest_sample[v] = nearest.value;
+                double local = spacing;
+                if (radius_scale > 0.0)
+                {
+                    const double r =
+                        radius_scale * static_cast<double>(samples.radii[nearest.value]);
+                    if (r > 0.0 && std::isfinite(r))
+                        local = r;
+                }
+                excess[v] = static_cast<float>(std::sqrt(static_cast<double>(squared)) / local);
             }
-            excess[v] = static_cast<float>(std::sqrt(static_cast<double>(squared)) / local);
-        }
-    });
+        });
+    }
     const auto ring = [&](std::size_t v) {
         return std::span<const std::uint32_t>(rings.adjacent)
             .subspan(rings.offsets[v], rings.offsets[v + 1] - rings.offsets[v]);
