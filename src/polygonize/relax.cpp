@@ -155,7 +155,8 @@ std::size_t despike(std::span<Vec3d> x, const Vec3d& origin, const Field& field,
             Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
             for (const std::uint32_t w : r)
                 scatter += (x[w] - c) * (x[w] - c).transpose();
-            const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+            Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+            eigen.computeDirect(scatter); // closed form: one per vertex of the finest level
             centre[v] = c;
             offset[v] = std::abs((x[v] - c).dot(eigen.eigenvectors().col(0)));
             edge[v] = length / static_cast<double>(r.size());
