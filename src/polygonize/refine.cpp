@@ -282,7 +282,9 @@ Distances distances_from(const PointCloud& samples, const MultiresMesh& mesh,
     for (std::size_t v = 0; v < n; ++v)
         surface.vertices.positions[v] = mesh.positions()[v].cast<float>();
     surface.triangles.assign(faces.begin(), faces.end());
-    const TriangleBvh bvh(surface);
+    // Above the base mesh the faces are the level below's children in order (child_faces()):
+    // the BVH keeps each face's four children together and sorts a quarter as many boxes.
+    const TriangleBvh bvh(surface, {.group_size = level > 0 && faces.size() % 4 == 0 ? 4U : 1U});
     std::vector<double> bounds;
     if (hint.faces.size() == samples.size())
     {

@@ -415,26 +415,37 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
                                    " refers to vertex " + std::to_string(v) + " but the mesh has " +
                                    std::to_string(v_count) + " vertices");
 
+    const std::size_t group = options.group_size == 0 ? 1 : options.group_size;
+    if (f_count % group != 0)
+        throw InvalidInput("triangle BVH: " + std::to_string(f_count) +
+                           " triangles are not groups of " + std::to_string(group));
     origin_ = mesh.vertices.origin;
     face_count_ = f_count;
-    const std::size_t leaf_size = options.leaf_size == 0 ? 4 : options.leaf_size;
+    // The build sorts the groups (items) and puts leaf_size triangles, at least one group, in
+    // a leaf.
+    const std::size_t items = f_count / group;
+    const std::size_t leaf_size =
+        std::max<std::size_t>(1, (options.leaf_size == 0 ? 4 : options.leaf_size) / group);
 
-    // Each triangle's box, in one array that the build partitions in place, so that every pass
+    // Each group's box, in one array that the build partitions in place, so that every pass
     // over a range streams.
-    std::vector<BuildRef> refs(f_count);
-    std::vector<BuildBox> block_box((f_count + ref_block - 1) / ref_block);
-    parallel_blocks(f_count, ref_block, [&](std::size_t first, std::size_t last) {
+    std::vector<BuildRef> refs(items);
+    std::vector<BuildBox> block_box((items + ref_block - 1) / ref_block);
+    parallel_blocks(items, ref_block, [&](std::size_t first, std::size_t last) {
         BuildBox& box = block_box[first / ref_block];
-        for (std::size_t f = first; f < last; ++f)
+        for (std::size_t g = first; g < last; ++g)
         {
-            const auto& t = mesh.triangles[f];
-            const Vec3f& a = mesh.vertices.positions[t[0]];
-            const Vec3f& b = mesh.vertices.positions[t[1]];
-            const Vec3f& c = mesh.vertices.positions[t[2]];
-            BuildRef& r = refs[f];
-            r.lo << a.cwiseMin(b).cwiseMin(c), 0.0F;
-            r.hi << a.cwiseMax(b).cwiseMax(c), 0.0F;
-            r.face = static_cast<std::uint32_t>(f);
+            BuildRef& r = refs[g];
+            r.lo = Lanes::Constant(float_max);
+            r.hi = Lanes::Constant(-float_max);
+            for (std::size_t f = g * group; f < (g + 1) * group; ++f)
+                for (const std::uint32_t v : mesh.triangles[f])
+                {
+                    const Vec3f& p = mesh.vertices.positions[v];
+                    r.lo = r.lo.min(Lanes(p.x(), p.y(), p.z(), 0.0F));
+                    r.hi = r.hi.max(Lanes(p.x(), p.y(), p.z(), 0.0F));
+                }
+            r.face = static_cast<std::uint32_t>(g);
             box.add(r);
         }
     });
@@ -641,7 +652,7 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
         tops[at].right = right;
         return at;
     };
-    split_top(split_top, 0, f_count, 0, root);
+    split_top(split_top, 0, items, 0, root);
     std::vector<BuildRef>().swap(scratch);
     std::vector<std::vector<Node>> subtrees(roots.size());
     parallel_blocks(roots.size(), 1, [&](std::size_t first, std::size_t last) {
@@ -651,7 +662,7 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
             build_subtree(top.begin, top.end, top.depth, top.box, subtrees[r]);
         }
     });
-    nodes_.reserve(2 * f_count / leaf_size + 1);
+    nodes_.reserve(2 * items / leaf_size + 1);
     const auto emit = [&](const auto& self, std::size_t t) -> void {
         const Top& top = tops[t];
         if (top.subtree != 0)
@@ -681,13 +692,20 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
         self(self, top.right);
     };
     emit(emit, 0);
+    if (group > 1)
+        for (Node& node : nodes_)
+            if (node.count > 0)
+            {
+                node.index *= static_cast<std::uint32_t>(group);
+                node.count *= static_cast<std::uint32_t>(group);
+            }
 
     corners_.resize(f_count);
     face_ids_.resize(f_count);
     parallel_blocks(f_count, ref_block, [&](std::size_t first, std::size_t last) {
         for (std::size_t i = first; i < last; ++i)
         {
-            const std::uint32_t f = refs[i].face;
+            const auto f = static_cast<std::uint32_t>(refs[i / group].face * group + i % group);
             face_ids_[i] = f;
             const auto& t = mesh.triangles[f];
             corners_[i] = Corners{mesh.vertices.positions[t[0]].cast<double>(),

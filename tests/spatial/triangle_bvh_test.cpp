@@ -358,6 +358,35 @@ TEST(TriangleBvh, LargeMeshExactAndTheSameTreeForAnyThreadCount)
     }
 }
 
+TEST(TriangleBvh, GroupsOfFacesGiveTheSameDistances)
+{
+    // The children of a 1-to-4 split kept together: the same distances as one face at a time,
+    // and each hit's face among those at that distance.
+    TriMesh mesh = grid_plane(60); // 7,200 triangles
+    for (Vec3f& p : mesh.vertices.positions)
+        p.z() = 0.2F * std::sin(3.0F * p.x() + 2.0F * p.y());
+    const TriangleBvh single(mesh);
+    const TriangleBvh grouped(mesh, {.group_size = 4});
+    EXPECT_EQ(grouped.face_count(), mesh.face_count());
+    EXPECT_LT(grouped.node_count(), single.node_count());
+    for (const Vec3d& q : random_queries(3000, 1.5, 51))
+    {
+        const TriangleBvh::Hit a = single.closest(q);
+        const TriangleBvh::Hit b = grouped.closest(q);
+        ASSERT_TRUE(b.found());
+        EXPECT_EQ(a.distance, b.distance);
+        const auto& t = mesh.triangles[b.face.value];
+        const Vec3d w = closest_point_barycentric(
+            q, mesh.vertices.world(t[0]), mesh.vertices.world(t[1]), mesh.vertices.world(t[2]));
+        EXPECT_EQ((q - (w[0] * mesh.vertices.world(t[0]) + w[1] * mesh.vertices.world(t[1]) +
+                        w[2] * mesh.vertices.world(t[2])))
+                      .norm(),
+                  b.distance);
+    }
+    mesh.triangles.pop_back();
+    EXPECT_THROW(TriangleBvh(mesh, {.group_size = 4}), InvalidInput);
+}
+
 TEST(TriangleBvh, BoundsOnlyPruneTheNearestTriangles)
 {
     const TriMesh mesh = random_mesh(300, 600, 41);
