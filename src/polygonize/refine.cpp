@@ -1388,11 +1388,9 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
          options.sample_tree->size() != samples.size()))
         throw InvalidInput("refine: the k-d tree given is not over the samples' positions");
     std::optional<KdTree> own_tree;
-    if (options.sample_tree == nullptr && (!(options.sampling_density > 0.0) || fair))
-        own_tree.emplace(samples.positions);
-    const KdTree* sample_tree = options.sample_tree != nullptr ? options.sample_tree
-                                : own_tree                     ? &*own_tree
-                                                               : nullptr;
+    const KdTree* sample_tree = options.sample_tree;
+    if (sample_tree == nullptr && (!(options.sampling_density > 0.0) || fair))
+        sample_tree = &own_tree.emplace(samples.positions);
     report.sampling_density = options.sampling_density > 0.0
                                   ? options.sampling_density
                                   : measure_sampling_density(*sample_tree, samples).median;

@@ -64,6 +64,14 @@ struct BuildRef
     [[nodiscard]] Lanes centre2() const { return lo + hi; }
 };
 
+/// Whether x comes before y along `axis`: by their boxes' centres, ties by face index.
+bool centre_before(const BuildRef& x, const BuildRef& y, Eigen::Index axis)
+{
+    const float cx = x.lo[axis] + x.hi[axis];
+    const float cy = y.lo[axis] + y.hi[axis];
+    return cx < cy || (cx == cy && x.face < y.face);
+}
+
 /// The box of some triangles and the box of their centres (at twice the scale); empty: lo
 /// above hi.
 struct BuildBox
@@ -124,9 +132,6 @@ std::size_t split_small(std::vector<BuildRef>& refs, std::size_t begin, std::siz
                         BuildBox& left, BuildBox& right)
 {
     const std::size_t n = end - begin;
-    std::array<Lanes, small_split_refs> centre;
-    for (std::size_t i = 0; i < n; ++i)
-        centre[i] = refs[begin + i].centre2();
     std::array<std::array<std::uint8_t, small_split_refs>, 3> order{};
     double best_cost = std::numeric_limits<double>::infinity();
     std::size_t best_axis = 0;
@@ -136,8 +141,7 @@ std::size_t split_small(std::vector<BuildRef>& refs, std::size_t begin, std::siz
         auto& o = order[ax];
         const auto a = static_cast<Eigen::Index>(ax);
         const auto before = [&](std::uint8_t x, std::uint8_t y) {
-            return centre[x][a] < centre[y][a] ||
-                   (centre[x][a] == centre[y][a] && refs[begin + x].face < refs[begin + y].face);
+            return centre_before(refs[begin + x], refs[begin + y], a);
         };
         for (std::size_t i = 0; i < n; ++i)
         {
@@ -480,9 +484,7 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
                 refs.begin() + static_cast<std::ptrdiff_t>(middle),
                 refs.begin() + static_cast<std::ptrdiff_t>(end),
                 [a = static_cast<Eigen::Index>(axis)](const BuildRef& x, const BuildRef& y) {
-                    const float cx = x.lo[a] + x.hi[a];
-                    const float cy = y.lo[a] + y.hi[a];
-                    return cx < cy || (cx == cy && x.face < y.face);
+                    return centre_before(x, y, a);
                 });
             return by_boxes(middle);
         };
