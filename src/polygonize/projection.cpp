@@ -19,6 +19,7 @@ struct LineSample
     double t = 0.0;
     double value = 0.0;
     bool defined = false;
+    double slope = 0.0; ///< the gradient along the line, d·∇f (0 where not finite)
 };
 
 class Line
@@ -27,11 +28,12 @@ public:
     Line(const Field& field, const Vec3d& p, const Vec3d& d) : field_(field), p_(p), d_(d) {}
 
     [[nodiscard]] LineSample at(double t) const { return of(t, field_.evaluate(point(t))); }
-    [[nodiscard]] static LineSample of(double t, const FieldSample& s)
+    [[nodiscard]] LineSample of(double t, const FieldSample& s) const
     {
         if (!std::isfinite(s.value))
-            return {t, std::numeric_limits<double>::quiet_NaN(), false};
-        return {t, s.value, s.defined};
+            return {t, std::numeric_limits<double>::quiet_NaN(), false, 0.0};
+        const double slope = s.gradient.dot(d_);
+        return {t, s.value, s.defined, std::isfinite(slope) ? slope : 0.0};
     }
     [[nodiscard]] Vec3d point(double t) const { return p_ + t * d_; }
 
@@ -121,17 +123,41 @@ std::optional<Vec3d> project_from(const Field& field, const FieldSample* at_p, c
     const double tolerance = options.relative_tolerance * max_distance;
 
     // p + 0·d is p, bit for bit: the caller's sample is the line's at 0.
-    const LineSample centre = at_p != nullptr ? Line::of(0.0, *at_p) : line.at(0.0);
-    if (centre.defined && centre.value == 0.0)
+    const LineSample centre = at_p != nullptr ? line.of(0.0, *at_p) : line.at(0.0);
+    if (centre.defined && std::abs(centre.value) <= tolerance)
     {
-        // Exactly on the surface: accept if the field grows along the direction.
-        const FieldSample s = at_p != nullptr ? *at_p : field.evaluate(p);
-        if (s.gradient.dot(direction) > 0.0)
+        // On the surface (as near as a located crossing is): accept if the field grows along
+        // the direction.
+        if (centre.slope > 0.0)
             return p;
     }
 
     LineSample pos_prev = centre; // innermost sample of the positive side
     LineSample neg_prev = centre; // innermost sample of the negative side
+
+    // The first sample on the side the sign at p points to, at twice the distance where the
+    // field's slope at p puts the surface (a Newton step), where that lies within the first step:
+    // a point near the surface (a relaxed or predicted vertex, most of them) then brackets its
+    // crossing tightly, which regula falsi closes in an evaluation or two instead of the three
+    // to five that a bracket of a whole step takes. Any sign change it finds lies within the
+    // first step on that side, as the march's would (the other side cannot close a bracket
+    // there). Otherwise, or if the sign does not change, the march goes on as it would.
+    if (centre.defined && centre.slope > 0.0)
+    {
+        const double guess = -2.0 * centre.value / centre.slope;
+        if (std::abs(guess) < h && guess != 0.0)
+        {
+            const LineSample probe = line.at(guess);
+            std::optional<double> found;
+            if (guess > 0.0 && probe.value >= 0.0)
+                found = refine_bracket(line, centre, probe, tolerance, options.max_iterations);
+            else if (guess < 0.0 && probe.value < 0.0)
+                found = refine_bracket(line, probe, centre, tolerance, options.max_iterations);
+            if (found)
+                return line.point(*found);
+            (guess > 0.0 ? pos_prev : neg_prev) = probe;
+        }
+    }
     for (int k = 1; k <= options.steps; ++k)
     {
         const double r = k == options.steps ? max_distance : k * h;
