@@ -175,22 +175,24 @@ TEST(Projection, FindsTheNearestOutwardCrossing)
                  InvalidInput);
 }
 
+/// The unit sphere's distance field, counting its evaluations.
+struct CountingSphere : Field
+{
+    std::shared_ptr<const Field> inner = make_sphere(Vec3d::Zero(), 1.0);
+    mutable int evaluations = 0;
+    using Field::evaluate;
+    [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override
+    {
+        ++evaluations;
+        return inner->evaluate(p);
+    }
+    [[nodiscard]] Aabb bounds() const override { return inner->bounds(); }
+};
+
 TEST(Projection, TheCallersSampleAtTheStartGivesTheSamePoint)
 {
-    // A counting field: the caller's sample at p saves the evaluations at p, nothing else.
-    struct Counting : Field
-    {
-        std::shared_ptr<const Field> inner = make_sphere(Vec3d::Zero(), 1.0);
-        mutable int evaluations = 0;
-        using Field::evaluate;
-        [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override
-        {
-            ++evaluations;
-            return inner->evaluate(p);
-        }
-        [[nodiscard]] Aabb bounds() const override { return inner->bounds(); }
-    };
-    const Counting field;
+    // The caller's sample at p saves the evaluation at p, nothing else.
+    const CountingSphere field;
     for (const Vec3d& p : {Vec3d(0.5, 0.2, 0.1), Vec3d(0.0, 1.3, 0.0), Vec3d(1.0, 0.0, 0.0)})
     {
         for (const Vec3d& direction : {Vec3d(p.normalized()), Vec3d(-p.normalized())})
@@ -206,26 +208,14 @@ TEST(Projection, TheCallersSampleAtTheStartGivesTheSamePoint)
             {
                 EXPECT_EQ(*plain, *given);
             }
-            EXPECT_LE(field.evaluations, plain_evaluations - 1); // 2 fewer on the surface
+            EXPECT_LE(field.evaluations, plain_evaluations - 1);
         }
     }
 }
 
 TEST(Projection, APointNearTheSurfaceBracketsItsCrossingAtTwiceTheNewtonStep)
 {
-    struct Counting : Field
-    {
-        std::shared_ptr<const Field> inner = make_sphere(Vec3d::Zero(), 1.0);
-        mutable int evaluations = 0;
-        using Field::evaluate;
-        [[nodiscard]] FieldSample evaluate(const Vec3d& p) const override
-        {
-            ++evaluations;
-            return inner->evaluate(p);
-        }
-        [[nodiscard]] Aabb bounds() const override { return inner->bounds(); }
-    };
-    const Counting field;
+    const CountingSphere field;
     const double reach = 1.0;
     const double tolerance = ProjectionOptions{}.relative_tolerance * reach;
     // Inside and outside, a thousandth of the reach off the unit sphere, along the radius (the
