@@ -1585,11 +1585,6 @@ constexpr double chord_split_length = 1.5;
 /// ... one of its faces' centroids lies farther than this many times the median face's from
 /// f = 0 ...
 constexpr double chord_split_error = 2.0;
-/// ... and farther than this fraction of the median edge (a centroid nearer than that is on a
-/// flat face up to the projection's tolerance, 10⁻⁶ of an edge: where every face is flat, twice
-/// the median of that rounding split edges at random; the clean 1M plate of bench/peers took
-/// 3,750 splits, the cap, where it had taken 65) ...
-constexpr double chord_split_min_error = 1e-4;
 /// ... and its two faces meet at a dihedral angle under this, degrees (a smooth, curved spot,
 /// not a crease, whose faces the shape rounds align with it).
 constexpr double chord_split_dihedral = 10.0;
@@ -1600,8 +1595,7 @@ constexpr double chord_split_min_angle = 20.0;
 /// Splits the base mesh's longest chords (BaseMeshOptions::chord_split_share): the edges longer
 /// than chord_split_length times the median edge, across which the faces meet at less than
 /// chord_split_dihedral and next to a face whose centroid lies more than chord_split_error
-/// times the median face's off f = 0 (and chord_split_min_error of the median edge), the
-/// farthest first. Each edge's midpoint is projected
+/// times the median face's off f = 0, the farthest first. Each edge's midpoint is projected
 /// onto f = 0 (project_vertex()) and the edge split there when the projection succeeds and the
 /// new triangles keep their shape (chord_split_min_angle) and their side. Returns the splits;
 /// the new vertices come last, in `state` (on the surface), `filled` (0) and `start` (the
@@ -1631,16 +1625,14 @@ std::size_t split_long_chords(OmMesh& mesh, const Field& field, double max_share
                 error[i] = std::abs(sample.value);
         }
     });
+    const double error_limit = chord_split_error * middle_value(error);
     std::vector<double> lengths;
     lengths.reserve(mesh.n_edges());
     for (const auto e : mesh.edges())
         lengths.push_back((at(mesh.to_vertex_handle(mesh.halfedge_handle(e, 0))) -
                            at(mesh.from_vertex_handle(mesh.halfedge_handle(e, 0))))
                               .norm());
-    const double median_length = middle_value(lengths);
-    const double length_limit = chord_split_length * median_length;
-    const double error_limit =
-        std::max(chord_split_error * middle_value(error), chord_split_min_error * median_length);
+    const double length_limit = chord_split_length * middle_value(lengths);
     const double cos_dihedral = std::cos(chord_split_dihedral * degrees);
     const auto normal_of = [&](OmMesh::FaceHandle f) {
         std::array<Vec3d, 3> p;
