@@ -45,8 +45,9 @@ struct ProjectionOptions
 /// Illinois regula falsi to options.relative_tolerance · max_distance; the located point must be a
 /// defined sample, and a sign change at the border between defined and undefined space (the rim of
 /// a hole in a point field, where the surface ends) is no crossing. A rejected bracket lets the
-/// march go on. Deterministic: the same input gives the same point. \param direction  need not be
-/// unit length; a zero or non-finite direction, a non-positive or
+/// march go on. Deterministic: the same input gives the same point.
+///
+/// \param direction  need not be unit length; a zero or non-finite direction, a non-positive or
 ///                   non-finite max_distance or a non-finite p give nullopt
 [[nodiscard]] std::optional<Vec3d> project_to_zero(const Field& field, const Vec3d& p,
                                                    const Vec3d& direction, double max_distance);
