@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -41,6 +42,12 @@ constexpr float grid_cell_scale = 2.5F;
 /// Beyond every influence radius the field's magnitude is the distance to a sample at most this
 /// factor farther than the nearest (PointField).
 constexpr float far_distance_factor = 1.01F;
+
+/// Candidates a single-point evaluation keeps for the next one on its thread (NeighbourMemo):
+/// the blended neighbours and this many more, whose distance bounds how far the next query may
+/// move before another sample could come between.
+constexpr std::size_t memo_extra = 8;
+constexpr std::size_t memo_capacity = max_blend_k + 1 + memo_extra;
 
 /// A point field's evaluation against an analytic primitive's (Field::cost), roughly.
 constexpr double point_field_cost = 50.0;
@@ -970,6 +977,23 @@ struct FarField
 /// The far grid's answer at a query point (nullopt outside its box).
 using FarCell = std::optional<FeatureGrid::CellQuery>;
 
+/// The samples nearest to the last single-point evaluation of a point field on one thread:
+/// successive evaluations are mostly close together (the samples of a projection along its
+/// line, regula falsi's steps), and a query within the margin that `bound2` leaves around
+/// `centre` has its wanted() nearest samples among these, which then need no search.
+struct NeighbourMemo
+{
+    std::uint64_t field = 0; ///< PointField::Impl::id of the field that filled it; 0: empty
+    Vec3f centre = Vec3f::Zero();
+    /// The squared distance from `centre` of the farthest of `slot`: no other sample is nearer.
+    float bound2 = 0.0F;
+    std::uint32_t count = 0;
+    std::array<std::uint32_t, memo_capacity> slot{};
+};
+
+/// Unique per point field ever built, so that a thread's memo never mixes fields.
+std::atomic<std::uint64_t> next_field_id{1};
+
 struct PointField::Impl
 {
     PointCloud surfels;
@@ -1003,6 +1027,8 @@ struct PointField::Impl
     mutable std::unique_ptr<const FarField> far;
     mutable std::atomic<const FarField*> far_built{nullptr};
 
+    std::uint64_t id = next_field_id.fetch_add(1, std::memory_order_relaxed);
+
     Impl(PointCloud cloud, const PointFieldOptions& opts)
         : surfels(std::move(cloud)), options(opts), tree(surfels.positions)
     {}
@@ -1025,11 +1051,28 @@ struct PointField::Impl
     /// grid's knn_nearby() found there: `found` (0 if it was not asked, or found none)
     /// neighbours in `slot` and `dist2`, which have room for wanted() and may be overwritten.
     /// `nearby`: whether maybe_nearby() holds at `p`. Above `hi`, a far value may be any bound
-    /// above it (Field::evaluate_within).
+    /// above it (Field::evaluate_within). With a `memo` (whose candidates `slot` and `dist2`
+    /// have room for), a search of the kd-tree takes memo_extra more neighbours and keeps them
+    /// there (recall_neighbours()).
     [[nodiscard]] FieldSample evaluate_with(const Vec3d& p, const Vec3f& query,
                                             const FarField* far_data, bool nearby,
                                             std::size_t found, std::uint32_t* slot, float* dist2,
-                                            double hi) const;
+                                            double hi, NeighbourMemo* memo = nullptr) const;
+
+    /// How many neighbours the memo keeps: wanted() and memo_extra more, at most every sample.
+    [[nodiscard]] std::size_t memo_size() const;
+    /// Keeps the `found` nearest samples of `query` (slot, nearest first) in `memo`, if they
+    /// are memo_size() of them.
+    void remember_neighbours(NeighbourMemo& memo, const Vec3f& query, std::size_t found,
+                             const std::uint32_t* slot, const float* dist2) const;
+    /// The wanted() nearest samples of `query`, nearest first, into `slot` and `dist2`, from the
+    /// memo, if the memo proves them: no other sample can be nearer than the last of them, no
+    /// two of them are at the same distance (so that every search, whatever its tie rule,
+    /// finds them in this order, with these distances) and the nearest lies well inside the
+    /// largest influence radius (so that evaluate_with() blends them, as a search's would).
+    /// False (and the buffers overwritten) otherwise.
+    [[nodiscard]] bool recall_neighbours(const NeighbourMemo& memo, const Vec3f& query,
+                                         std::uint32_t* slot, float* dist2) const;
 
     /// The value at `p` (relative to the origin) where the far grid proves that no influence
     /// ball reaches and every candidate sample's surface puts `p` inside; false (and `out`
@@ -1388,7 +1431,7 @@ bool PointField::Impl::maybe_nearby(const Vec3d& p, const FarField* far_data) co
 FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
                                             const FarField* far_data, bool nearby,
                                             std::size_t found, std::uint32_t* slot, float* dist2,
-                                            double hi) const
+                                            double hi, NeighbourMemo* memo) const
 {
     const Impl& m = *this;
     FieldSample out;
@@ -1458,7 +1501,13 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
         }
         // The grid has already turned the query down (found == 0: its cells were scanned for
         // want, or the query lies beyond their reach): straight to the kd-tree.
-        found = m.grid->knn_far(query, want, std::span(slot, want), std::span(dist2, want));
+        const std::size_t ask = memo != nullptr ? m.memo_size() : want;
+        found = m.grid->knn_far(query, ask, std::span(slot, ask), std::span(dist2, ask));
+        if (memo != nullptr)
+        {
+            m.remember_neighbours(*memo, query, found, slot, dist2);
+            found = std::min(found, want);
+        }
     }
     const PackedSurfel& nearest = m.packed[slot[0]];
     // Defined inside the union of the blended samples' influence balls, so that a gap next to
@@ -1617,23 +1666,118 @@ FieldSample PointField::evaluate(const Vec3d& world_point) const
                            std::numeric_limits<double>::infinity());
 }
 
+std::size_t PointField::Impl::memo_size() const
+{
+    return std::min(wanted() + memo_extra, surfels.size());
+}
+
+void PointField::Impl::remember_neighbours(NeighbourMemo& memo, const Vec3f& query,
+                                           std::size_t found, const std::uint32_t* slot,
+                                           const float* dist2) const
+{
+    const std::size_t size = memo_size();
+    if (found != size || size <= wanted())
+    {
+        memo.field = 0;
+        return;
+    }
+    memo.field = id;
+    memo.centre = query;
+    memo.bound2 = dist2[size - 1];
+    memo.count = static_cast<std::uint32_t>(size);
+    std::copy(slot, slot + size, memo.slot.begin());
+}
+
+bool PointField::Impl::recall_neighbours(const NeighbourMemo& memo, const Vec3f& query,
+                                         std::uint32_t* slot, float* dist2) const
+{
+    const std::size_t want = wanted();
+    if (memo.field != id || memo.count <= want)
+        return false;
+    const std::size_t count = memo.count;
+    std::array<float, memo_capacity> d2{};
+    grid->squared_distances(query, std::span(memo.slot.data(), count), std::span(d2.data(), count));
+    // The candidates in the order (distance, slot) that the point grid keeps (its keys: a
+    // non-negative float's bits order as the float does).
+    std::array<std::uint64_t, memo_capacity> key{};
+    for (std::size_t i = 0; i < count; ++i)
+        key[i] = (std::uint64_t{std::bit_cast<std::uint32_t>(d2[i])} << 32U) | memo.slot[i];
+    std::sort(key.begin(), key.begin() + static_cast<std::ptrdiff_t>(count));
+    const auto distance2 = [&key](std::size_t i) {
+        return std::bit_cast<float>(static_cast<std::uint32_t>(key[i] >> 32U));
+    };
+    // No ties among the first want + 1: their order is the distances' alone.
+    for (std::size_t i = 0; i < want; ++i)
+        if (!(distance2(i) < distance2(i + 1)))
+            return false;
+    // Any sample not in the memo is at least sqrt(bound2) from the centre, so at least
+    // sqrt(bound2) - |query - centre| from the query: it cannot come before the want-th
+    // candidate while that is nearer still. The relative slack covers the float rounding of
+    // the distances (a few units in the last place).
+    constexpr double slack = 1e-5;
+    const double moved = (query - memo.centre).cast<double>().norm();
+    const double last = std::sqrt(static_cast<double>(distance2(want - 1)));
+    const double bound = std::sqrt(static_cast<double>(memo.bound2));
+    if (!((last + moved) * (1.0 + slack) < bound * (1.0 - slack)))
+        return false;
+    // Near a sample (its distance well inside the largest radius): none of the far paths of
+    // evaluate_with(), which a search's answer would take only beyond every radius.
+    const double nearest = std::sqrt(static_cast<double>(distance2(0)));
+    if (!(nearest < 0.99 * max_radius))
+        return false;
+    for (std::size_t i = 0; i < want; ++i)
+    {
+        slot[i] = static_cast<std::uint32_t>(key[i]);
+        dist2[i] = distance2(i);
+    }
+    return true;
+}
+
 FieldSample PointField::evaluate_within(const Vec3d& world_point, double /*lo*/, double hi) const
 {
     const Impl& m = *impl_;
     const Vec3d p = world_point - m.surfels.origin;
     const Vec3f query = p.cast<float>();
-    std::array<std::uint32_t, max_blend_k + 1> slot{};
-    std::array<float, max_blend_k + 1> dist2{};
+    std::array<std::uint32_t, memo_capacity> slot{};
+    std::array<float, memo_capacity> dist2{};
     const std::size_t want = m.wanted();
     const FarField* far = m.far_built.load(std::memory_order_acquire);
+    if (!blends(m.options.fit))
+    {
+        std::size_t found = 0;
+        const bool nearby = m.maybe_nearby(p, far);
+        if (nearby)
+            found = m.grid->knn_nearby(query, want, std::span(slot.data(), want),
+                                       std::span(dist2.data(), want));
+        return m.evaluate_with(p, query, far, nearby, found, slot.data(), dist2.data(), hi);
+    }
+    // The wanted() nearest samples from this thread's last evaluation where they are provably
+    // the same (recall_neighbours()); otherwise searched, with memo_extra more kept for the
+    // next. Either way the same neighbours, in the same order, with the same distances: the
+    // value does not depend on which evaluations came before on the thread.
+    thread_local NeighbourMemo memo;
+    if (m.recall_neighbours(memo, query, slot.data(), dist2.data()))
+        return m.evaluate_with(p, query, far, true, want, slot.data(), dist2.data(), hi);
     std::size_t found = 0;
     const bool nearby = m.maybe_nearby(p, far);
     if (nearby)
     {
-        found = m.grid->knn_nearby(query, want, std::span(slot.data(), want),
-                                   std::span(dist2.data(), want));
+        const std::size_t ask = m.memo_size();
+        found = m.grid->knn_nearby(query, ask, std::span(slot.data(), ask),
+                                   std::span(dist2.data(), ask));
+        if (found > 0)
+        {
+            m.remember_neighbours(memo, query, found, slot.data(), dist2.data());
+            found = std::min(found, want);
+        }
+        else
+        {
+            // The grid's cells may hold the wanted() nearest but not the rest.
+            found = m.grid->knn_nearby(query, want, std::span(slot.data(), want),
+                                       std::span(dist2.data(), want));
+        }
     }
-    return m.evaluate_with(p, query, far, nearby, found, slot.data(), dist2.data(), hi);
+    return m.evaluate_with(p, query, far, nearby, found, slot.data(), dist2.data(), hi, &memo);
 }
 
 double PointField::cost() const

@@ -7,6 +7,8 @@
 #include "pointform/core/parallel.h"
 #include "pointform/spatial/spatial_sort.h"
 
+#include "unfused.h"
+
 #include <nanoflann.hpp>
 
 #include <algorithm>
@@ -39,9 +41,32 @@ struct PositionSpan
     }
 };
 
-using NanoTree = nanoflann::KDTreeSingleIndexAdaptor<
-    nanoflann::L2_Simple_Adaptor<float, PositionSpan, float, std::uint32_t>, PositionSpan, 3,
-    std::uint32_t>;
+/// nanoflann's L2_Simple_Adaptor with the squared distance rounded as the point grid rounds
+/// it (detail::unfused_squared_distance()), on any target: the two answer a query with the same
+/// bits, so that a caller may take either's neighbours (and their distances) for the other's.
+struct UnfusedL2
+{
+    using ElementType = float;
+    using DistanceType = float;
+
+    const PositionSpan& data_source;
+
+    explicit UnfusedL2(const PositionSpan& source) : data_source(source) {}
+
+    [[nodiscard]] float evalMetric(const float* a, std::uint32_t b, std::size_t /*size*/) const
+    {
+        const Vec3f& p = data_source.points[b];
+        return detail::unfused_squared_distance(a[0], a[1], a[2], p.x(), p.y(), p.z());
+    }
+
+    template <typename U, typename V>
+    [[nodiscard]] float accum_dist(const U a, const V b, std::size_t /*dim*/) const
+    {
+        return (a - b) * (a - b);
+    }
+};
+
+using NanoTree = nanoflann::KDTreeSingleIndexAdaptor<UnfusedL2, PositionSpan, 3, std::uint32_t>;
 
 constexpr std::size_t query_block = 2048;
 
@@ -590,7 +615,9 @@ PointId KdTree::nearest_within_factor(const Vec3f& query, float factor, PointId 
     nanoflann::KNNResultSet<float, std::uint32_t, std::size_t> result(1);
     result.init(&index, &d2);
     index = start.value;
-    d2 = (impl_->data.points[start.value] - query).squaredNorm();
+    const Vec3f& from = impl_->data.points[start.value];
+    d2 = detail::unfused_squared_distance(query.x(), query.y(), query.z(), from.x(), from.y(),
+                                          from.z());
     nanoflann::SearchParams params;
     params.eps = factor - 1.0F;
     impl_->tree.findNeighbors(result, query.data(), params);

@@ -7,6 +7,8 @@
 #include "pointform/core/parallel.h"
 #include "pointform/spatial/kd_tree.h"
 
+#include "unfused.h"
+
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -24,17 +26,6 @@
 #define PF_GRID_AVX2 1
 #else
 #define PF_GRID_AVX2 0
-#endif
-
-// Keeps a product apart from the sum it goes into: where the compiler may fuse multiplies and
-// adds (a target with FMA), the squared distances are rounded the same on every path (Within's,
-// Selection's scalar and wide loops) all the same.
-#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
-#define PF_GRID_UNFUSED(value) asm("" : "+x"(value))
-#elif defined(__GNUC__) && defined(__aarch64__)
-#define PF_GRID_UNFUSED(value) asm("" : "+w"(value))
-#else
-#define PF_GRID_UNFUSED(value) static_cast<void>(value)
 #endif
 
 namespace pointform {
@@ -126,9 +117,9 @@ public:
             __m128 xx = _mm_mul_ps(dx, dx);
             __m128 yy = _mm_mul_ps(dy, dy);
             __m128 zz = _mm_mul_ps(dz, dz);
-            PF_GRID_UNFUSED(xx);
-            PF_GRID_UNFUSED(yy);
-            PF_GRID_UNFUSED(zz);
+            PF_UNFUSED(xx);
+            PF_UNFUSED(yy);
+            PF_UNFUSED(zz);
             const __m128 d2 = _mm_add_ps(_mm_add_ps(xx, yy), zz);
             auto inside = static_cast<unsigned>(_mm_movemask_ps(_mm_cmple_ps(d2, reach2)));
             if (inside == 0)
@@ -152,9 +143,9 @@ public:
             float xx = dx * dx;
             float yy = dy * dy;
             float zz = dz * dz;
-            PF_GRID_UNFUSED(xx);
-            PF_GRID_UNFUSED(yy);
-            PF_GRID_UNFUSED(zz);
+            PF_UNFUSED(xx);
+            PF_UNFUSED(yy);
+            PF_UNFUSED(zz);
             const float d2 = xx + yy + zz;
             key_[count_] = key_of(std::bit_cast<std::uint32_t>(d2), s);
             count_ += d2 <= reach2_ ? 1U : 0U;
@@ -282,9 +273,9 @@ __attribute__((target("avx2"))) __m256 squared_distances_avx2(const float* xs, c
     __m256 xx = _mm256_mul_ps(dx, dx);
     __m256 yy = _mm256_mul_ps(dy, dy);
     __m256 zz = _mm256_mul_ps(dz, dz);
-    PF_GRID_UNFUSED(xx);
-    PF_GRID_UNFUSED(yy);
-    PF_GRID_UNFUSED(zz);
+    PF_UNFUSED(xx);
+    PF_UNFUSED(yy);
+    PF_UNFUSED(zz);
     return _mm256_add_ps(_mm256_add_ps(xx, yy), zz);
 }
 
@@ -1097,6 +1088,19 @@ void PointGrid::knn_nearby(std::span<const Vec3f> queries, std::size_t k,
         start = end;
     }
 #endif
+}
+
+void PointGrid::squared_distances(const Vec3f& query, std::span<const std::uint32_t> slots,
+                                  std::span<float> squared_distances) const
+{
+    check_buffer_size("PointGrid::squared_distances", "squared_distances", squared_distances.size(),
+                      slots.size());
+    for (std::size_t i = 0; i < slots.size(); ++i)
+    {
+        const std::uint32_t s = slots[i];
+        squared_distances[i] = detail::unfused_squared_distance(xs_[s], ys_[s], zs_[s], query.x(),
+                                                                query.y(), query.z());
+    }
 }
 
 std::size_t PointGrid::knn_far(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,

@@ -207,6 +207,75 @@ TEST(PointField, BatchEqualsSingleWhateverTheThreadCount)
     }
 }
 
+TEST(PointField, SuccessiveEvaluationsAreTheBatchsBitForBit)
+{
+    // One by one, an evaluation near the one before takes its neighbours from it when they are
+    // provably the same (a projection's samples along its line, regula falsi's steps); the
+    // batch searches for every point. Both must give the same bits: along lines through a
+    // part with creases (quadric fits and their crease data) in steps from 1e-6 to 0.05,
+    // with samples duplicated (ties in every distance), through a hole and far outside, and
+    // alternating with a second field on the same thread.
+    PointCloud raw = sample_shape(Shape::Part, {.count = 12000, .seed = 5});
+    PointCloud samples;
+    samples.origin = raw.origin;
+    for (std::size_t i = 0; i < raw.size(); ++i)
+    {
+        const Vec3d p = raw.origin + raw.positions[i].cast<double>();
+        if ((p - Vec3d(0.5, 0.5, 0.0)).norm() < 0.25)
+            continue; // a hole
+        samples.positions.push_back(raw.positions[i]);
+        if (i % 7 == 0)
+            samples.positions.push_back(raw.positions[i]); // a duplicate
+    }
+    const PointField field(compute_surfels(samples).surfels);
+    const PointField other(sphere_surfels(3000, 0.15F));
+    std::vector<Vec3d> points;
+    std::mt19937_64 rng(31);
+    std::uniform_real_distribution<double> u(-1.4, 1.4);
+    std::normal_distribution<double> gauss;
+    for (const double step : {1e-6, 1e-4, 3e-3, 5e-2})
+    {
+        for (int line = 0; line < 40; ++line)
+        {
+            // Most lines from near a sample, the rest from anywhere around the part.
+            const std::size_t near = (static_cast<std::size_t>(line) * 263) % samples.size();
+            const Vec3d start =
+                line % 4 != 0 ? Vec3d(samples.origin + samples.positions[near].cast<double>() +
+                                      0.03 * Vec3d(gauss(rng), gauss(rng), gauss(rng)))
+                              : Vec3d(u(rng), u(rng), u(rng));
+            const Vec3d direction = Vec3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+            for (int i = 0; i < 60; ++i)
+                points.push_back(start + (i * step) * direction);
+        }
+    }
+    // Back and forth on one short segment, as regula falsi closes a bracket.
+    for (int i = 0; i < 200; ++i)
+        points.push_back(Vec3d(0.3, -0.2, 0.1) +
+                         (i % 2 == 0 ? 1e-3 : -1e-3) / (1 + i) * Vec3d(0.6, 0.0, 0.8));
+    std::vector<FieldSample> batch(points.size());
+    field.evaluate(points, batch);
+    std::vector<FieldSample> other_batch(points.size());
+    other.evaluate(points, other_batch);
+    std::size_t defined = 0;
+    for (std::size_t i = 0; i < points.size(); ++i)
+    {
+        const FieldSample single = field.evaluate(points[i]);
+        ASSERT_EQ(single.defined, batch[i].defined) << i;
+        ASSERT_EQ(single.value, batch[i].value) << i;
+        ASSERT_EQ(single.gradient, batch[i].gradient) << i;
+        defined += single.defined ? 1 : 0;
+        if (i % 5 == 0)
+        {
+            const FieldSample sphere = other.evaluate(points[i]);
+            ASSERT_EQ(sphere.value, other_batch[i].value) << i;
+            ASSERT_EQ(sphere.gradient, other_batch[i].gradient) << i;
+        }
+    }
+    // Most lines run near the surface, some far from it.
+    EXPECT_GT(defined, points.size() / 3);
+    EXPECT_LT(defined, points.size());
+}
+
 /// RMS of the field over points of the true unit sphere: how far the zero set lies from it.
 double rms_on_true_sphere(const PointField& field)
 {

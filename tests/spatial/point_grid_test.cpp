@@ -120,6 +120,47 @@ TEST(PointGrid, KnnFarAnswersWhatTheCellsTurnDown)
                  InvalidInput);
 }
 
+TEST(PointGrid, SquaredDistancesAreTheBitsOfEveryQuery)
+{
+    // squared_distances() of the slots a query found gives the distances that query reported,
+    // bit for bit, from the cells (knn_nearby()) and from the kd-tree (knn_far()) alike: a
+    // caller that re-ranks candidates it holds gets what a new query would.
+    const PointCloud cloud = sample_shape(Shape::Part, {.count = 4000, .seed = 8});
+    const KdTree tree(cloud.positions);
+    const PointGrid grid(cloud.positions, 0.25F, tree);
+    std::mt19937_64 rng(14);
+    std::uniform_real_distribution<float> u(-1.6F, 1.6F);
+    std::normal_distribution<float> gauss(0.0F, 0.02F);
+    constexpr std::size_t k = 17;
+    int near_queries = 0;
+    for (int q = 0; q < 500; ++q)
+    {
+        // Half near the points (the cells answer), half anywhere (mostly the kd-tree).
+        const Vec3f query = q % 2 == 0 ? Vec3f(cloud.positions[static_cast<std::size_t>(q) * 7] +
+                                               Vec3f(gauss(rng), gauss(rng), gauss(rng)))
+                                       : Vec3f(u(rng), u(rng), u(rng));
+        std::array<std::uint32_t, k> slots{};
+        std::array<float, k> d2{};
+        std::array<float, k> again{};
+        if (grid.knn_nearby(query, k, slots, d2) == k)
+        {
+            ++near_queries;
+            grid.squared_distances(query, slots, again);
+            for (std::size_t j = 0; j < k; ++j)
+                ASSERT_EQ(std::bit_cast<std::uint32_t>(again[j]),
+                          std::bit_cast<std::uint32_t>(d2[j]));
+        }
+        ASSERT_EQ(grid.knn_far(query, k, slots, d2), k);
+        grid.squared_distances(query, slots, again);
+        for (std::size_t j = 0; j < k; ++j)
+            ASSERT_EQ(std::bit_cast<std::uint32_t>(again[j]), std::bit_cast<std::uint32_t>(d2[j]));
+    }
+    EXPECT_GT(near_queries, 200);
+    std::array<std::uint32_t, 3> three{};
+    std::array<float, 2> short_d2{};
+    EXPECT_THROW(grid.squared_distances(Vec3f::Zero(), three, short_d2), InvalidInput);
+}
+
 TEST(PointGrid, SparseRegionsAndGridsQueriedInTurnStayExact)
 {
     // A plane sampled densely on one half and 8 times as sparsely on the other (a scan's near

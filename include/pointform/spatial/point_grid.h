@@ -70,6 +70,14 @@ public:
     void knn_nearby(std::span<const Vec3f> queries, std::size_t k, std::span<std::uint32_t> slots,
                     std::span<float> squared_distances, std::span<std::uint32_t> found) const;
 
+    /// \brief The squared distances from `query` to the points at `slots`, rounded as the grid's
+    /// queries round them: bit for bit what knn() reports for those points, so that a caller
+    /// that ranks candidates it already holds gets the same order and values as a query.
+    /// \param squared_distances  a caller buffer of size >= slots.size()
+    /// \throw InvalidInput if the buffer is shorter
+    void squared_distances(const Vec3f& query, std::span<const std::uint32_t> slots,
+                           std::span<float> squared_distances) const;
+
     /// \brief The slot of an original point index.
     [[nodiscard]] std::uint32_t slot_of(std::uint32_t index) const { return slot_of_[index]; }
     [[nodiscard]] std::uint32_t original_index(std::uint32_t slot) const { return order_[slot]; }
