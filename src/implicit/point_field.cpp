@@ -43,9 +43,11 @@ constexpr float grid_cell_scale = 2.5F;
 /// factor farther than the nearest (PointField).
 constexpr float far_distance_factor = 1.01F;
 
-/// Candidates a single-point evaluation keeps for the next one on its thread (NeighbourMemo):
-/// the blended neighbours and this many more, whose distance bounds how far the next query may
-/// move before another sample could come between.
+/// Candidates a single-point evaluation that searched the kd-tree keeps for the next ones on
+/// its thread (NeighbourMemo): the blended neighbours and this many more, whose distance bounds
+/// how far a query may move before another sample could come between. 4 and 16 were tried on
+/// the simulated fandisk scans and table_scene_mug; more candidates let farther queries take
+/// them but cost every search more.
 constexpr std::size_t memo_extra = 8;
 constexpr std::size_t memo_capacity = max_blend_k + 1 + memo_extra;
 
@@ -977,16 +979,21 @@ struct FarField
 /// The far grid's answer at a query point (nullopt outside its box).
 using FarCell = std::optional<FeatureGrid::CellQuery>;
 
-/// The samples nearest to the last single-point evaluation of a point field on one thread:
-/// successive evaluations are mostly close together (the samples of a projection along its
-/// line, regula falsi's steps), and a query within the margin that `bound2` leaves around
-/// `centre` has its wanted() nearest samples among these, which then need no search.
+/// The samples nearest to the last single-point evaluation of a point field on one thread that
+/// the point grid turned down (a search of the kd-tree, the costly kind: far from the samples,
+/// or where they are sparse, as over a hole): successive evaluations are mostly close together
+/// (the samples of a projection along its line, regula falsi's steps), and a query within the
+/// margin that `bound2` leaves around `centre` has its wanted() nearest samples among these,
+/// which then need no search.
 struct NeighbourMemo
 {
     std::uint64_t field = 0; ///< PointField::Impl::id of the field that filled it; 0: empty
     Vec3f centre = Vec3f::Zero();
     /// The squared distance from `centre` of the farthest of `slot`: no other sample is nearer.
     float bound2 = 0.0F;
+    /// sqrt(bound2) minus the wanted()-th distance from `centre`: a query that has moved farther
+    /// than this is not tried (it rarely passes).
+    float gap = 0.0F;
     std::uint32_t count = 0;
     std::array<std::uint32_t, memo_capacity> slot{};
 };
@@ -1684,6 +1691,7 @@ void PointField::Impl::remember_neighbours(NeighbourMemo& memo, const Vec3f& que
     memo.field = id;
     memo.centre = query;
     memo.bound2 = dist2[size - 1];
+    memo.gap = std::sqrt(dist2[size - 1]) - std::sqrt(dist2[wanted() - 1]);
     memo.count = static_cast<std::uint32_t>(size);
     std::copy(slot, slot + size, memo.slot.begin());
 }
@@ -1693,6 +1701,8 @@ bool PointField::Impl::recall_neighbours(const NeighbourMemo& memo, const Vec3f&
 {
     const std::size_t want = wanted();
     if (memo.field != id || memo.count <= want)
+        return false;
+    if (!((query - memo.centre).squaredNorm() < memo.gap * memo.gap))
         return false;
     const std::size_t count = memo.count;
     std::array<float, memo_capacity> d2{};
@@ -1751,32 +1761,21 @@ FieldSample PointField::evaluate_within(const Vec3d& world_point, double /*lo*/,
                                        std::span(dist2.data(), want));
         return m.evaluate_with(p, query, far, nearby, found, slot.data(), dist2.data(), hi);
     }
-    // The wanted() nearest samples from this thread's last evaluation where they are provably
-    // the same (recall_neighbours()); otherwise searched, with memo_extra more kept for the
-    // next. Either way the same neighbours, in the same order, with the same distances: the
-    // value does not depend on which evaluations came before on the thread.
+    // The wanted() nearest samples from this thread's last search of the kd-tree where they are
+    // provably the same (recall_neighbours()); otherwise searched, and a search that the point
+    // grid turns down keeps memo_extra more for the next. Either way the same neighbours, in the
+    // same order, with the same distances: the value does not depend on which evaluations came
+    // before on the thread. Only the kd-tree's searches are kept: they are the costly ones (far
+    // from the samples, where they are sparse, as over a hole), and the grid's, near the
+    // samples, cost about what taking candidates back does.
     thread_local NeighbourMemo memo;
     if (m.recall_neighbours(memo, query, slot.data(), dist2.data()))
         return m.evaluate_with(p, query, far, true, want, slot.data(), dist2.data(), hi);
     std::size_t found = 0;
     const bool nearby = m.maybe_nearby(p, far);
     if (nearby)
-    {
-        const std::size_t ask = m.memo_size();
-        found = m.grid->knn_nearby(query, ask, std::span(slot.data(), ask),
-                                   std::span(dist2.data(), ask));
-        if (found > 0)
-        {
-            m.remember_neighbours(memo, query, found, slot.data(), dist2.data());
-            found = std::min(found, want);
-        }
-        else
-        {
-            // The grid's cells may hold the wanted() nearest but not the rest.
-            found = m.grid->knn_nearby(query, want, std::span(slot.data(), want),
-                                       std::span(dist2.data(), want));
-        }
-    }
+        found = m.grid->knn_nearby(query, want, std::span(slot.data(), want),
+                                   std::span(dist2.data(), want));
     return m.evaluate_with(p, query, far, nearby, found, slot.data(), dist2.data(), hi, &memo);
 }
 

@@ -210,11 +210,13 @@ TEST(PointField, BatchEqualsSingleWhateverTheThreadCount)
 TEST(PointField, SuccessiveEvaluationsAreTheBatchsBitForBit)
 {
     // One by one, an evaluation near the one before takes its neighbours from it when they are
-    // provably the same (a projection's samples along its line, regula falsi's steps); the
-    // batch searches for every point. Both must give the same bits: along lines through a
-    // part with creases (quadric fits and their crease data) in steps from 1e-6 to 0.05,
-    // with samples duplicated (ties in every distance), through a hole and far outside, and
-    // alternating with a second field on the same thread.
+    // provably the same (a projection's samples along its line, regula falsi's steps, where
+    // the point grid turns them down and the kd-tree answers); the batch searches for every
+    // point. Both must give the same bits: along lines through a part with creases (quadric
+    // fits and their crease data) and over a sparse patch beside it (the grid's cells follow
+    // the dense part, so the kd-tree answers there) in steps from 1e-6 to 0.05, with samples
+    // duplicated (ties in every distance), through a hole and far outside, and alternating
+    // with a second field on the same thread.
     PointCloud raw = sample_shape(Shape::Part, {.count = 12000, .seed = 5});
     PointCloud samples;
     samples.origin = raw.origin;
@@ -227,6 +229,17 @@ TEST(PointField, SuccessiveEvaluationsAreTheBatchsBitForBit)
         if (i % 7 == 0)
             samples.positions.push_back(raw.positions[i]); // a duplicate
     }
+    const Vec3d sparse_corner(-1.5, -1.5, -2.5);
+    constexpr double sparse_spacing = 0.15;
+    std::mt19937_64 jitter_rng(4);
+    std::uniform_real_distribution<double> jitter(-0.2 * sparse_spacing, 0.2 * sparse_spacing);
+    for (int a = 0; a < 20; ++a)
+        for (int b = 0; b < 20; ++b)
+            samples.positions.push_back((sparse_corner +
+                                         Vec3d(a * sparse_spacing + jitter(jitter_rng),
+                                               b * sparse_spacing + jitter(jitter_rng), 0.0) -
+                                         samples.origin)
+                                            .cast<float>());
     const PointField field(compute_surfels(samples).surfels);
     const PointField other(sphere_surfels(3000, 0.15F));
     std::vector<Vec3d> points;
@@ -248,6 +261,16 @@ TEST(PointField, SuccessiveEvaluationsAreTheBatchsBitForBit)
                 points.push_back(start + (i * step) * direction);
         }
     }
+    // Over the sparse patch, near its plane.
+    std::uniform_real_distribution<double> across(0.3, 2.5);
+    for (const double step : {1e-6, 1e-4, 3e-3})
+        for (int line = 0; line < 20; ++line)
+        {
+            const Vec3d start = sparse_corner + Vec3d(across(rng), across(rng), 0.05 * gauss(rng));
+            const Vec3d direction = Vec3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+            for (int i = 0; i < 60; ++i)
+                points.push_back(start + (i * step) * direction);
+        }
     // Back and forth on one short segment, as regula falsi closes a bracket.
     for (int i = 0; i < 200; ++i)
         points.push_back(Vec3d(0.3, -0.2, 0.1) +
