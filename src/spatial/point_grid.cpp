@@ -137,16 +137,8 @@ public:
 #else
         for (std::uint32_t s = range.begin; s < range.end; ++s)
         {
-            const float dx = xs[s] - q.x();
-            const float dy = ys[s] - q.y();
-            const float dz = zs[s] - q.z();
-            float xx = dx * dx;
-            float yy = dy * dy;
-            float zz = dz * dz;
-            PF_UNFUSED(xx);
-            PF_UNFUSED(yy);
-            PF_UNFUSED(zz);
-            const float d2 = xx + yy + zz;
+            const float d2 =
+                detail::unfused_squared_distance(xs[s], ys[s], zs[s], q.x(), q.y(), q.z());
             key_[count_] = key_of(std::bit_cast<std::uint32_t>(d2), s);
             count_ += d2 <= reach2_ ? 1U : 0U;
         }
