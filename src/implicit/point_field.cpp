@@ -994,7 +994,7 @@ struct NeighbourMemo
     /// sqrt(bound2) minus the wanted()-th distance from `centre`: a query that has moved farther
     /// than this is not tried (it rarely passes).
     float gap = 0.0F;
-    std::uint32_t count = 0;
+    /// The field's memo_size() nearest samples of `centre`, nearest first.
     std::array<std::uint32_t, memo_capacity> slot{};
 };
 
@@ -1058,8 +1058,8 @@ struct PointField::Impl
     /// grid's knn_nearby() found there: `found` (0 if it was not asked, or found none)
     /// neighbours in `slot` and `dist2`, which have room for wanted() and may be overwritten.
     /// `nearby`: whether maybe_nearby() holds at `p`. Above `hi`, a far value may be any bound
-    /// above it (Field::evaluate_within). With a `memo` (whose candidates `slot` and `dist2`
-    /// have room for), a search of the kd-tree takes memo_extra more neighbours and keeps them
+    /// above it (Field::evaluate_within). With a `memo` (for whose candidates `slot` and
+    /// `dist2` have room), a search of the kd-tree takes memo_extra more neighbours and keeps them
     /// there (recall_neighbours()).
     [[nodiscard]] FieldSample evaluate_with(const Vec3d& p, const Vec3f& query,
                                             const FarField* far_data, bool nearby,
@@ -1692,19 +1692,20 @@ void PointField::Impl::remember_neighbours(NeighbourMemo& memo, const Vec3f& que
     memo.centre = query;
     memo.bound2 = dist2[size - 1];
     memo.gap = std::sqrt(dist2[size - 1]) - std::sqrt(dist2[wanted() - 1]);
-    memo.count = static_cast<std::uint32_t>(size);
     std::copy(slot, slot + size, memo.slot.begin());
 }
 
 bool PointField::Impl::recall_neighbours(const NeighbourMemo& memo, const Vec3f& query,
                                          std::uint32_t* slot, float* dist2) const
 {
+    // Only remember_neighbours() sets `field`, with memo_size() candidates, more than wanted().
+    if (memo.field != id)
+        return false;
+    const Vec3f offset = query - memo.centre;
+    if (!(offset.squaredNorm() < memo.gap * memo.gap))
+        return false;
     const std::size_t want = wanted();
-    if (memo.field != id || memo.count <= want)
-        return false;
-    if (!((query - memo.centre).squaredNorm() < memo.gap * memo.gap))
-        return false;
-    const std::size_t count = memo.count;
+    const std::size_t count = memo_size();
     std::array<float, memo_capacity> d2{};
     grid->squared_distances(query, std::span(memo.slot.data(), count), std::span(d2.data(), count));
     // The candidates in the order (distance, slot) that the point grid keeps (its keys: a
@@ -1725,7 +1726,7 @@ bool PointField::Impl::recall_neighbours(const NeighbourMemo& memo, const Vec3f&
     // candidate while that is nearer still. The relative slack covers the float rounding of
     // the distances (a few units in the last place).
     constexpr double slack = 1e-5;
-    const double moved = (query - memo.centre).cast<double>().norm();
+    const double moved = offset.cast<double>().norm();
     const double last = std::sqrt(static_cast<double>(distance2(want - 1)));
     const double bound = std::sqrt(static_cast<double>(memo.bound2));
     if (!((last + moved) * (1.0 + slack) < bound * (1.0 - slack)))
@@ -1752,22 +1753,14 @@ FieldSample PointField::evaluate_within(const Vec3d& world_point, double /*lo*/,
     std::array<float, memo_capacity> dist2{};
     const std::size_t want = m.wanted();
     const FarField* far = m.far_built.load(std::memory_order_acquire);
-    if (!blends(m.options.fit))
-    {
-        std::size_t found = 0;
-        const bool nearby = m.maybe_nearby(p, far);
-        if (nearby)
-            found = m.grid->knn_nearby(query, want, std::span(slot.data(), want),
-                                       std::span(dist2.data(), want));
-        return m.evaluate_with(p, query, far, nearby, found, slot.data(), dist2.data(), hi);
-    }
     // The wanted() nearest samples from this thread's last search of the kd-tree where they are
     // provably the same (recall_neighbours()); otherwise searched, and a search that the point
     // grid turns down keeps memo_extra more for the next. Either way the same neighbours, in the
     // same order, with the same distances: the value does not depend on which evaluations came
     // before on the thread. Only the kd-tree's searches are kept: they are the costly ones (far
     // from the samples, where they are sparse, as over a hole), and the grid's, near the
-    // samples, cost about what taking candidates back does.
+    // samples, cost about what taking candidates back does. (A field without blending never
+    // searches the kd-tree for more than the nearest, so it keeps nothing and takes nothing.)
     thread_local NeighbourMemo memo;
     if (m.recall_neighbours(memo, query, slot.data(), dist2.data()))
         return m.evaluate_with(p, query, far, true, want, slot.data(), dist2.data(), hi);
