@@ -264,19 +264,19 @@ def main(argv=None) -> int:
                              "bpa", "--estimate-normals", "16"], work / "bpa.ply")
     print()
     header = ["shape", "variant", "tool", "wall s", "peak MiB", "vertices", "Hausdorff %diag",
-              "Chamfer %diag", "F@0.5%", "F@1%", "min angle < 20°", "valence 6", "folds"]
+              "Chamfer %diag", "F@0.5%", "F@1%", "min angle < 20°", "valence 6", "folds", "facing away"]
     print("| " + " | ".join(header) + " |")
     print("|" + "---|" * len(header))
     for r in rows:
         if "chamfer" not in r:
-            print(f"| {r['shape']} | {r['variant']} | {r['tool']} | {r['status']} |" + " |" * 9)
+            print(f"| {r['shape']} | {r['variant']} | {r['tool']} | {r['status']} |" + " |" * 10)
             continue
         vertices = r.get("vertices") or ""
         print(f"| {r['shape']} | {r['variant']} | {r['tool']} | {r['wall_s']:.1f} | "
               f"{r['peak_mib']:.0f} | {vertices} | {100 * r['hausdorff']:.4g} | "
               f"{100 * r['chamfer']:.4f} | {r['f0.005']:.4f} | {r['f0.01']:.4f} | "
               f"{100 * r['min_angle_under_20']:.2f}% | {100 * r['valence6']:.1f}% | "
-              f"{r.get('folded_faces', '')} |")
+              f"{r.get('folded_faces', '')} | {100 * r.get('facing_away', math.nan):.2f}% |")
     return 0
 
 

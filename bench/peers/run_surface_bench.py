@@ -139,6 +139,46 @@ def true_distance(shape: str, p: np.ndarray) -> np.ndarray:
     raise ValueError(shape)
 
 
+def _inside(shape: str, p: np.ndarray) -> np.ndarray:
+    """Whether points lie inside the analytic solid (the sign of its signed distance)."""
+    if shape == "sphere":
+        return np.linalg.norm(p, axis=1) < 1.0
+    if shape == "torus":
+        return np.hypot(np.hypot(p[:, 0], p[:, 1]) - 1.0, p[:, 2]) < 0.35
+    if shape == "two-spheres":
+        c = np.where(p[:, :1] > 0, 1.6, -1.6)
+        return np.linalg.norm(p - np.concatenate([c, np.zeros((len(p), 2))], 1), axis=1) < 1.0
+    if shape == "plate":
+        return _box_sdf(p, (-1.0, -1.0, -0.025), (1.0, 1.0, 0.025)) < 0.0
+    if shape == "blobby":
+        return np.any([np.linalg.norm(p - np.array(c), axis=1) < r for c, r in BLOBBY], axis=0)
+    if shape == "part":
+        return (np.min([_primitive_sdf(q, p) for q in PART_ADDED], axis=0) < 0.0) & \
+            (np.min([_primitive_sdf(q, p) for q in PART_REMOVED], axis=0) > 0.0)
+    raise ValueError(shape)
+
+
+def true_normals(shape: str, p: np.ndarray, diag: float) -> np.ndarray:
+    """The truth's outward unit normal nearest each point: a mesh truth's nearest triangle's; an
+    analytic shape's the gradient of its signed distance (central differences of 10⁻⁴ of the
+    diagonal; where the distance is not smooth, at the medial axis, any direction of it)."""
+    if shape == "bunny" or shape in SCANNED_MESHES:
+        loaded = o3d.io.read_triangle_mesh(str(BUNNY_MESH if shape == "bunny" else
+                                               SCANNED_MESHES[shape]))
+        mesh = o3d.geometry.TriangleMesh(loaded.vertices, loaded.triangles)
+        mesh.compute_triangle_normals()
+        scene = o3d.t.geometry.RaycastingScene()
+        scene.add_triangles(o3d.t.geometry.TriangleMesh.from_legacy(mesh))
+        closest = scene.compute_closest_points(o3d.core.Tensor(p.astype(np.float32)))
+        return np.asarray(mesh.triangle_normals)[closest["primitive_ids"].numpy()]
+
+    def signed(q):
+        return np.where(_inside(shape, q), -1.0, 1.0) * true_distance(shape, q)
+    h = 1e-4 * diag
+    gradient = np.stack([signed(p + h * e) - signed(p - h * e) for e in np.eye(3)], 1)
+    return gradient / np.maximum(np.linalg.norm(gradient, axis=1), 1e-300)[:, None]
+
+
 def load_points(path: Path) -> np.ndarray:
     v = read_ply(str(path))
     return np.stack([v["x"], v["y"], v["z"]], 1).astype(np.float64)
@@ -171,8 +211,12 @@ def evaluate(shape, mesh_path: Path, truth: np.ndarray, samples: np.ndarray, dia
     # Geometry only: Debian's Open3D asserts on some zero vertex normals while sampling.
     mesh = o3d.geometry.TriangleMesh(loaded.vertices, loaded.triangles)
     area = mesh.get_surface_area()
-    surface = surface_samples(mesh, 200000, np.random.default_rng(2026))[0]
+    surface, surface_normals = surface_samples(mesh, 200000, np.random.default_rng(2026))
     mesh_to_truth = true_distance(shape, surface)
+    # Inside-out pieces: the share of the area whose normal points away from the truth's
+    # nearest outward normal (more than 90° apart).
+    facing_away = float(np.mean(np.sum(surface_normals * true_normals(shape, surface, diag), 1)
+                                < 0.0))
     corners = np.asarray(mesh.vertices)[np.asarray(mesh.triangles)]
     structure = np.concatenate([np.asarray(mesh.vertices), corners.mean(1),
                                 0.5 * (corners + np.roll(corners, 1, axis=1)).reshape(-1, 3)])
@@ -201,6 +245,7 @@ def evaluate(shape, mesh_path: Path, truth: np.ndarray, samples: np.ndarray, dia
         "chamfer": (mesh_to_truth.mean() + truth_to_mesh["mean"]) / diag,
         "area": area,
         "spurious": spurious / len(surface[::20]),
+        "facing_away": facing_away,
         "pf_truth_to_mesh_max": truth_to_mesh["max"],
         "pf_distance_s": pf[1],
     }

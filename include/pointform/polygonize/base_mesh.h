@@ -81,8 +81,10 @@ struct BaseMeshOptions
     /// the ring outside it and follows the curvature around the hole; a membrane, each vertex
     /// the mean of its neighbours, would lie flat across it: 0.034 off a unit sphere over holes
     /// of radius 0.28, against 0.010, tests/polygonize/hole_fill_test.cpp) when the area its
-    /// rim encloses (the loop's vector area) is at most this fraction of its
-    /// component's surface area, in [0, 1); 0 = no hole filled. Scans leave holes where the
+    /// rim encloses (the loop's vector area) is at most this fraction of its component's
+    /// surface area and the fan of triangles from the rim's centroid at most twice that (a rim
+    /// that turns round the object has a small vector area and a large fan), in [0, 1); 0 = no
+    /// hole filled. Scans leave holes where the
     /// scanner saw nothing (occlusion, dark or shiny spots, the side an object stood on); the
     /// default closes those, as the peers' Poisson does, but not the rim of a partial scan (a
     /// single range image, a terrain), whose loop encloses about as much as the surface
