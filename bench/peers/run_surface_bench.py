@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import faulthandler
+import functools
 import multiprocessing
 import json
 import math
@@ -103,79 +104,73 @@ SCANNED_MESHES = {"fandisk": HERE.parent.parent / "data" / "meshes" / "fandisk.o
                   "spot": HERE.parent.parent / "data" / "meshes" / "spot.obj"}
 
 
+@functools.lru_cache(maxsize=None)
+def _mesh_truth(mesh_path: Path):
+    """A truth mesh's Open3D RaycastingScene and its triangles' unit normals, built once a
+    process (an evaluation asks for both the distances and the normals)."""
+    loaded = o3d.io.read_triangle_mesh(str(mesh_path))
+    mesh = o3d.geometry.TriangleMesh(loaded.vertices, loaded.triangles)
+    mesh.compute_triangle_normals()
+    scene = o3d.t.geometry.RaycastingScene()
+    scene.add_triangles(o3d.t.geometry.TriangleMesh.from_legacy(mesh))
+    return scene, np.asarray(mesh.triangle_normals)
+
+
 def _mesh_distance(mesh_path: Path, p: np.ndarray) -> np.ndarray:
     """Exact point-to-triangle distance to a mesh (Open3D's RaycastingScene)."""
-    loaded = o3d.io.read_triangle_mesh(str(mesh_path))
-    scene = o3d.t.geometry.RaycastingScene()
-    scene.add_triangles(o3d.t.geometry.TriangleMesh.from_legacy(
-        o3d.geometry.TriangleMesh(loaded.vertices, loaded.triangles)))
+    scene = _mesh_truth(mesh_path)[0]
     return scene.compute_distance(o3d.core.Tensor(p.astype(np.float32))).numpy().astype(np.float64)
 
 
-def true_distance(shape: str, p: np.ndarray) -> np.ndarray:
-    """Unsigned distance to the analytic surface `pointform sample` draws from (exact; for the
-    part, the distance bound of its CSG of exact primitive distances, exact but within its
-    concave creases and the hole's rims, where it may be lower)."""
+def _truth_mesh_path(shape: str):
+    """The mesh that is the truth of `shape`, or None for an analytic shape."""
+    return BUNNY_MESH if shape == "bunny" else SCANNED_MESHES.get(shape)
+
+
+def _signed_distance(shape: str, p: np.ndarray) -> np.ndarray:
+    """Signed distance to an analytic shape, negative inside (exact; for the part, the
+    distance bound of its CSG of exact primitive distances, exact but within its concave
+    creases and the hole's rims, where it may be lower in magnitude)."""
     if shape == "sphere":
-        return np.abs(np.linalg.norm(p, axis=1) - 1.0)
+        return np.linalg.norm(p, axis=1) - 1.0
     if shape == "torus":
         rho = np.hypot(p[:, 0], p[:, 1])
-        return np.abs(np.hypot(rho - 1.0, p[:, 2]) - 0.35)
+        return np.hypot(rho - 1.0, p[:, 2]) - 0.35
     if shape == "two-spheres":
         c = np.where(p[:, :1] > 0, 1.6, -1.6)
-        return np.abs(np.linalg.norm(p - np.concatenate([c, np.zeros((len(p), 2))], 1), axis=1) - 1.0)
+        return np.linalg.norm(p - np.concatenate([c, np.zeros((len(p), 2))], 1), axis=1) - 1.0
     if shape == "plate":
-        return np.abs(_box_sdf(p, (-1.0, -1.0, -0.025), (1.0, 1.0, 0.025)))
+        return _box_sdf(p, (-1.0, -1.0, -0.025), (1.0, 1.0, 0.025))
     if shape == "blobby":
-        return _blobby_distance(p)
-    if shape == "bunny":
-        return _mesh_distance(BUNNY_MESH, p)
-    if shape in SCANNED_MESHES:
-        return _mesh_distance(SCANNED_MESHES[shape], p)
+        inside = np.any([np.linalg.norm(p - np.array(c), axis=1) < r for c, r in BLOBBY], axis=0)
+        return np.where(inside, -1.0, 1.0) * _blobby_distance(p)
     if shape == "part":
         value = np.min([_primitive_sdf(q, p) for q in PART_ADDED], axis=0)
-        value = np.maximum(value, -np.min([_primitive_sdf(q, p) for q in PART_REMOVED], axis=0))
-        return np.abs(value)
+        return np.maximum(value, -np.min([_primitive_sdf(q, p) for q in PART_REMOVED], axis=0))
     raise ValueError(shape)
 
 
-def _inside(shape: str, p: np.ndarray) -> np.ndarray:
-    """Whether points lie inside the analytic solid (the sign of its signed distance)."""
-    if shape == "sphere":
-        return np.linalg.norm(p, axis=1) < 1.0
-    if shape == "torus":
-        return np.hypot(np.hypot(p[:, 0], p[:, 1]) - 1.0, p[:, 2]) < 0.35
-    if shape == "two-spheres":
-        c = np.where(p[:, :1] > 0, 1.6, -1.6)
-        return np.linalg.norm(p - np.concatenate([c, np.zeros((len(p), 2))], 1), axis=1) < 1.0
-    if shape == "plate":
-        return _box_sdf(p, (-1.0, -1.0, -0.025), (1.0, 1.0, 0.025)) < 0.0
-    if shape == "blobby":
-        return np.any([np.linalg.norm(p - np.array(c), axis=1) < r for c, r in BLOBBY], axis=0)
-    if shape == "part":
-        return (np.min([_primitive_sdf(q, p) for q in PART_ADDED], axis=0) < 0.0) & \
-            (np.min([_primitive_sdf(q, p) for q in PART_REMOVED], axis=0) > 0.0)
-    raise ValueError(shape)
+def true_distance(shape: str, p: np.ndarray) -> np.ndarray:
+    """Unsigned distance to the surface `pointform sample` draws from, or to the truth mesh of
+    the bunny and the scanned meshes (see _signed_distance())."""
+    mesh_path = _truth_mesh_path(shape)
+    if mesh_path is not None:
+        return _mesh_distance(mesh_path, p)
+    return np.abs(_signed_distance(shape, p))
 
 
 def true_normals(shape: str, p: np.ndarray, diag: float) -> np.ndarray:
     """The truth's outward unit normal nearest each point: a mesh truth's nearest triangle's; an
     analytic shape's the gradient of its signed distance (central differences of 10⁻⁴ of the
     diagonal; where the distance is not smooth, at the medial axis, any direction of it)."""
-    if shape == "bunny" or shape in SCANNED_MESHES:
-        loaded = o3d.io.read_triangle_mesh(str(BUNNY_MESH if shape == "bunny" else
-                                               SCANNED_MESHES[shape]))
-        mesh = o3d.geometry.TriangleMesh(loaded.vertices, loaded.triangles)
-        mesh.compute_triangle_normals()
-        scene = o3d.t.geometry.RaycastingScene()
-        scene.add_triangles(o3d.t.geometry.TriangleMesh.from_legacy(mesh))
+    mesh_path = _truth_mesh_path(shape)
+    if mesh_path is not None:
+        scene, normals = _mesh_truth(mesh_path)
         closest = scene.compute_closest_points(o3d.core.Tensor(p.astype(np.float32)))
-        return np.asarray(mesh.triangle_normals)[closest["primitive_ids"].numpy()]
-
-    def signed(q):
-        return np.where(_inside(shape, q), -1.0, 1.0) * true_distance(shape, q)
+        return normals[closest["primitive_ids"].numpy()]
     h = 1e-4 * diag
-    gradient = np.stack([signed(p + h * e) - signed(p - h * e) for e in np.eye(3)], 1)
+    gradient = np.stack([_signed_distance(shape, p + h * e) - _signed_distance(shape, p - h * e)
+                         for e in np.eye(3)], 1)
     return gradient / np.maximum(np.linalg.norm(gradient, axis=1), 1e-300)[:, None]
 
 
