@@ -23,7 +23,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <numbers>
 #include <random>
 #include <utility>
@@ -274,34 +273,22 @@ TEST(HoleFill, AMarchingCubesMeshOfAPartialScanKeepsItsRim)
     EXPECT_EQ(analyze_topology(mesh).boundary_loops, 1U);
 }
 
-/// The unit icosphere without the faces whose centroid `cut` takes, its vertices compacted.
+/// The unit icosphere without the faces whose centroid `cut` takes (keep_faces()).
 template <class Cut>
 TriMesh sphere_without(const Cut& cut)
 {
-    const TriMesh sphere = test::icosphere(5);
-    TriMesh out;
-    std::vector<std::uint32_t> index(sphere.vertex_count(),
-                                     std::numeric_limits<std::uint32_t>::max());
-    for (const Triangle& t : sphere.triangles)
+    TriMesh sphere = test::icosphere(5);
+    std::vector<std::uint8_t> keep(sphere.face_count());
+    for (std::size_t f = 0; f < sphere.face_count(); ++f)
     {
+        const Triangle& t = sphere.triangles[f];
         const Vec3d c = (sphere.vertices.world(t[0]) + sphere.vertices.world(t[1]) +
                          sphere.vertices.world(t[2])) /
                         3.0;
-        if (cut(c))
-            continue;
-        Triangle kept{};
-        for (std::size_t k = 0; k < 3; ++k)
-        {
-            if (index[t[k]] == std::numeric_limits<std::uint32_t>::max())
-            {
-                index[t[k]] = static_cast<std::uint32_t>(out.vertices.positions.size());
-                out.vertices.positions.push_back(sphere.vertices.positions[t[k]]);
-            }
-            kept[k] = index[t[k]];
-        }
-        out.triangles.push_back(kept);
+        keep[f] = cut(c) ? 0 : 1;
     }
-    return out;
+    (void)keep_faces(sphere, keep);
+    return sphere;
 }
 
 TEST(HoleFill, AHoleIsMeasuredByTheAreaItsRimSpansNotByItsVectorArea)
