@@ -710,9 +710,8 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
             const auto f = static_cast<std::uint32_t>(refs[i / group].face * group + i % group);
             face_ids_[i] = f;
             const auto& t = mesh.triangles[f];
-            corners_[i] = Corners{mesh.vertices.positions[t[0]].cast<double>(),
-                                  mesh.vertices.positions[t[1]].cast<double>(),
-                                  mesh.vertices.positions[t[2]].cast<double>()};
+            corners_[i] = Corners{mesh.vertices.positions[t[0]], mesh.vertices.positions[t[1]],
+                                  mesh.vertices.positions[t[2]]};
         }
     });
 }
@@ -783,9 +782,9 @@ Aabb TriangleBvh::bounds() const
         return box;
     for (const Corners& k : corners_)
     {
-        box.extend(origin_ + k.a);
-        box.extend(origin_ + k.b);
-        box.extend(origin_ + k.c);
+        box.extend(origin_ + k.a.cast<double>());
+        box.extend(origin_ + k.b.cast<double>());
+        box.extend(origin_ + k.c.cast<double>());
     }
     return box;
 }
@@ -839,9 +838,11 @@ TriangleBvh::Hit TriangleBvh::closest(const Vec3d& world_point, double max_dista
         {
             for (std::uint32_t i = node.index; i < node.index + node.count; ++i)
             {
-                const Corners& k = corners_[i];
-                const Vec3d bary = closest_point_barycentric(p, k.a, k.b, k.c);
-                const Vec3d q = bary[0] * k.a + bary[1] * k.b + bary[2] * k.c;
+                const Vec3d a = corners_[i].a.cast<double>();
+                const Vec3d b = corners_[i].b.cast<double>();
+                const Vec3d c = corners_[i].c.cast<double>();
+                const Vec3d bary = closest_point_barycentric(p, a, b, c);
+                const Vec3d q = bary[0] * a + bary[1] * b + bary[2] * c;
                 const double d2 = (p - q).squaredNorm();
                 if (d2 < best2)
                 {
@@ -869,7 +870,8 @@ TriangleBvh::Hit TriangleBvh::closest(const Vec3d& world_point, double max_dista
     if (best_slot == std::numeric_limits<std::uint32_t>::max())
         return hit;
     const Corners& k = corners_[best_slot];
-    const Vec3d q = best_bary[0] * k.a + best_bary[1] * k.b + best_bary[2] * k.c;
+    const Vec3d q = best_bary[0] * k.a.cast<double>() + best_bary[1] * k.b.cast<double>() +
+                    best_bary[2] * k.c.cast<double>();
     hit.face = FaceId(face_ids_[best_slot]);
     hit.barycentric = best_bary;
     hit.point = origin_ + q;
@@ -895,9 +897,11 @@ bool TriangleBvh::any_within(const Vec3d& world_point, double distance) const
         {
             for (std::uint32_t i = node.index; i < node.index + node.count; ++i)
             {
-                const Corners& k = corners_[i];
-                const Vec3d bary = closest_point_barycentric(p, k.a, k.b, k.c);
-                if ((p - (bary[0] * k.a + bary[1] * k.b + bary[2] * k.c)).squaredNorm() < limit2)
+                const Vec3d a = corners_[i].a.cast<double>();
+                const Vec3d b = corners_[i].b.cast<double>();
+                const Vec3d c = corners_[i].c.cast<double>();
+                const Vec3d bary = closest_point_barycentric(p, a, b, c);
+                if ((p - (bary[0] * a + bary[1] * b + bary[2] * c)).squaredNorm() < limit2)
                     return true;
             }
             continue;

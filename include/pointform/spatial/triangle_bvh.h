@@ -116,12 +116,13 @@ private:
         std::uint32_t count;
     };
 
-    /// A triangle's corners relative to origin_, in double precision.
+    /// A triangle's corners relative to origin_, as the mesh holds them (the queries work in
+    /// double precision from these floats, which convert exactly; half the memory of doubles).
     struct Corners
     {
-        Vec3d a;
-        Vec3d b;
-        Vec3d c;
+        Vec3f a;
+        Vec3f b;
+        Vec3f c;
     };
 
     Vec3d origin_ = Vec3d::Zero();
