@@ -8,6 +8,7 @@
 #include "pointform/spatial/feature_grid.h"
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/point_grid.h"
+#include "pointform/spatial/spatial_sort.h"
 
 #include "blend_kernels.h"
 
@@ -1276,12 +1277,18 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
     std::vector<float> query_reach(subsample);
     std::vector<float> fit_reach(subsample);
     std::vector<double> fit_flatness(subsample);
+    // Searched along a Morton curve, as measure_sampling_density() does (the same searches).
+    std::vector<Vec3f> probes(subsample);
+    for (std::size_t r = 0; r < subsample; ++r)
+        probes[r] = m.surfels.positions[r * stride];
+    const std::vector<std::uint32_t> probe_order = spatial_order(probes);
     parallel_blocks(subsample, 256, [&](std::size_t begin, std::size_t end) {
         std::vector<std::uint32_t> index(reach_k);
         std::vector<float> d2(reach_k);
-        for (std::size_t r = begin; r < end; ++r)
+        for (std::size_t o = begin; o < end; ++o)
         {
-            m.tree.knn(m.surfels.positions[r * stride], reach_k, index, d2);
+            const std::size_t r = probe_order[o];
+            m.tree.knn(probes[r], reach_k, index, d2);
             query_reach[r] = d2[query_k - 1];
             fit_reach[r] = d2[k - 1];
             fit_flatness[r] = flatness(m.surfels.positions, std::span(index).first(k));

@@ -6,6 +6,7 @@
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 #include "pointform/spatial/kd_tree.h"
+#include "pointform/spatial/spatial_sort.h"
 
 #include <algorithm>
 #include <cmath>
@@ -38,14 +39,23 @@ SamplingDensity measure_sampling_density(const KdTree& tree, const PointCloudVie
     const std::size_t k = std::min<std::size_t>(8, samples.size());
     std::vector<double> nearest(queries, -1.0);
     ProgressReporter reporter(progress, "sampling density");
+    // Searched along a Morton curve: neighbouring queries then walk the same nodes of the tree
+    // while they are in cache (the samples may come in any order: on the clean 1M blobby of
+    // bench/peers, in random order, 0.11-0.13 s instead of 0.30-0.41 s at 2 threads). The same
+    // searches, so the same distances.
+    std::vector<Vec3f> points(queries);
+    for (std::size_t q = 0; q < queries; ++q)
+        points[q] = samples.positions[q * stride];
+    const std::vector<std::uint32_t> order = spatial_order(points);
     parallel_blocks(
         queries, 1024,
         [&](std::size_t begin, std::size_t end) {
             std::vector<std::uint32_t> indices(k);
             std::vector<float> d2(k);
-            for (std::size_t q = begin; q < end; ++q)
+            for (std::size_t r = begin; r < end; ++r)
             {
-                const std::size_t found = tree.knn(samples.positions[q * stride], k, indices, d2);
+                const std::size_t q = order[r];
+                const std::size_t found = tree.knn(points[q], k, indices, d2);
                 for (std::size_t i = 0; i < found; ++i)
                     if (d2[i] > 0.0F)
                     {
