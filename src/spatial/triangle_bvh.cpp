@@ -782,9 +782,8 @@ Aabb TriangleBvh::bounds() const
         return box;
     for (const Corners& k : corners_)
     {
-        box.extend(origin_ + k.a.cast<double>());
-        box.extend(origin_ + k.b.cast<double>());
-        box.extend(origin_ + k.c.cast<double>());
+        for (const Vec3d& corner : k.widened())
+            box.extend(origin_ + corner);
     }
     return box;
 }
@@ -838,9 +837,7 @@ TriangleBvh::Hit TriangleBvh::closest(const Vec3d& world_point, double max_dista
         {
             for (std::uint32_t i = node.index; i < node.index + node.count; ++i)
             {
-                const Vec3d a = corners_[i].a.cast<double>();
-                const Vec3d b = corners_[i].b.cast<double>();
-                const Vec3d c = corners_[i].c.cast<double>();
+                const auto [a, b, c] = corners_[i].widened();
                 const Vec3d bary = closest_point_barycentric(p, a, b, c);
                 const Vec3d q = bary[0] * a + bary[1] * b + bary[2] * c;
                 const double d2 = (p - q).squaredNorm();
@@ -869,9 +866,8 @@ TriangleBvh::Hit TriangleBvh::closest(const Vec3d& world_point, double max_dista
     }
     if (best_slot == std::numeric_limits<std::uint32_t>::max())
         return hit;
-    const Corners& k = corners_[best_slot];
-    const Vec3d q = best_bary[0] * k.a.cast<double>() + best_bary[1] * k.b.cast<double>() +
-                    best_bary[2] * k.c.cast<double>();
+    const auto [a, b, c] = corners_[best_slot].widened();
+    const Vec3d q = best_bary[0] * a + best_bary[1] * b + best_bary[2] * c;
     hit.face = FaceId(face_ids_[best_slot]);
     hit.barycentric = best_bary;
     hit.point = origin_ + q;
@@ -897,9 +893,7 @@ bool TriangleBvh::any_within(const Vec3d& world_point, double distance) const
         {
             for (std::uint32_t i = node.index; i < node.index + node.count; ++i)
             {
-                const Vec3d a = corners_[i].a.cast<double>();
-                const Vec3d b = corners_[i].b.cast<double>();
-                const Vec3d c = corners_[i].c.cast<double>();
+                const auto [a, b, c] = corners_[i].widened();
                 const Vec3d bary = closest_point_barycentric(p, a, b, c);
                 if ((p - (bary[0] * a + bary[1] * b + bary[2] * c)).squaredNorm() < limit2)
                     return true;

@@ -123,6 +123,12 @@ private:
         Vec3f a;
         Vec3f b;
         Vec3f c;
+
+        /// The corners in double precision, as the queries use them.
+        [[nodiscard]] std::array<Vec3d, 3> widened() const
+        {
+            return {a.cast<double>(), b.cast<double>(), c.cast<double>()};
+        }
     };
 
     Vec3d origin_ = Vec3d::Zero();
