@@ -21,9 +21,10 @@ namespace {
 
 /// The samples whose nearest triangle lies in each component. The largest component (most
 /// faces) is weighed against the rest: a sample's nearest triangle among the rest (usually few
-/// faces), then whether the largest has one strictly closer (a search that stops at the first
-/// such triangle). The nearest triangle of the whole mesh is in the component found, as an
-/// exact search finds it, but for exact ties, which go to the rest.
+/// faces), then whether the largest has one strictly closer: a point of it found for an earlier
+/// sample (in Morton order) that is, or else a search bounded by the rest's distance. The
+/// nearest triangle of the whole mesh is in the component found, as an exact search finds it,
+/// but for exact ties, which go to the rest.
 std::vector<std::size_t> component_support(const TriMesh& mesh,
                                            const std::vector<std::uint32_t>& face_component,
                                            std::size_t components, const PointCloud& samples)
@@ -63,7 +64,11 @@ std::vector<std::size_t> component_support(const TriMesh& mesh,
     const std::vector<std::uint32_t> order = spatial_order(samples.positions);
     parallel_blocks(order.size(), 1024, [&](std::size_t begin, std::size_t end) {
         // The nearest point among the rest found for the sample before bounds the next search.
-        Vec3d previous = Vec3d::Constant(std::numeric_limits<double>::quiet_NaN());
+        constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+        Vec3d previous = Vec3d::Constant(nan);
+        // A point of the largest component found for an earlier sample: where it is nearer
+        // than the rest (by a margin far above rounding), so is the largest, with no search.
+        Vec3d on_large = Vec3d::Constant(nan);
         for (std::size_t k = begin; k < end; ++k)
         {
             const std::uint32_t i = order[k];
@@ -77,8 +82,21 @@ std::vector<std::size_t> component_support(const TriMesh& mesh,
             if (!hit.found())
                 continue; // a non-finite sample
             previous = hit.point;
-            nearest[i] =
-                large_bvh.any_within(p, hit.distance) ? largest : rest_component[hit.face.value];
+            if ((p - on_large).norm() * (1.0 + 1e-9) < hit.distance)
+            {
+                nearest[i] = largest;
+                continue;
+            }
+            const TriangleBvh::Hit large_hit = large_bvh.closest(p, hit.distance);
+            if (large_hit.found() && large_hit.distance < hit.distance)
+            {
+                on_large = large_hit.point;
+                nearest[i] = largest;
+            }
+            else
+            {
+                nearest[i] = rest_component[hit.face.value];
+            }
         }
     });
     std::vector<std::size_t> support(components, 0);
