@@ -456,13 +456,17 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
     BuildBox root;
     for (const BuildBox& box : block_box)
         root.merge(box);
-    std::vector<BuildRef> scratch; // the parallel partitions' output, then copied back
-
     // Splits [begin, end) (of node box `box`) into two children, writing their boxes, or
     // returns begin for a leaf. Large ranges are binned and partitioned in fixed blocks in
-    // parallel (the same tree for any thread count: the bins' boxes and counts merge exactly).
+    // parallel (the same tree for any thread count: the bins' boxes and counts merge exactly),
+    // through `scratch`, which is the caller's own: the subtrees are built at once, and a
+    // subtree of more than parallel_split_refs groups (a mesh of over about a million) splits
+    // its ranges in blocks too; one buffer shared by them was resized and written by two
+    // threads at once (a 20M-face mesh crashed the build; the 10M-sample refinement's level 4
+    // aborted or measured distances to a corrupted tree).
     const auto split = [&](std::size_t begin, std::size_t end, int depth, const BuildBox& box,
-                           BuildBox& left, BuildBox& right) -> std::size_t {
+                           BuildBox& left, BuildBox& right,
+                           std::vector<BuildRef>& scratch) -> std::size_t {
         const std::size_t count = end - begin;
         if (count <= leaf_size)
             return begin;
@@ -578,6 +582,7 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
         };
         constexpr std::size_t no_parent = std::numeric_limits<std::size_t>::max();
         std::vector<Pending> pending;
+        std::vector<BuildRef> scratch;
         pending.push_back({first, last, first_depth, no_parent, first_box});
         BuildBox left;
         BuildBox right;
@@ -596,7 +601,7 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
                 }
                 out.push_back(node_of(range.box));
                 const std::size_t mid =
-                    split(range.begin, range.end, range.depth, range.box, left, right);
+                    split(range.begin, range.end, range.depth, range.box, left, right, scratch);
                 if (mid == range.begin || mid == range.end)
                 {
                     out[node_index].index = static_cast<std::uint32_t>(range.begin);
@@ -630,6 +635,7 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
     // Subtrees of at most this many triangles, or below this depth, are built in parallel.
     constexpr std::size_t subtree_triangles = 16384;
     constexpr int top_depth = 6;
+    std::vector<BuildRef> scratch; // the top splits' partitions (one after another)
     const auto split_top = [&](const auto& self, std::size_t begin, std::size_t end, int depth,
                                const BuildBox& box) -> std::size_t {
         const std::size_t at = tops.size();
@@ -642,7 +648,7 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
         }
         BuildBox left_box;
         BuildBox right_box;
-        const std::size_t mid = split(begin, end, depth, box, left_box, right_box);
+        const std::size_t mid = split(begin, end, depth, box, left_box, right_box, scratch);
         if (mid == begin || mid == end)
         {
             tops[at].leaf = true;
