@@ -460,10 +460,11 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
     // returns begin for a leaf. Large ranges are binned and partitioned in fixed blocks in
     // parallel (the same tree for any thread count: the bins' boxes and counts merge exactly),
     // through `scratch`, which is the caller's own: the subtrees are built at once, and a
-    // subtree of more than parallel_split_refs groups (a mesh of over about a million) splits
-    // its ranges in blocks too; one buffer shared by them was resized and written by two
-    // threads at once (a 20M-face mesh crashed the build; the 10M-sample refinement's level 4
-    // aborted or measured distances to a corrupted tree).
+    // subtree of more than parallel_split_refs groups (from meshes of a few million faces up,
+    // as the top splits are unbalanced) splits its ranges in blocks too; one buffer shared by
+    // them was resized and written by two threads at once (a 20M-face mesh crashed the build;
+    // the 10M-sample refinement's level 4, 12M faces, aborted or measured distances to a
+    // corrupted tree).
     const auto split = [&](std::size_t begin, std::size_t end, int depth, const BuildBox& box,
                            BuildBox& left, BuildBox& right,
                            std::vector<BuildRef>& scratch) -> std::size_t {
