@@ -4,9 +4,12 @@
 #include "pointform/geometry/point_cloud.h"
 
 #include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
 
 #include <cmath>
 #include <string>
+#include <type_traits>
+#include <utility>
 
 namespace pointform {
 
@@ -56,6 +59,26 @@ std::size_t keep_points(PointCloud& cloud, std::span<const std::uint8_t> keep)
     compact(cloud.colors);
     compact(cloud.radii);
     return before - cloud.size();
+}
+
+void reorder_points(PointCloud& cloud, std::span<const std::uint32_t> order)
+{
+    PF_ASSERT(order.size() == cloud.size());
+    const auto gather = [&](auto& values) {
+        if (values.empty())
+            return;
+        std::remove_reference_t<decltype(values)> out(values.size());
+        parallel_blocks(order.size(), std::size_t{1} << 16U,
+                        [&](std::size_t begin, std::size_t end) {
+                            for (std::size_t j = begin; j < end; ++j)
+                                out[j] = values[order[j]];
+                        });
+        values = std::move(out);
+    };
+    gather(cloud.positions);
+    gather(cloud.normals);
+    gather(cloud.colors);
+    gather(cloud.radii);
 }
 
 Vec3d choose_origin(const Vec3d& first)

@@ -86,19 +86,16 @@ public:
     using IndexType = std::uint32_t;
     using CountType = std::size_t;
 
-    /// `coincident_in_order`: points at one place lie in one leaf in ascending index order (the
-    /// Morton tree's leaves, whose order is the points' or, in a refined cell, sorted by key and
-    /// then index); then a query whose k nearest are all
-    /// coincident with it stops at the next coincident point (a higher index, as is every
-    /// point left in that leaf; every other point is farther), instead of offering every copy:
-    /// a cloud with 50,000 copies of one point took 84 s with nanoflann's tree and 8 s with the
-    /// Morton tree before this.
+    /// The tree's leaves hold points at one place in ascending index order (build_in_order()),
+    /// so a query whose k nearest are all coincident with it stops at the next coincident point
+    /// (a higher index, as is every point left in that leaf; every other point is farther),
+    /// instead of offering every copy: a cloud with 50,000 copies of one point took 84 s with
+    /// nanoflann's tree and 8 s with the Morton tree before this.
+    /// `original`: the caller's index of each of the tree's points (null: the same), whose
+    /// order those copies keep.
     OrderedKnnResult(std::size_t capacity, std::uint32_t* indices, float* distances,
-                     bool coincident_in_order)
-        : capacity_(capacity),
-          indices_(indices),
-          distances_(distances),
-          coincident_in_order_(coincident_in_order)
+                     const std::uint32_t* original)
+        : capacity_(capacity), indices_(indices), distances_(distances), original_(original)
     {}
 
     [[nodiscard]] std::size_t size() const { return count_; }
@@ -107,11 +104,13 @@ public:
     /// Inserts (dist, index) in order; always lets the search go on.
     bool addPoint(float dist, std::uint32_t index)
     {
+        if (original_ != nullptr)
+            index = original_[index];
         const auto before = [](float d1, std::uint32_t i1, float d2, std::uint32_t i2) {
             return d1 < d2 || (d1 == d2 && i1 < i2);
         };
         if (full() && !before(dist, index, distances_[capacity_ - 1], indices_[capacity_ - 1]))
-            return !(coincident_in_order_ && dist == 0.0F && distances_[capacity_ - 1] == 0.0F);
+            return !(dist == 0.0F && distances_[capacity_ - 1] == 0.0F);
         std::size_t i = full() ? capacity_ - 1 : count_++;
         for (; i > 0 && before(dist, index, distances_[i - 1], indices_[i - 1]); --i)
         {
@@ -138,10 +137,46 @@ private:
     std::size_t capacity_;
     std::uint32_t* indices_;
     float* distances_;
+    const std::uint32_t* original_;
     std::size_t count_ = 0;
     static constexpr float infinity = std::numeric_limits<float>::infinity();
     float bound_ = infinity; ///< worstDist(): infinite until full
-    bool coincident_in_order_;
+};
+
+/// The nearest point found, as nanoflann's KNNResultSet of one keeps it (a point replaces it only
+/// when strictly nearer, so of several tied the first met), with the caller's index. The bound
+/// may start at a given point's distance.
+class NearestResult
+{
+public:
+    using DistanceType = float;
+    using IndexType = std::uint32_t;
+    using CountType = std::size_t;
+
+    NearestResult(const std::uint32_t* original, std::uint32_t index, float distance)
+        : original_(original), index_(index), distance_(distance)
+    {}
+
+    [[nodiscard]] std::size_t size() const { return 1; }
+    [[nodiscard]] bool full() const { return true; }
+
+    bool addPoint(float dist, std::uint32_t index)
+    {
+        if (dist < distance_)
+        {
+            distance_ = dist;
+            index_ = original_ != nullptr ? original_[index] : index;
+        }
+        return true;
+    }
+
+    [[nodiscard]] float worstDist() const { return distance_; }
+    [[nodiscard]] std::uint32_t index() const { return index_; }
+
+private:
+    const std::uint32_t* original_;
+    std::uint32_t index_;
+    float distance_;
 };
 
 using Node = NanoTree::Node;
@@ -182,48 +217,7 @@ MortonSplit morton_split(std::span<const std::uint64_t> keys, Offset left, Offse
     return {middle, bit % 3};
 }
 
-/// nanoflann's divideTree(), node for node (same splits, same leaves, same order of indices),
-/// with the nodes taken in turn from `next`: each subtree built at once has a range of its own.
-Node* divide_tree(NanoTree& tree, std::span<const Vec3f> points, Node*& next, Offset left,
-                  Offset right, BoundingBox& bbox)
-{
-    Node* node = next++;
-    if (right - left <= tree.m_leaf_max_size)
-    {
-        node->child1 = node->child2 = nullptr;
-        node->node_type.lr.left = left;
-        node->node_type.lr.right = right;
-        for (int d = 0; d < 3; ++d)
-            bbox[d].low = bbox[d].high = points[tree.vAcc[left]][d];
-        for (Offset k = left + 1; k < right; ++k)
-            for (int d = 0; d < 3; ++d)
-            {
-                const float v = points[tree.vAcc[k]][d];
-                if (bbox[d].low > v)
-                    bbox[d].low = v;
-                if (bbox[d].high < v)
-                    bbox[d].high = v;
-            }
-        return node;
-    }
-    Offset index = 0;
-    NanoTree::Dimension cutfeat = 0;
-    float cutval = 0.0F;
-    tree.middleSplit_(tree, left, right - left, index, cutfeat, cutval, bbox);
-    node->node_type.sub.divfeat = cutfeat;
-    BoundingBox left_bbox(bbox);
-    left_bbox[cutfeat].high = cutval;
-    node->child1 = divide_tree(tree, points, next, left, left + index, left_bbox);
-    BoundingBox right_bbox(bbox);
-    right_bbox[cutfeat].low = cutval;
-    node->child2 = divide_tree(tree, points, next, left + index, right, right_bbox);
-    node->node_type.sub.divlow = left_bbox[cutfeat].high;
-    node->node_type.sub.divhigh = right_bbox[cutfeat].low;
-    bbox = united(left_bbox, right_bbox);
-    return node;
-}
-
-/// Points a subtree at least, below which it is built by one thread (divide_tree()).
+/// Points a subtree at least, below which it is built by one thread (morton_subtree()).
 constexpr std::size_t min_subtree = 8192;
 
 /// The subtree of points [left, right) of the tree's order `vacc`, whose Morton `keys` do not
@@ -276,12 +270,10 @@ struct Top
 {
     Offset left;
     Offset right;
-    BoundingBox bbox{}; // the box handed down (if any); the points' own box once built
+    BoundingBox bbox{}; // the points' own box once built
     std::size_t child1 = 0;
     std::size_t child2 = 0;
     NanoTree::Dimension cutfeat = 0;
-    float cutval = 0.0F;
-    Offset index = 0;
     bool split = false;
     Node* node = nullptr;
 };
@@ -320,19 +312,26 @@ void finish_tree(NanoTree& tree, std::vector<Top>& top, std::span<const std::siz
 
 struct KdTree::Impl
 {
-    PositionSpan data;
+    /// The caller's points.
+    std::span<const Vec3f> original;
+    /// The caller's points in Morton order (spatial_order()), when they are not in it already:
+    /// a tree over points scattered in memory (a file's order) answers queries several times
+    /// slower, each point of a leaf on another cache line. Empty otherwise.
+    std::vector<Vec3f> sorted;
+    /// The caller's index of each point of `sorted` (spatial_order()); empty when not sorted.
+    std::vector<std::uint32_t> original_index;
+    PositionSpan data; ///< what the tree indexes: `sorted`, or else `original`
     NanoTree tree;
-    /// Built by build_in_order(): all copies of a point lie in one leaf, in index order.
-    bool in_order = false;
-    /// The nodes of the subtrees built at once (the tree's own pool has the top ones): the
-    /// subtree of points [left, right) has nodes [2 left, 2 right), more than its at most
-    /// 2 (right - left) - 1. Left uninitialised, so only the pages used are ever resident; one
-    /// block allocated by this thread, rather than pools by the threads that build the
-    /// subtrees, which would keep the freed nodes in their own malloc arenas.
+    /// The subtrees' nodes (the tree's own pool has the top ones): the subtree of points
+    /// [left, right) has nodes [2 left, 2 right), more than its at most 2 (right - left) - 1.
+    /// Left uninitialised, so only the pages used are ever resident; one block allocated by this
+    /// thread, rather than pools by the threads that build the subtrees, which would keep the
+    /// freed nodes in their own malloc arenas.
     std::unique_ptr<Node[]> nodes;
 
     Impl(std::span<const Vec3f> points, std::size_t leaf)
-        : data{points},
+        : original(points),
+          data{points},
           tree(3, data,
                nanoflann::KDTreeSingleIndexAdaptorParams(
                    leaf, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex))
@@ -341,45 +340,60 @@ struct KdTree::Impl
             build();
     }
 
-    /// Points in Morton order (spatial_order(), as compute_surfels() and the field sort them)
-    /// get a tree split where their Morton keys first differ (build_in_order()): in one pass
-    /// over the points, in their order (but in cells that a far outlier made too large, which
-    /// are keyed again over their own box). Others get nanoflann's tree
-    /// (build_by_splits()). The k nearest neighbours do not depend on the tree (OrderedKnnResult).
-    void build();
+    /// The caller's index of each tree index, or null when they are the same.
+    [[nodiscard]] const std::uint32_t* caller_index() const
+    {
+        return original_index.empty() ? nullptr : original_index.data();
+    }
 
-    /// nanoflann's buildIndex(), giving the same tree, in parallel: the top nodes are split
-    /// level by level, the nodes of a level at once, down to subtrees of about n / 64 points
-    /// (at least min_subtree), which are then built at once; the top nodes' split bounds and
-    /// boxes are filled in last, from their children's boxes, bottom up.
-    void build_by_splits();
+    /// The tree over the points in Morton order (build_in_order()), the caller's if they are
+    /// in it (as compute_surfels() and the field sort them), or else a copy put in it. The
+    /// tree's layout does not change the k nearest neighbours (OrderedKnnResult) nor the
+    /// caller's indices of any result.
+    void build();
 
     /// The tree of morton_subtree() over points whose Morton `keys` do not decrease: the top
     /// nodes one by one down to subtrees of about n / 64 points (at least min_subtree), which
-    /// are built at once; the top nodes' split bounds and boxes last, bottom up.
+    /// are built at once; the top nodes' split bounds and boxes last, bottom up. Points at one
+    /// place lie in one leaf, in index order.
     void build_in_order(std::span<std::uint64_t> keys);
 };
 
 void KdTree::Impl::build()
 {
-    const std::size_t n = data.points.size();
+    const std::size_t n = original.size();
     // Filled in parallel (so the pages are touched where they are used), hence not zeroed first.
     const auto storage = std::make_unique_for_overwrite<std::uint64_t[]>(n);
-    const std::span<std::uint64_t> keys(storage.get(), n);
-    morton_keys(data.points, keys);
-    std::atomic<bool> sorted{true};
+    std::span<std::uint64_t> keys(storage.get(), n);
+    morton_keys(original, keys);
+    std::atomic<bool> in_order{true};
     parallel_blocks(n - 1, 1U << 16U, [&](std::size_t begin, std::size_t end) {
         bool local = true;
         for (std::size_t i = begin; i < end; ++i)
             local &= keys[i] <= keys[i + 1];
         if (!local)
-            sorted.store(false, std::memory_order_relaxed);
+            in_order.store(false, std::memory_order_relaxed);
     });
-    in_order = sorted.load();
-    if (in_order)
+    if (in_order.load())
+    {
         build_in_order(keys);
-    else
-        build_by_splits();
+        return;
+    }
+    // The same keys in the new order (the box is the same), which does not decrease them;
+    // points at one place keep their order.
+    original_index = pointform::spatial_order(original);
+    sorted.resize(n);
+    const auto sorted_storage = std::make_unique_for_overwrite<std::uint64_t[]>(n);
+    const std::span<std::uint64_t> sorted_keys(sorted_storage.get(), n);
+    parallel_blocks(n, 1U << 16U, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            sorted[i] = original[original_index[i]];
+            sorted_keys[i] = keys[original_index[i]];
+        }
+    });
+    data.points = sorted;
+    build_in_order(sorted_keys);
 }
 
 void KdTree::Impl::build_in_order(std::span<std::uint64_t> keys)
@@ -423,84 +437,6 @@ void KdTree::Impl::build_in_order(std::span<std::uint64_t> keys)
     });
 }
 
-void KdTree::Impl::build_by_splits()
-{
-    const std::span<const Vec3f> points = data.points;
-    const std::size_t n = points.size();
-    tree.m_size = n;
-    tree.m_size_at_index_build = n;
-    tree.vAcc.resize(n);
-    constexpr std::size_t block = 1U << 16U;
-    const std::size_t blocks = (n + block - 1) / block;
-    std::vector<BoundingBox> block_boxes(blocks);
-    parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
-        BoundingBox& box = block_boxes[begin / block];
-        for (int d = 0; d < 3; ++d)
-            box[d].low = box[d].high = points[begin][d];
-        for (std::size_t i = begin; i < end; ++i)
-        {
-            tree.vAcc[i] = static_cast<std::uint32_t>(i);
-            for (int d = 0; d < 3; ++d)
-            {
-                const float v = points[i][d];
-                box[d].low = std::min(box[d].low, v);
-                box[d].high = std::max(box[d].high, v);
-            }
-        }
-    });
-    BoundingBox root_box = block_boxes[0];
-    for (const BoundingBox& box : block_boxes)
-        for (int d = 0; d < 3; ++d)
-        {
-            root_box[d].low = std::min(root_box[d].low, box[d].low);
-            root_box[d].high = std::max(root_box[d].high, box[d].high);
-        }
-
-    // The top of the tree: nodes in the order they are made, so a node's children come after it.
-    const std::size_t grain = std::max({min_subtree, n / 64, tree.m_leaf_max_size});
-    std::vector<Top> top{{.left = 0, .right = n, .bbox = root_box}};
-    std::vector<std::size_t> level{0};
-    std::vector<std::size_t> subtrees;
-    while (!level.empty())
-    {
-        std::vector<std::size_t> splits;
-        for (const std::size_t t : level)
-            (top[t].right - top[t].left > grain ? splits : subtrees).push_back(t);
-        parallel_blocks(splits.size(), 1, [&](std::size_t begin, std::size_t end) {
-            for (std::size_t s = begin; s < end; ++s)
-            {
-                Top& node = top[splits[s]];
-                tree.middleSplit_(tree, node.left, node.right - node.left, node.index, node.cutfeat,
-                                  node.cutval, node.bbox);
-                node.split = true;
-            }
-        });
-        level.clear();
-        for (const std::size_t t : splits)
-        {
-            Top low = top[t];
-            low.right = top[t].left + top[t].index;
-            low.bbox[top[t].cutfeat].high = top[t].cutval;
-            low.split = false;
-            Top high = top[t];
-            high.left = low.right;
-            high.bbox[top[t].cutfeat].low = top[t].cutval;
-            high.split = false;
-            top[t].child1 = top.size();
-            level.push_back(top.size());
-            top.push_back(low);
-            top[t].child2 = top.size();
-            level.push_back(top.size());
-            top.push_back(high);
-        }
-    }
-    nodes.reset(new Node[2 * n]); // NOLINT(cppcoreguidelines-owning-memory): not initialised
-    finish_tree(tree, top, subtrees, [&](Top& node) {
-        Node* next = nodes.get() + 2 * node.left;
-        node.node = divide_tree(tree, points, next, node.left, node.right, node.bbox);
-    });
-}
-
 KdTree::KdTree(std::span<const Vec3f> positions, const KdTreeOptions& options)
 {
     if (positions.size() >= std::numeric_limits<std::uint32_t>::max())
@@ -515,7 +451,7 @@ KdTree& KdTree::operator=(KdTree&&) noexcept = default;
 
 std::size_t KdTree::size() const
 {
-    return impl_->data.points.size();
+    return impl_->original.size();
 }
 
 void check_knn_table_shape(const KnnTable& table, std::size_t rows, const char* function)
@@ -567,7 +503,12 @@ void throw_knn_index_out_of_range(std::uint32_t index, std::size_t row, std::siz
 
 std::span<const Vec3f> KdTree::positions() const
 {
-    return impl_->data.points;
+    return impl_->original;
+}
+
+std::span<const std::uint32_t> KdTree::spatial_order() const
+{
+    return impl_->original_index;
 }
 
 std::size_t KdTree::knn(const Vec3f& query, std::size_t k, std::span<std::uint32_t> indices,
@@ -578,7 +519,7 @@ std::size_t KdTree::knn(const Vec3f& query, std::size_t k, std::span<std::uint32
     check_buffer_size("KdTree::knn", "squared_distances", squared_distances.size(), k);
     if (k == 0)
         return 0;
-    OrderedKnnResult result(k, indices.data(), squared_distances.data(), impl_->in_order);
+    OrderedKnnResult result(k, indices.data(), squared_distances.data(), impl_->caller_index());
     impl_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
     return result.size();
 }
@@ -589,16 +530,13 @@ PointId KdTree::nearest_within_factor(const Vec3f& query, float factor,
     PF_ASSERT(factor >= 1.0F);
     if (size() == 0)
         return {};
-    std::uint32_t index = 0;
-    float d2 = 0.0F;
-    nanoflann::KNNResultSet<float, std::uint32_t, std::size_t> result(1);
-    result.init(&index, &d2);
+    NearestResult result(impl_->caller_index(), 0, std::numeric_limits<float>::max());
     nanoflann::SearchParams params;
     params.eps = factor - 1.0F;
     impl_->tree.findNeighbors(result, query.data(), params);
     if (squared_distance != nullptr)
-        *squared_distance = d2;
-    return PointId{index};
+        *squared_distance = result.worstDist();
+    return PointId{result.index()};
 }
 
 PointId KdTree::nearest_within_factor(const Vec3f& query, float factor, PointId start,
@@ -610,20 +548,16 @@ PointId KdTree::nearest_within_factor(const Vec3f& query, float factor, PointId 
                            " is not a point of the tree (" + std::to_string(size()) + " points)");
     // The result set's worst distance is the search's bound: preset it to the start's, so
     // that the search only looks for points nearer than that.
-    std::uint32_t index = 0;
-    float d2 = 0.0F;
-    nanoflann::KNNResultSet<float, std::uint32_t, std::size_t> result(1);
-    result.init(&index, &d2);
-    index = start.value;
-    const Vec3f& from = impl_->data.points[start.value];
-    d2 = detail::unfused_squared_distance(query.x(), query.y(), query.z(), from.x(), from.y(),
-                                          from.z());
+    const Vec3f& from = impl_->original[start.value];
+    NearestResult result(impl_->caller_index(), start.value,
+                         detail::unfused_squared_distance(query.x(), query.y(), query.z(), from.x(),
+                                                          from.y(), from.z()));
     nanoflann::SearchParams params;
     params.eps = factor - 1.0F;
     impl_->tree.findNeighbors(result, query.data(), params);
     if (squared_distance != nullptr)
-        *squared_distance = d2;
-    return PointId{index};
+        *squared_distance = result.worstDist();
+    return PointId{result.index()};
 }
 
 PointId KdTree::nearest(const Vec3f& query, float* squared_distance) const
@@ -647,6 +581,9 @@ std::size_t KdTree::radius_search(const Vec3f& query, float radius,
     nanoflann::SearchParams params;
     params.sorted = false;
     impl_->tree.radiusSearch(query.data(), radius * radius, found, params);
+    if (const std::uint32_t* caller = impl_->caller_index(); caller != nullptr)
+        for (auto& hit : found)
+            hit.first = caller[hit.first];
     std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) {
         return a.second < b.second || (a.second == b.second && a.first < b.first);
     });
@@ -670,13 +607,20 @@ KnnTable knn_batch(const KdTree& tree, std::span<const Vec3f> queries, std::size
     table.indices.resize(queries.size() * k);
     const bool all = !options.farthest_distance_only;
     table.squared_distances.resize(all ? queries.size() * k : queries.size());
+    // The tree's own points are queried in its order, when it sorted them: each query near
+    // the one before.
+    const std::span<const std::uint32_t> order =
+        queries.data() == tree.positions().data() && queries.size() == tree.size()
+            ? tree.spatial_order()
+            : std::span<const std::uint32_t>();
     ProgressReporter progress(options.progress, "k-nearest neighbours");
     parallel_blocks(
         queries.size(), query_block,
         [&](std::size_t begin, std::size_t end) {
             std::vector<float> row(all ? 0 : k);
-            for (std::size_t i = begin; i < end; ++i)
+            for (std::size_t j = begin; j < end; ++j)
             {
+                const std::size_t i = order.empty() ? j : order[j];
                 const std::span<float> distances =
                     all ? std::span<float>(table.squared_distances.data() + i * k, k)
                         : std::span<float>(row);

@@ -137,6 +137,29 @@ TEST(PointCloud, KeepPointsKeepsEveryAttributeInOrder)
     validate(cloud);
 }
 
+TEST(PointCloud, ReorderPointsMovesEveryAttribute)
+{
+    PointCloud cloud;
+    for (int i = 0; i < 4; ++i)
+    {
+        const auto f = static_cast<float>(i);
+        cloud.positions.emplace_back(f, 0.0F, 0.0F);
+        cloud.radii.push_back(10.0F + f);
+        cloud.colors.push_back({static_cast<std::uint8_t>(i), 0, 0});
+    }
+    const std::vector<std::uint32_t> order = {2, 0, 3, 1};
+    reorder_points(cloud, order);
+    ASSERT_EQ(cloud.size(), 4U);
+    EXPECT_TRUE(cloud.normals.empty()); // absent attributes stay absent
+    for (std::size_t j = 0; j < 4; ++j)
+    {
+        EXPECT_EQ(cloud.positions[j].x(), static_cast<float>(order[j]));
+        EXPECT_EQ(cloud.radii[j], 10.0F + static_cast<float>(order[j]));
+        EXPECT_EQ(cloud.colors[j].r, order[j]);
+    }
+    validate(cloud);
+}
+
 TEST(Shapes, BlobbyAndPartSamplesLieOnTheSolidsSurfaceWithOutwardNormals)
 {
     for (const Shape shape : {Shape::Blobby, Shape::Part})

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 
 namespace pointform {
@@ -136,6 +137,29 @@ TEST(Reconstruct, QuantizedCoordinatesGiveTheSurface)
     const SurfelsFromSamples surfels = surfels_from_samples(points);
     EXPECT_GT(surfels.copies, 1000U);
     expect_unit_sphere(reconstruct(surfels.surfels), step);
+}
+
+// The samples are put in Morton order before the field: the same samples in any order (and the
+// same storage origin) give the same mesh, bit for bit.
+TEST(Reconstruct, TheSamplesOrderDoesNotChangeTheMesh)
+{
+    const PointCloud surfels = sphere_surfels(20000);
+    PointCloud shuffled = surfels;
+    std::vector<std::uint32_t> order(surfels.size());
+    std::iota(order.begin(), order.end(), 0U);
+    std::shuffle(order.begin(), order.end(), std::mt19937(8));
+    reorder_points(shuffled, order);
+    ASSERT_NE(shuffled.positions, surfels.positions);
+    const auto finest = [](const PointCloud& samples) {
+        const ReconstructReport report = reconstruct(samples);
+        const MultiresMesh& hierarchy = report.semi_regular.hierarchy;
+        return hierarchy.level_mesh(hierarchy.finest_level());
+    };
+    const TriMesh a = finest(surfels);
+    const TriMesh b = finest(shuffled);
+    EXPECT_GT(a.face_count(), 1000U);
+    EXPECT_EQ(a.triangles, b.triangles);
+    EXPECT_EQ(a.vertices.positions, b.vertices.positions);
 }
 
 TEST(Reconstruct, ExactLevelsAndTheBaseFaceTarget)

@@ -11,7 +11,6 @@
 #include "support/thread_counts.h"
 
 #include <gtest/gtest.h>
-#include <nanoflann.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -169,74 +168,6 @@ TEST(KdTree, ResultsIndependentOfThreadCount)
     }
 }
 
-/// nanoflann's dataset adaptor over a vector of points, for a reference tree.
-struct ReferenceAdaptor
-{
-    const std::vector<Vec3f>* points;
-    [[nodiscard]] std::size_t kdtree_get_point_count() const { return points->size(); }
-    [[nodiscard]] float kdtree_get_pt(std::size_t i, std::size_t dim) const
-    {
-        return (*points)[i][static_cast<Eigen::Index>(dim)];
-    }
-    template <class Box>
-    bool kdtree_get_bbox(Box& /*box*/) const
-    {
-        return false;
-    }
-};
-
-// The tree is built in parallel (its top split level by level, then subtrees at once): it must be
-// nanoflann's own tree, node for node, whatever the thread count. A search that stops early
-// (nearest_within_factor) depends on the layout, so its answers, on points with many ties on
-// the split planes, are compared with those of nanoflann's serial buildIndex().
-TEST(KdTree, ParallelBuildIsNanoflannsTree)
-{
-    // 300,000 points on a coarse lattice, so many share coordinates with a split plane.
-    std::vector<Vec3f> points = random_points(300000, 17);
-    for (auto& p : points)
-        p = (p * 64.0F).array().round().matrix() / 64.0F;
-    using Reference = nanoflann::KDTreeSingleIndexAdaptor<
-        nanoflann::L2_Simple_Adaptor<float, ReferenceAdaptor, float, std::uint32_t>,
-        ReferenceAdaptor, 3, std::uint32_t>;
-    const ReferenceAdaptor adaptor{&points};
-    const Reference reference(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    const std::vector<Vec3f> queries = random_points(20000, 18);
-    std::vector<std::uint32_t> expected(queries.size());
-    for (std::size_t q = 0; q < queries.size(); ++q)
-    {
-        std::uint32_t index = 0;
-        float d2 = 0.0F;
-        nanoflann::KNNResultSet<float, std::uint32_t, std::size_t> result(1);
-        result.init(&index, &d2);
-        nanoflann::SearchParams params;
-        params.eps = 1.0F;
-        reference.findNeighbors(result, queries[q].data(), params);
-        expected[q] = index;
-    }
-    const auto runs = test::at_thread_counts(
-        [&] {
-            const KdTree tree(points);
-            std::vector<std::uint32_t> found(queries.size());
-            for (std::size_t q = 0; q < queries.size(); ++q)
-                found[q] = tree.nearest_within_factor(queries[q], 2.0F).value;
-            return found;
-        },
-        {.min_multi_block_loops = 2}, {1, 2, 3, 4});
-    for (const auto& found : runs)
-        EXPECT_EQ(found, expected);
-}
-
-TEST(KdTree, DuplicatePointsAreOrderedByIndex)
-{
-    std::vector<Vec3f> points(10, Vec3f(1.0F, 2.0F, 3.0F));
-    points.push_back(Vec3f(5.0F, 5.0F, 5.0F));
-    const KdTree tree(points);
-    const KnnTable table = knn_batch(tree, std::span<const Vec3f>(points).first(1), 10);
-    std::vector<std::uint32_t> expected(10);
-    std::iota(expected.begin(), expected.end(), 0U);
-    EXPECT_EQ(table.indices, expected);
-}
-
 /// Squared distance as nanoflann's L2_Simple_Adaptor sums it (x, then y, then z, in float), so
 /// that exact ties are ties in both.
 float squared_distance(const Vec3f& a, const Vec3f& b)
@@ -248,6 +179,99 @@ float squared_distance(const Vec3f& a, const Vec3f& b)
         d2 += d * d;
     }
     return d2;
+}
+
+// Points out of Morton order are searched in a sorted copy: every answer is in the caller's
+// indices and the same as over the same points given in Morton order (mapped), ties at the k-th
+// distance and at distance 0 (copies) included, whatever the thread count; the queries of
+// knn_batch() over the tree's own points run in the tree's order, in more than one block.
+TEST(KdTree, PointsOutOfOrderAreSearchedInASortedCopy)
+{
+    // 60,000 points on a coarse lattice (many ties, exact in float), some repeated, in random
+    // order.
+    std::vector<Vec3f> points = random_points(60000, 17);
+    for (auto& p : points)
+        p = (p * 16.0F).array().round().matrix() / 16.0F;
+    for (std::size_t i = 0; i < 1000; ++i)
+        points[points.size() - 1 - i] = points[i * 7];
+    const std::vector<std::uint32_t> order = spatial_order(points);
+    std::vector<Vec3f> sorted(points.size());
+    for (std::size_t i = 0; i < order.size(); ++i)
+        sorted[i] = points[order[i]];
+
+    const KdTree in_order(sorted);
+    EXPECT_TRUE(in_order.spatial_order().empty());
+    EXPECT_EQ(in_order.positions().data(), sorted.data());
+    constexpr std::size_t k = 20;
+    const KnnTable expected_sorted = knn_batch(in_order, sorted, k);
+    const auto runs = test::at_thread_counts(
+        [&] {
+            const KdTree tree(points);
+            EXPECT_EQ(tree.positions().data(), points.data());
+            EXPECT_EQ(std::vector<std::uint32_t>(tree.spatial_order().begin(),
+                                                 tree.spatial_order().end()),
+                      order);
+            return knn_batch(tree, points, k);
+        },
+        {.min_multi_block_loops = 2}, {1, 2, 3});
+    for (const KnnTable& table : runs)
+    {
+        ASSERT_EQ(table.rows(), points.size());
+        EXPECT_EQ(table.indices, runs[0].indices);
+        // Row order[i] over the caller's points is row i over the sorted ones: the same
+        // distances.
+        for (std::size_t i = 0; i < order.size(); ++i)
+            ASSERT_TRUE(std::equal(table.distances2(order[i]).begin(),
+                                   table.distances2(order[i]).end(),
+                                   expected_sorted.distances2(i).begin()));
+    }
+    // The neighbours, ties taken by the caller's index (the lattice's distances are exact).
+    for (std::size_t q = 0; q < points.size(); q += 211)
+    {
+        const auto truth = brute_sorted(points, points[q]);
+        for (std::size_t j = 0; j < k; ++j)
+            ASSERT_EQ(runs[0].neighbors(q)[j], truth[j].second) << "query " << q << " rank " << j;
+    }
+
+    // nearest_within_factor() and radius_search() answer in the caller's indices too.
+    const KdTree tree(points);
+    const std::vector<Vec3f> queries = random_points(300, 18);
+    for (const Vec3f& q : queries)
+    {
+        const auto truth = brute_sorted(points, q);
+        float d2 = 0.0F;
+        const PointId near = tree.nearest_within_factor(q, 1.0F, &d2);
+        ASSERT_EQ(d2, squared_distance(points[near.value], q));
+        ASSERT_NEAR(d2, truth.front().first, 1e-6F * truth.front().first);
+        const PointId started = tree.nearest_within_factor(q, 2.0F, PointId(truth[5].second), &d2);
+        ASSERT_EQ(d2, squared_distance(points[started.value], q));
+        ASSERT_LE(d2, truth[5].first * (1.0F + 1e-6F));
+        // The radius halfway between two distances, so that rounding cannot move a point
+        // across it.
+        const float radius = std::sqrt(0.5F * (truth[30].first + truth[31].first));
+        if (truth[31].first - truth[30].first < 1e-4F * truth[31].first)
+            continue;
+        std::vector<std::uint32_t> within;
+        std::vector<float> within_d2;
+        ASSERT_EQ(tree.radius_search(q, radius, within, within_d2), 31U);
+        std::vector<std::uint32_t> brute;
+        for (std::size_t j = 0; j < 31; ++j)
+            brute.push_back(truth[j].second);
+        std::sort(within.begin(), within.end());
+        std::sort(brute.begin(), brute.end());
+        ASSERT_EQ(within, brute);
+    }
+}
+
+TEST(KdTree, DuplicatePointsAreOrderedByIndex)
+{
+    std::vector<Vec3f> points(10, Vec3f(1.0F, 2.0F, 3.0F));
+    points.push_back(Vec3f(5.0F, 5.0F, 5.0F));
+    const KdTree tree(points);
+    const KnnTable table = knn_batch(tree, std::span<const Vec3f>(points).first(1), 10);
+    std::vector<std::uint32_t> expected(10);
+    std::iota(expected.begin(), expected.end(), 0U);
+    EXPECT_EQ(table.indices, expected);
 }
 
 /// Sites with many coincident copies each (their indices scattered through the array), plus
@@ -299,7 +323,9 @@ TEST(KdTree, TiesAtTheKthNeighbourGoToTheLowestIndices)
                 }
             }
             if (k > 1)
+            {
                 EXPECT_GT(tied, 10U) << "k " << k; // the case under test does occur
+            }
         }
     }
 }

@@ -76,6 +76,11 @@ struct PointCloudView
 /// \return the number of points removed
 std::size_t keep_points(PointCloud& cloud, std::span<const std::uint8_t> keep);
 
+/// \brief Puts the points in the order `order` gives (point j becomes point order[j]'s), with
+/// every attribute.
+/// \pre `order` is a permutation of the cloud's indices
+void reorder_points(PointCloud& cloud, std::span<const std::uint32_t> order);
+
 /// \brief Picks the float storage origin for a cloud whose first point is `first`: the point
 /// rounded to whole units, so that small models (within about ±0.5 unit of zero) keep origin 0
 /// and float inputs round-trip exactly, while georeferenced ones are re-centred.
