@@ -1255,6 +1255,18 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
     {
         throw InvalidInput("point field: rim_reach must be in (0, 1]");
     }
+    // The samples in Morton order (spatial_order()), whatever order they came in: the fits, the
+    // trees and every pass over them then read memory in order, not a file's (1M samples in a
+    // random order took 1.4-2.6 s longer in reconstruct), and the field is the same for any
+    // order of the same samples (up to the order of samples at one place).
+    {
+        const std::vector<std::uint32_t> order = spatial_order(surfels.positions);
+        bool in_order = true;
+        for (std::size_t j = 0; j < order.size() && in_order; ++j)
+            in_order = order[j] == j;
+        if (!in_order)
+            reorder_points(surfels, order);
+    }
     impl_ = std::make_unique<Impl>(std::move(surfels), options);
     Impl& m = *impl_;
     const std::size_t n = m.surfels.size();

@@ -6,7 +6,6 @@
 #include "pointform/core/error.h"
 #include "pointform/core/memory.h"
 #include "pointform/polygonize/marching_cubes.h"
-#include "pointform/spatial/spatial_sort.h"
 
 #include <algorithm>
 #include <chrono>
@@ -273,14 +272,11 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
     ReconstructReport report;
     StageClock clock(report.stage_seconds);
     const Aabb bounds = surfels.bounds();
-    // The samples in Morton order (spatial_order()): the field's fits and trees and every pass
-    // over the samples then read memory in order, not a file's (at 1M samples in a random order
-    // the whole run took 1.4-2.6 s longer). A base-mesh file names samples by their index as
-    // given, so it is read against them in that order.
+    // The field puts the samples in Morton order (field.surfels()), and a base-mesh file names
+    // samples by their index as given, so it is read against them in that order.
     std::optional<PointCloud> given;
     if (!options.base_mesh.empty())
         given = surfels;
-    reorder_points(surfels, spatial_order(surfels.positions));
     const PointField field(std::move(surfels),
                            {.fit = options.fit, .rim_reach = options.rim_reach});
     clock.lap("field");

@@ -7,6 +7,7 @@
 #include "pointform/core/parallel.h"
 #include "pointform/geometry/shapes.h"
 #include "pointform/hermite/surfels.h"
+#include "pointform/spatial/spatial_sort.h"
 
 #include "support/thread_counts.h"
 
@@ -16,6 +17,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <numeric>
 #include <random>
 
 namespace pointform {
@@ -205,6 +207,44 @@ TEST(PointField, BatchEqualsSingleWhateverTheThreadCount)
         ASSERT_EQ(runs[1][i].gradient, single.gradient);
         ASSERT_EQ(runs[2][i].gradient, single.gradient);
     }
+}
+
+TEST(PointField, KeepsItsSamplesInMortonOrderAndIsTheSameForAnyOrder)
+{
+    const PointCloud surfels = sphere_surfels(6000, 0.15F);
+    PointCloud shuffled = surfels;
+    std::vector<std::uint32_t> order(surfels.size());
+    std::iota(order.begin(), order.end(), 0U);
+    std::shuffle(order.begin(), order.end(), std::mt19937(5));
+    reorder_points(shuffled, order);
+    ASSERT_NE(shuffled.positions, surfels.positions);
+    const PointField a(surfels);
+    const PointField b(shuffled);
+
+    // Both hold the samples along the Morton curve: the same samples in the same order.
+    const std::vector<std::uint32_t> again = spatial_order(a.surfels().positions);
+    for (std::size_t j = 0; j < again.size(); ++j)
+        ASSERT_EQ(again[j], j);
+    EXPECT_EQ(a.surfels().positions, b.surfels().positions);
+    EXPECT_EQ(a.surfels().normals, b.surfels().normals);
+    EXPECT_EQ(a.surfels().radii, b.surfels().radii);
+
+    std::vector<Vec3d> points;
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(-1.4, 1.4);
+    for (int i = 0; i < 3000; ++i)
+        points.emplace_back(u(rng), u(rng), u(rng));
+    std::vector<FieldSample> va(points.size());
+    std::vector<FieldSample> vb(points.size());
+    a.evaluate(points, va);
+    b.evaluate(points, vb);
+    for (std::size_t i = 0; i < points.size(); ++i)
+    {
+        ASSERT_EQ(va[i].value, vb[i].value);
+        ASSERT_EQ(va[i].gradient, vb[i].gradient);
+        ASSERT_EQ(va[i].defined, vb[i].defined);
+    }
+    EXPECT_EQ(a.median_radius(), b.median_radius());
 }
 
 TEST(PointField, SuccessiveEvaluationsAreTheBatchsBitForBit)

@@ -130,7 +130,8 @@ struct PointFieldOptions
 class PointField final : public Field
 {
 public:
-    /// \param surfels positions with unit normals and radii (as compute_surfels makes them)
+    /// \param surfels positions with unit normals and radii (as compute_surfels makes them), in
+    ///        any order (the field keeps them in Morton order)
     /// \throw InvalidInput if the cloud is empty, or normals or radii are missing, non-finite or
     ///        not positive
     explicit PointField(PointCloud surfels, const PointFieldOptions& options = {});
@@ -151,6 +152,8 @@ public:
     [[nodiscard]] Aabb bounds() const override;
     void append_seeds(std::vector<Vec3d>& seeds) const override;
 
+    /// \brief The samples, with unit normals, in Morton order (spatial_order()), not
+    /// necessarily the order given: the field is the same whatever order its samples come in.
     [[nodiscard]] const PointCloud& surfels() const;
     /// \brief The k-d tree over surfels()' positions (RefineOptions::sample_tree takes it).
     [[nodiscard]] const KdTree& tree() const;
