@@ -38,11 +38,6 @@ double half_area(const Aabb& box)
     return s.x() * s.y() + s.y() * s.z() + s.z() * s.x();
 }
 
-/// Triangles binned, partitioned and boxed in blocks of this many (a fixed count, so that the
-/// tree does not depend on the thread count).
-constexpr std::size_t ref_block = 16384;
-/// Ranges of at least this many triangles are binned and partitioned in parallel blocks.
-constexpr std::size_t parallel_split_refs = 4 * ref_block;
 /// Ranges of at most this many triangles are split by the surface-area heuristic at every
 /// position along each axis (their boxes' centres sorted) instead of by bins: most nodes are
 /// this small, and filling and sweeping 3 × 16 bins cost them more than the sort.
@@ -420,6 +415,12 @@ TriangleBvh::TriangleBvh(const TriMesh& mesh, const TriangleBvhOptions& options)
                                    std::to_string(v_count) + " vertices");
 
     const std::size_t group = options.group_size == 0 ? 1 : options.group_size;
+    // Groups binned, partitioned and boxed in blocks of this many (a fixed count, so that the
+    // tree does not depend on the thread count); ranges of at least four blocks are binned and
+    // partitioned in parallel blocks.
+    const std::size_t ref_block =
+        options.build_block == 0 ? TriangleBvhOptions::default_build_block : options.build_block;
+    const std::size_t parallel_split_refs = 4 * ref_block;
     if (f_count % group != 0)
         throw InvalidInput("triangle BVH: " + std::to_string(f_count) +
                            " triangles are not groups of " + std::to_string(group));

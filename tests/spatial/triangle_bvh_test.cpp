@@ -358,6 +358,59 @@ TEST(TriangleBvh, LargeMeshExactAndTheSameTreeForAnyThreadCount)
     }
 }
 
+TEST(TriangleBvh, SubtreesBuiltAtOnceSplitInBlocksOfTheirOwn)
+{
+    // Blocks of 32 groups: ranges of 128 and more are split in blocks, inside the subtrees that
+    // are built at once too, as those of meshes of millions of faces are at the default block
+    // (a buffer shared by those subtrees once corrupted the tree). A wavy 120 x 120 grid,
+    // 28,800 triangles in shuffled order, alone and in groups of 4 (as the refinement builds it).
+    TriMesh mesh = grid_plane(120);
+    for (Vec3f& p : mesh.vertices.positions)
+        p.z() = 0.15F * std::sin(6.0F * p.x()) * std::cos(4.0F * p.y());
+    std::shuffle(mesh.triangles.begin(), mesh.triangles.end(), std::mt19937_64(43));
+    const auto queries = random_queries(4000, 1.2, 44);
+    const std::vector<TriangleBvh::Hit> reference = closest_points(TriangleBvh(mesh), queries);
+    for (const std::size_t group : {1U, 4U})
+    {
+        struct Built
+        {
+            std::size_t nodes;
+            std::vector<TriangleBvh::Hit> hits;
+        };
+        const auto runs = test::at_thread_counts(
+            [&] {
+                const TriangleBvh bvh(mesh, {.group_size = group, .build_block = 32});
+                return Built{bvh.node_count(), closest_points(bvh, queries)};
+            },
+            {.min_multi_block_loops = 4}, {1, 2, 3});
+        for (std::size_t r = 0; r < runs.size(); ++r)
+        {
+            ASSERT_EQ(runs[r].nodes, runs[0].nodes) << r + 1 << " threads, groups of " << group;
+            for (std::size_t i = 0; i < queries.size(); ++i)
+            {
+                // Exact, as the default build's; the same tree at every thread count.
+                ASSERT_EQ(runs[r].hits[i].distance, reference[i].distance)
+                    << "query " << i << ", " << r + 1 << " threads, groups of " << group;
+                ASSERT_EQ(runs[r].hits[i].face, runs[0].hits[i].face) << r + 1 << " threads";
+            }
+        }
+    }
+    // Every 100th query against every triangle, by the same closest-point routine.
+    for (std::size_t i = 0; i < queries.size(); i += 100)
+    {
+        double truth = std::numeric_limits<double>::infinity();
+        for (const Triangle& t : mesh.triangles)
+        {
+            const Vec3d a = mesh.vertices.world(t[0]);
+            const Vec3d b = mesh.vertices.world(t[1]);
+            const Vec3d c = mesh.vertices.world(t[2]);
+            const Vec3d w = closest_point_barycentric(queries[i], a, b, c);
+            truth = std::min(truth, (queries[i] - (w[0] * a + w[1] * b + w[2] * c)).norm());
+        }
+        EXPECT_EQ(reference[i].distance, truth) << "query " << i;
+    }
+}
+
 TEST(TriangleBvh, GroupsOfFacesGiveTheSameDistances)
 {
     // The children of a 1-to-4 split kept together: the same distances as one face at a time,

@@ -29,6 +29,14 @@ struct TriangleBvhOptions
     /// parent, so the build sorts a quarter as many boxes. The triangle count must be a
     /// multiple (else InvalidInput); 0 or 1 = every triangle on its own.
     std::size_t group_size = 1;
+    /// The build bins, partitions and boxes the groups in blocks of this many, fixed so that
+    /// the tree is the same for any thread count; a range of at least four blocks is split in
+    /// parallel blocks, also inside the subtrees that are built at once. The default suits
+    /// every size; a small block makes a small mesh take the large meshes' paths (tests of
+    /// the parallel build). 0 = default_build_block.
+    std::size_t build_block = default_build_block;
+
+    static constexpr std::size_t default_build_block = 16384;
 };
 
 /// \brief Options for batch closest-point queries.
