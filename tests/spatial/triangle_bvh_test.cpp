@@ -365,8 +365,8 @@ TEST(TriangleBvh, LargeMeshExactAndTheSameTreeForAnyThreadCount)
 
 TEST(TriangleBvh, SubtreesBuiltAtOnceSplitInBlocksOfTheirOwn)
 {
-    // Blocks of 32 groups: ranges of 128 and more are split in blocks, inside the subtrees that
-    // are built at once too, as those of meshes of millions of faces are at the default block
+    // Blocks of 256 groups: ranges of 1,024 and more are split in blocks, inside the subtrees
+    // that are built at once too, as those of meshes of millions of faces are at the default block
     // (a buffer shared by those subtrees once corrupted the tree). A wavy 120 x 120 grid,
     // 28,800 triangles in shuffled order, alone and in groups of 4 (as the refinement builds it).
     TriMesh mesh = grid_plane(120);
@@ -384,7 +384,7 @@ TEST(TriangleBvh, SubtreesBuiltAtOnceSplitInBlocksOfTheirOwn)
         };
         const auto runs = test::at_thread_counts(
             [&] {
-                const TriangleBvh bvh(mesh, {.group_size = group, .build_block = 32});
+                const TriangleBvh bvh(mesh, {.group_size = group, .build_block = 256});
                 return Built{bvh.node_count(), closest_points(bvh, queries)};
             },
             {.min_multi_block_loops = 4}, {1, 2, 3});
