@@ -1000,6 +1000,25 @@ void relax_and_project(const OmMesh& mesh, const Field& field, bool relax, Verte
             const Vec3d normal = vertex_normal(mesh, v, old);
             const double reach = mean_edge_length(mesh, v, old);
             Vec3d candidate = old[i];
+            if (relax && mesh.is_boundary(v))
+            {
+                // Along the boundary only: to the middle of its two boundary neighbours, in
+                // the direction from one to the other (a loop's vertices spread evenly along
+                // it, its shape kept).
+                const auto out = mesh.halfedge_handle(v);
+                const auto in = mesh.prev_halfedge_handle(out);
+                if (mesh.is_boundary(out) && mesh.is_boundary(in))
+                {
+                    const Vec3d& a =
+                        old[static_cast<std::size_t>(mesh.from_vertex_handle(in).idx())];
+                    const Vec3d& b =
+                        old[static_cast<std::size_t>(mesh.to_vertex_handle(out).idx())];
+                    const Vec3d chord = b - a;
+                    const double length2 = chord.squaredNorm();
+                    if (length2 > 0.0)
+                        candidate += (0.5 * (a + b) - old[i]).dot(chord) / length2 * chord;
+                }
+            }
             if (relax && !mesh.is_boundary(v))
             {
                 Vec3d centre = Vec3d::Zero();
@@ -1871,8 +1890,9 @@ BaseMeshResult build_base_mesh(const TriMesh& intermediate, const Field& field,
                 {
                     break;
                 }
-                if (round >= 2 && static_cast<double>(bad) >= (1.0 - options.min_round_gain) *
-                                                                  static_cast<double>(previous))
+                if (options.min_round_gain > 0.0 && round >= 2 &&
+                    static_cast<double>(bad) >=
+                        (1.0 - options.min_round_gain) * static_cast<double>(previous))
                 {
                     break; // no longer improving much
                 }

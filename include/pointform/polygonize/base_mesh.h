@@ -38,23 +38,29 @@ struct BaseMeshOptions
     std::optional<double> boundary_tolerance;
     /// Triangle-shape target, degrees, in [0, 60): after decimation, rounds of shape improvement
     /// (edge flips that raise the minimum angle, then a tangential umbrella relaxation of every
-    /// interior vertex, then the projection of every vertex onto f = 0) go on, at least two, until
-    /// no triangle away from the boundary has a smaller angle, a round removes less than
-    /// min_round_gain of those left, or max_smoothing_rounds is reached. Triangles at a small
-    /// boundary loop (a hole narrower than the base edges) cannot all meet it.
+    /// interior vertex and a relaxation of every boundary vertex along its loop, then the
+    /// projection of every vertex onto f = 0) go on, at least two, until no triangle away from
+    /// the boundary has a smaller angle, max_smoothing_rounds is reached, or (when
+    /// min_round_gain is set) a round removes less than that share of those left. Triangles at
+    /// a small boundary loop (a hole narrower than the base edges) cannot all meet it.
     double min_angle_degrees = 30.0;
     /// Cap on the shape rounds; 0 = none (no flips, no relaxation: the decimated marching-cubes
     /// vertices are only projected).
     int max_smoothing_rounds = 8;
     /// The shape rounds stop (after two) once a round leaves at least 1 − min_round_gain of the
-    /// triangles under min_angle_degrees that it found, in [0, 1); 0 = only once none goes.
-    /// The counts flatten after four or five rounds (1M noisy sphere: 4,133, 1,381, 961, 784,
-    /// 754, 715, 675; noisy thin plate: 4,945, 1,749, 1,302, 1,132, 1,062, 1,014, 967; clean
-    /// blobby: 716, 197, 94, 87, 75, 70, 69 of 75k faces), each round a field projection of
-    /// every vertex (0.3-0.4 s at 1M), but the last rounds still even out creases: 0.1 stops
-    /// the 1M noisy sphere and plate after 5 rounds and the clean blobby after 4 (about 2 s of
-    /// 20 at 1M), and doubles the output's triangles under 20° on the clean part and plate of
-    /// bench/peers at 100k (0.53% -> 1.00%, 0.62% -> 1.22%), so the default waits.
+    /// triangles under min_angle_degrees that it found, in [0, 1); 0 = they run to
+    /// max_smoothing_rounds unless none is left. The counts flatten after four or five rounds
+    /// (1M noisy sphere: 4,133, 1,381, 961, 784, 754, 715, 675; noisy thin plate: 4,945, 1,749,
+    /// 1,302, 1,132, 1,062, 1,014, 967; clean blobby: 716, 197, 94, 87, 75, 70, 69 of 75k
+    /// faces), each round a field projection of every vertex (0.3-0.4 s at 1M), but the last
+    /// rounds still even out creases: 0.1 stops the 1M noisy sphere and plate after 5 rounds
+    /// and the clean blobby after 4 (about 2 s of 20 at 1M), and doubles the output's triangles
+    /// under 20° on the clean part and plate of bench/peers at 100k (0.53% -> 1.00%, 0.62% ->
+    /// 1.22%), so the default waits. Until the thirty-seventh session 0 still stopped at the
+    /// first round that removed none, which a count going up by one can trigger: on simulated
+    /// fandisk scans (bench/peers/virtual_scan.py, seeds 3 and 4), whose counts still fell by
+    /// 3-10% a round at the eighth, that stop came after 6 and 5 rounds, with 1.51% and 1.02% of
+    /// the output's triangles under 20°; 8 rounds give 0.99% and 0.86%.
     double min_round_gain = 0.0;
     /// Flips only between triangles whose normals differ by at most this, degrees, in [0, 90):
     /// a flip must not cut across a crease.
