@@ -19,6 +19,7 @@
 #include <numbers>
 #include <numeric>
 #include <random>
+#include <tuple>
 
 namespace pointform {
 namespace {
@@ -470,6 +471,26 @@ TEST(PointField, CreaseFitsMeetTheFacesAtCreasesAndLeaveSmoothSurfacesAlone)
     EXPECT_EQ(runs[0], runs[2]);
 }
 
+/// The surfels of raw points (normals estimated), each normal turned to the side of `truth`'s
+/// (the solid's outward normals): the orientation must have agreed with it everywhere or nowhere.
+PointCloud oriented_as_the_solid(const PointCloud& raw, const std::vector<Vec3f>& truth,
+                                 const SurfelOptions& options)
+{
+    PointCloud surfels = compute_surfels(raw, options).surfels;
+    EXPECT_EQ(surfels.size(), raw.size());
+    std::size_t flipped = 0;
+    for (std::size_t i = 0; i < surfels.size(); ++i)
+    {
+        if (surfels.normals[i].dot(truth[i]) < 0.0F)
+        {
+            surfels.normals[i] = -surfels.normals[i];
+            ++flipped;
+        }
+    }
+    EXPECT_TRUE(flipped == 0 || flipped == surfels.size()) << flipped << " flipped";
+    return surfels;
+}
+
 TEST(PointField, ConcaveCreasesAreNotFilled)
 {
     // The inner corner of an L (a floor z = 0 for x >= 0 and a wall x = 0 for z >= 0, the solid
@@ -494,18 +515,7 @@ TEST(PointField, ConcaveCreasesAreNotFilled)
                                    static_cast<float>(u(rng)));
         truth.emplace_back(1.0F, 0.0F, 0.0F);
     }
-    PointCloud surfels = compute_surfels(raw).surfels;
-    ASSERT_EQ(surfels.size(), raw.size());
-    std::size_t flipped = 0;
-    for (std::size_t i = 0; i < surfels.size(); ++i)
-    {
-        if (surfels.normals[i].dot(truth[i]) < 0.0F)
-        {
-            surfels.normals[i] = -surfels.normals[i];
-            ++flipped;
-        }
-    }
-    EXPECT_TRUE(flipped == 0 || flipped == surfels.size()) << flipped << " flipped";
+    const PointCloud surfels = oriented_as_the_solid(raw, truth, {});
     const PointField field(surfels);
     const double spacing = side / std::sqrt(static_cast<double>(per_face));
     const Vec3d bisector = Vec3d(1.0, 0.0, 1.0).normalized();
@@ -535,6 +545,85 @@ TEST(PointField, ConcaveCreasesAreNotFilled)
     std::sort(offsets.begin(), offsets.end());
     EXPECT_LT(std::abs(offsets[offsets.size() / 2]), 0.3 * spacing);
     EXPECT_LT(std::max(std::abs(offsets.front()), std::abs(offsets.back())), 0.6 * spacing);
+}
+
+TEST(PointField, ConvexEdgeKeepsBothFacesUpToTheEdge)
+{
+    // The outer edge of the solid x < 0, z < 0: a top face z = 0 and a wall x = 0, each 12
+    // spacings h wide and 500 long, sampled uniformly at random (one sample per h², the faces
+    // alternating), normals estimated and oriented as the solid's. On both faces, 2 to 3 h from
+    // the edge, the field is the distance to the face (0) to a quarter of h but at a few
+    // places, where quadrics fitted across the edge (crease_fit off) round it off: 3 of the
+    // 9,600 probes off by more than h/4 (the worst 0.28 h) against 59 (0.61 h). Across the
+    // edge, where the field is defined and the true distance is over 0.3 h, its sign is the
+    // truth's but at 5 of 59,714 points: a dent over a spacing deep into the edge at one place
+    // and a bump half a spacing over the top face beside the edge at two others (random gaps of
+    // the sampling, left for later work on the crease lines).
+    constexpr double h = 0.01;
+    constexpr double width = 12.0 * h;
+    constexpr double length = 500.0 * h;
+    const auto count = static_cast<std::size_t>(2.0 * width * length / (h * h));
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> across(0.0, width);
+    std::uniform_real_distribution<double> along(0.0, length);
+    PointCloud raw;
+    std::vector<Vec3f> truth;
+    for (std::size_t i = 0; i < count; ++i)
+    {
+        const double a = across(rng);
+        const double y = along(rng);
+        const bool top = i % 2 == 0;
+        raw.positions.emplace_back(static_cast<float>(top ? -a : 0.0), static_cast<float>(y),
+                                   static_cast<float>(top ? 0.0 : -a));
+        truth.emplace_back(top ? Vec3f::UnitZ() : Vec3f::UnitX());
+    }
+    const PointCloud surfels =
+        oriented_as_the_solid(raw, truth, {.radius_scale = default_field_radius_scale});
+    struct Off
+    {
+        std::size_t count = 0;
+        std::size_t probes = 0;
+        double worst = 0.0;
+    };
+    const auto on_faces = [&](const PointField& field) {
+        Off off;
+        for (double y = 0.1 * length; y < 0.9 * length; y += 0.25 * h)
+            for (const double depth : {2.0 * h, 2.5 * h, 3.0 * h})
+                for (const Vec3d& p : {Vec3d(0.0, y, -depth), Vec3d(-depth, y, 0.0)})
+                {
+                    const double value = std::abs(field.evaluate(p).value);
+                    off.count += value > 0.25 * h ? 1U : 0U;
+                    off.worst = std::max(off.worst, value);
+                    ++off.probes;
+                }
+        return off;
+    };
+    const PointField field(surfels);
+    const Off fitted = on_faces(field);
+    const Off rounded = on_faces(PointField(surfels, {.crease_fit = false}));
+    EXPECT_LT(static_cast<double>(fitted.count), 0.002 * static_cast<double>(fitted.probes))
+        << fitted.count << " of " << fitted.probes;
+    EXPECT_LT(fitted.worst, 0.5 * h);
+    EXPECT_GT(rounded.count, 5 * fitted.count);
+    std::size_t wrong = 0;
+    std::size_t checked = 0;
+    for (double y = 0.1 * length; y < 0.9 * length; y += 2.0 * h)
+        for (int i = -12; i <= 6; ++i)
+            for (int k = -12; k <= 6; ++k)
+            {
+                const double x = 0.5 * h * i;
+                const double z = 0.5 * h * k;
+                const double t = x < 0.0 && z < 0.0
+                                     ? std::max(x, z)
+                                     : std::hypot(std::max(x, 0.0), std::max(z, 0.0));
+                const FieldSample s = field.evaluate(Vec3d(x, y, z));
+                if (std::abs(t) <= 0.3 * h || !s.defined)
+                    continue;
+                ++checked;
+                wrong += (s.value > 0.0) != (t > 0.0) ? 1U : 0U;
+            }
+    EXPECT_GT(checked, 50000U);
+    EXPECT_LE(wrong, checked / 5000) << wrong << " of " << checked;
 }
 
 TEST(PointField, EndsSoonAfterARimAndSpansHolesWhereRadiiAreRaised)
