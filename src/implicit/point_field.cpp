@@ -394,9 +394,9 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
                 narrow_out->test.spread2 =
                     static_cast<float>(std::max(0.0, narrow->second - wide->second));
                 narrow_out->test.sigma2 = static_cast<float>(sigma2 * scale2);
-                // pool_narrow_fits() asks σ̂² ≤ misfit · σ² ≤ misfit · clean² · reach², with
-                // reach that of the nearest narrow_k, within this fit's.
-                // A gap under narrow_pool_least of that reach changes nothing that matters.
+                // pool_narrow_fits() asks σ̂² ≤ misfit · σ² ≤ misfit · clean² · reach² (its
+                // reach, that of the nearest narrow_k, is within this fit's), and a gap under
+                // narrow_pool_least of the reach changes nothing that matters.
                 const double reach2 = small->reach * small->reach;
                 const double gap = std::abs(c[0] - coef[0]);
                 narrow_out->candidate =
@@ -421,9 +421,10 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
 /// where the whole neighbourhood shows the wide fits biased (narrow_pool_bias) and its samples
 /// nearly exact (narrow_pool_clean): the detail of a clean scan that a quadric over 48
 /// neighbours flattens, but whose gap at any one sample is within what that sample's own
-/// residuals (ten degrees of freedom) could explain. `narrow` is indexed by the slots of
-/// `grid` (over the same samples as `tree`); `take(slot, fit)` is called for each sample whose
-/// narrow fit is taken (from any thread, once per slot).
+/// residuals (ten degrees of freedom) could explain. `tests` is indexed by the slots of `grid`
+/// (over the same samples as `tree`); `candidates` are the narrow fits that may be taken, a list
+/// per block of slots; `take(candidate)` is called for each one taken (from any thread, once
+/// per slot).
 /// Measured (field |f| at the samples of the shipped bunny scan, the truth being the mesh they
 /// are the vertices of, median in % of the diagonal): 0.0128 -> 0.0084; bench/peers' noisy
 /// inputs and its clean analytic shapes the same field to the digits printed.
