@@ -225,6 +225,30 @@ bool plausible_fit(const Eigen::Matrix<double, 6, 1>& coef, double reach)
            slope * reach + curvature * reach * reach <= max_fit_slope * reach;
 }
 
+/// A quadric fitted in coordinates scaled by 1 / `scale` (fit_local_surface()) as
+/// PackedSurfel::a..f, in the sample's own (unscaled) frame.
+std::array<float, 6> unscaled_quadric(const Eigen::Matrix<double, 6, 1>& coef, double scale)
+{
+    const double inv_scale = 1.0 / scale;
+    return {static_cast<float>(coef[0] * scale),
+            static_cast<float>(coef[1]),
+            static_cast<float>(coef[2]),
+            static_cast<float>(coef[3] * inv_scale),
+            static_cast<float>(coef[4] * inv_scale),
+            static_cast<float>(coef[5] * inv_scale)};
+}
+
+/// Sets `out`'s quadric (PackedSurfel::a..f).
+void set_quadric(PackedSurfel& out, const std::array<float, 6>& quadric)
+{
+    out.a = quadric[0];
+    out.b = quadric[1];
+    out.c = quadric[2];
+    out.d = quadric[3];
+    out.e = quadric[4];
+    out.f = quadric[5];
+}
+
 /// The local surface of sample i (see PackedSurfel) from its neighbours (the sample first,
 /// nearest first); `positions` and `normals` are indexed like `neighbors` and i. A quadric fit
 /// to the narrowest `narrow_k` of them (0: none) replaces the one fit to all where the two
@@ -380,17 +404,13 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
             const double spread = std::sqrt(sigma2 * std::max(0.0, narrow->second)) +
                                   std::sqrt(sigma2 * std::max(0.0, wide->second));
             const bool plausible = plausible_fit(narrow->first, small->reach);
-            const bool taken =
-                std::abs(narrow->first[0] - coef[0]) > narrow_fit_gamma * spread && plausible;
+            const double gap = std::abs(narrow->first[0] - coef[0]);
+            const bool taken = gap > narrow_fit_gamma * spread && plausible;
             if (narrow_out != nullptr)
             {
-                const double world = std::sqrt(scale2);
-                const Vec6& c = narrow->first;
-                narrow_out->coef = {
-                    static_cast<float>(c[0] * world), static_cast<float>(c[1]),
-                    static_cast<float>(c[2]),         static_cast<float>(c[3] / world),
-                    static_cast<float>(c[4] / world), static_cast<float>(c[5] / world)};
-                narrow_out->test.gap = static_cast<float>(std::abs(c[0] - coef[0]) * world);
+                const double scale = std::sqrt(scale2);
+                narrow_out->coef = unscaled_quadric(narrow->first, scale);
+                narrow_out->test.gap = static_cast<float>(gap * scale);
                 narrow_out->test.spread2 =
                     static_cast<float>(std::max(0.0, narrow->second - wide->second));
                 narrow_out->test.sigma2 = static_cast<float>(sigma2 * scale2);
@@ -398,7 +418,6 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
                 // reach, that of the nearest narrow_k, is within this fit's), and a gap under
                 // narrow_pool_least of the reach changes nothing that matters.
                 const double reach2 = small->reach * small->reach;
-                const double gap = std::abs(c[0] - coef[0]);
                 narrow_out->candidate =
                     plausible && !taken &&
                     gap * gap > narrow_pool_least * narrow_pool_least * reach2 &&
@@ -408,13 +427,28 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
                 coef = narrow->first;
         }
     }
-    const double scale = std::sqrt(scale2);
-    out.a = static_cast<float>(coef[0] * scale);
-    out.b = static_cast<float>(coef[1]);
-    out.c = static_cast<float>(coef[2]);
-    out.d = static_cast<float>(coef[3] * inv_scale);
-    out.e = static_cast<float>(coef[4] * inv_scale);
-    out.f = static_cast<float>(coef[5] * inv_scale);
+    set_quadric(out, unscaled_quadric(coef, std::sqrt(scale2)));
+}
+
+/// The k nearest of each query (grid slots and squared distances, nearest first, k per query
+/// from query i · k on): the grid's batch search, and the kd-tree for the queries too far from
+/// their neighbours for the cells around them.
+void knn_of_batch(const PointGrid& grid, const KdTree& tree, std::span<const Vec3f> queries,
+                  std::size_t k, std::vector<std::uint32_t>& slots, std::vector<float>& dist2)
+{
+    slots.resize(queries.size() * k);
+    dist2.resize(queries.size() * k);
+    std::vector<std::uint32_t> found(queries.size());
+    grid.knn_nearby(queries, k, slots, dist2, found);
+    for (std::size_t q = 0; q < queries.size(); ++q)
+    {
+        if (found[q] == k)
+            continue;
+        const std::span<std::uint32_t> neighbors(slots.data() + q * k, k);
+        tree.knn(queries[q], k, neighbors, std::span(dist2.data() + q * k, k));
+        for (std::uint32_t& neighbor : neighbors)
+            neighbor = grid.slot_of(neighbor);
+    }
 }
 
 /// The narrow quadrics that the sample-by-sample test of fit_local_surface() left out, taken
@@ -438,7 +472,6 @@ void pool_narrow_fits(const PointGrid& grid, const KdTree& tree, std::span<const
         std::vector<Vec3f> queries;
         std::vector<std::uint32_t> slots;
         std::vector<float> dist2;
-        std::vector<std::uint32_t> found;
         std::vector<float> variances;
         for (std::size_t b = begin; b < end; ++b)
         {
@@ -446,20 +479,12 @@ void pool_narrow_fits(const PointGrid& grid, const KdTree& tree, std::span<const
             queries.clear();
             for (const NarrowCandidate& c : block)
                 queries.push_back(positions[c.slot]);
-            slots.resize(block.size() * narrow_k);
-            dist2.resize(block.size() * narrow_k);
-            found.resize(block.size());
-            grid.knn_nearby(queries, narrow_k, slots, dist2, found);
+            knn_of_batch(grid, tree, queries, narrow_k, slots, dist2);
             for (std::size_t q = 0; q < block.size(); ++q)
             {
-                const std::span<std::uint32_t> neighbors(slots.data() + q * narrow_k, narrow_k);
-                const std::span<float> d2(dist2.data() + q * narrow_k, narrow_k);
-                if (found[q] != narrow_k)
-                {
-                    tree.knn(queries[q], narrow_k, neighbors, d2);
-                    for (std::uint32_t& neighbor : neighbors)
-                        neighbor = grid.slot_of(neighbor);
-                }
+                const std::span<const std::uint32_t> neighbors(slots.data() + q * narrow_k,
+                                                               narrow_k);
+                const std::span<const float> d2(dist2.data() + q * narrow_k, narrow_k);
                 variances.clear();
                 for (const std::uint32_t j : neighbors)
                     if (tests[j].sigma2 >= 0.0F)
@@ -1540,24 +1565,14 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
                 queries.push_back(fit_positions[slot]);
             }
         }
-        std::vector<std::uint32_t> slots(samples.size() * k);
-        std::vector<float> dist2(samples.size() * k);
-        std::vector<std::uint32_t> found(samples.size());
-        fit_grid.knn_nearby(queries, k, slots, dist2, found);
+        std::vector<std::uint32_t> slots;
+        std::vector<float> dist2;
+        knn_of_batch(fit_grid, m.tree, queries, k, slots, dist2);
         double area = 0.0;
         for (std::size_t q = 0; q < samples.size(); ++q)
         {
             const std::span<std::uint32_t> neighbors(slots.data() + q * k, k);
-            const std::span<float> d2(dist2.data() + q * k, k);
-            if (found[q] != k)
-            {
-                // Too far from its neighbours for the cells around it: the kd-tree.
-                m.tree.knn(queries[q], k, neighbors, d2);
-                for (std::uint32_t& neighbor : neighbors)
-                {
-                    neighbor = fit_grid.slot_of(neighbor);
-                }
-            }
+            const std::span<const float> d2(dist2.data() + q * k, k);
             // The ball to the last neighbour holds k samples: π d² / k of surface per sample.
             area += std::numbers::pi * static_cast<double>(d2[k - 1]) / static_cast<double>(k);
             const std::uint32_t i = fit_grid.original_index(samples[q]);
@@ -1599,17 +1614,11 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
     });
     if (!narrow_tests.empty())
     {
-        pool_narrow_fits(fit_grid, m.tree, fit_positions, narrow_tests, narrow_candidates,
-                         options.quadric_narrow_k, [&](const NarrowCandidate& fit) {
-                             PackedSurfel& packed =
-                                 m.packed[m.grid->slot_of(fit_grid.original_index(fit.slot))];
-                             packed.a = fit.coef[0];
-                             packed.b = fit.coef[1];
-                             packed.c = fit.coef[2];
-                             packed.d = fit.coef[3];
-                             packed.e = fit.coef[4];
-                             packed.f = fit.coef[5];
-                         });
+        pool_narrow_fits(
+            fit_grid, m.tree, fit_positions, narrow_tests, narrow_candidates,
+            options.quadric_narrow_k, [&](const NarrowCandidate& fit) {
+                set_quadric(m.packed[m.grid->slot_of(fit_grid.original_index(fit.slot))], fit.coef);
+            });
     }
     m.area = 0.0;
     for (const double area : block_area)
