@@ -22,7 +22,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <random>
 #include <utility>
@@ -457,6 +459,87 @@ TEST(HoleFill, PatchesAreAsCoarseAsTheRestAndFairedRegionsWellShaped)
     const AngleQuality angles = angle_quality(finest);
     RecordProperty("slivers", std::to_string(angles.sliver_share));
     EXPECT_LT(angles.sliver_share, 0.01);
+    EXPECT_TRUE(analyze_topology(finest).is_closed());
+    EXPECT_EQ(analyze_topology(finest).euler_characteristic, 2);
+}
+
+/// A deterministic value in [0, 1) for index i (splitmix64's finalizer).
+double unit_hash(std::uint64_t i)
+{
+    i += 0x9E3779B97F4A7C15ULL;
+    i = (i ^ (i >> 30U)) * 0xBF58476D1CE4E5B9ULL;
+    i = (i ^ (i >> 27U)) * 0x94D049BB133111EBULL;
+    i ^= i >> 31U;
+    return static_cast<double>(i >> 11U) * 0x1.0p-53;
+}
+
+TEST(HoleFill, ThinningRimsAreFairedWithTheirHoles)
+{
+    // A noisy scan of the unit sphere with four holes whose sampling thins out toward them, as
+    // a scanner's does where its rays graze the surface before it sees none: no samples within
+    // 0.2 of a hole's centre, then a share growing as the square of the distance out to 0.5.
+    // Between the thinning samples the mesh follows the field's extrapolation of their noisy
+    // fits. The fairing of the finest level takes in that rim, along the mesh up to 14
+    // spacings from the hole, wherever a vertex is farther than 0.75 spacings from every
+    // sample (measured: 601 vertices faired where 311 lie over the bare discs; 436 with the
+    // earlier band of 3 rings beyond 1.5 spacings), and the mesh over the holes and rims lies
+    // closer to the sphere (mean 0.00164 against 0.00207 then; the worst 0.0165 and 0.0177).
+    // On a sphere the field's quadrics extrapolate well, so this is not always so: with the
+    // bare discs 0.1 and the share growing as the fourth power out to 0.6 the worst was 0.0263
+    // against 0.0146 (the mean 0.00234 against 0.00202); on twenty simulated scans of a CAD
+    // part and a cow, whose rims' fits extrapolate worse, every one was closer.
+    const std::array<Vec3d, 4> centres = {Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(-0.6, -0.8, 0),
+                                          Vec3d(0, 0, -1)};
+    constexpr double bare = 0.2;
+    constexpr double thinning = 0.5;
+    const PointCloud drawn =
+        sample_shape(Shape::Sphere, {.count = 60000, .seed = 5, .noise = 0.002});
+    PointCloud raw_points;
+    raw_points.origin = drawn.origin;
+    for (std::size_t i = 0; i < drawn.size(); ++i)
+    {
+        const Vec3d p = drawn.world(i);
+        double keep = 1.0;
+        for (const Vec3d& c : centres)
+        {
+            const double t = std::clamp(((p - c).norm() - bare) / (thinning - bare), 0.0, 1.0);
+            keep = std::min(keep, t * t);
+        }
+        if (unit_hash(i) < keep)
+            raw_points.positions.push_back(drawn.positions[i]);
+    }
+    const ReconstructReport report = reconstruct(surfels_from_samples(raw_points).surfels, {});
+    const UnsupportedFairing& faired = report.semi_regular.refinement.unsupported;
+    EXPECT_GE(faired.regions, centres.size());
+    const MultiresMesh& hierarchy = report.semi_regular.hierarchy;
+    const TriMesh finest = hierarchy.level_mesh(hierarchy.finest_level());
+    std::size_t bare_vertices = 0;
+    for (std::size_t v = 0; v < finest.vertex_count(); ++v)
+        bare_vertices += std::any_of(centres.begin(), centres.end(),
+                                     [&](const Vec3d& c) {
+                                         return (finest.vertices.world(v) - c).norm() < bare;
+                                     })
+                             ? 1
+                             : 0;
+    RecordProperty("faired_vertices", std::to_string(faired.vertices));
+    RecordProperty("bare_vertices", std::to_string(bare_vertices));
+    EXPECT_GT(static_cast<double>(faired.vertices), 1.6 * static_cast<double>(bare_vertices));
+    double worst = 0.0;
+    double mean = 0.0;
+    for (const Vec3d& c : centres)
+    {
+        const test::SphereDeviation near = test::sphere_deviation(hierarchy, c, thinning);
+        worst = std::max(worst, near.worst);
+        mean += near.mean / static_cast<double>(centres.size());
+    }
+    RecordProperty("worst", std::to_string(worst));
+    RecordProperty("mean", std::to_string(mean));
+    EXPECT_LT(worst, 0.02);
+    EXPECT_LT(mean, 0.0019);
+    // The held vertices next to the faired regions relax with them: few thin triangles.
+    const AngleQuality angles = angle_quality(finest);
+    RecordProperty("slivers", std::to_string(angles.sliver_share));
+    EXPECT_LT(angles.sliver_share, 0.003);
     EXPECT_TRUE(analyze_topology(finest).is_closed());
     EXPECT_EQ(analyze_topology(finest).euler_characteristic, 2);
 }
