@@ -481,13 +481,14 @@ TEST(HoleFill, ThinningRimsAreFairedWithTheirHoles)
     // Between the thinning samples the mesh follows the field's extrapolation of their noisy
     // fits. The fairing of the finest level takes in that rim, along the mesh up to 14
     // spacings from the hole, wherever a vertex is farther than 0.75 spacings from every
-    // sample (measured: 601 vertices faired where 311 lie over the bare discs; 436 with the
-    // earlier band of 3 rings beyond 1.5 spacings), and the mesh over the holes and rims lies
-    // closer to the sphere (mean 0.00164 against 0.00207 then; the worst 0.0165 and 0.0177).
-    // On a sphere the field's quadrics extrapolate well, so this is not always so: with the
-    // bare discs 0.1 and the share growing as the fourth power out to 0.6 the worst was 0.0263
-    // against 0.0146 (the mean 0.00234 against 0.00202); on twenty simulated scans of a CAD
-    // part and a cow, whose rims' fits extrapolate worse, every one was closer.
+    // sample (measured: 638 vertices faired where 311 lie over the bare discs; 436 with the
+    // earlier band of 3 rings beyond 1.5 spacings and a core at 2.5), and the mesh over the
+    // holes and rims lies closer to the sphere (mean 0.00164 against 0.00207 then; the worst
+    // 0.0117 and 0.0177). On a sphere the field's quadrics extrapolate well, so this is not
+    // always so: with the bare discs 0.1 and the share growing as the fourth power out to 0.6
+    // the worst was 0.0268 against 0.0146 (the mean 0.00230 against 0.00202); on twenty
+    // simulated scans of a CAD part and a cow, whose rims' fits extrapolate worse, every one
+    // was closer.
     const std::array<Vec3d, 4> centres = {Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(-0.6, -0.8, 0),
                                           Vec3d(0, 0, -1)};
     constexpr double bare = 0.2;
