@@ -161,14 +161,16 @@ struct RefineOptions
     /// refine(), StopRule::Automatic: fair the finest level where no sample supports it. The
     /// regions of vertices far from every sample (a filled hole, BaseMeshOptions::fill_holes,
     /// and the band around it where the field extrapolates the rim's last, often noisy, fits:
-    /// farther than 2.5 local sample spacings, with an interior vertex or one farther than 5
-    /// (a spike), plus up to 3 rings of
-    /// neighbours farther than 1.5) take the smoothest surface that continues the mesh around
-    /// them (thin-plate fairing, the rest held). Measured on the noisy inputs with holes of
-    /// bench/peers (100k samples): symmetric Hausdorff to the truth, % of the diagonal, without
-    /// / with: sphere 0.48 / 0.37, plate 1.22 / 0.75, part 1.35 / 1.17; the shipped bunny scan,
-    /// Chamfer to bun_zipper 0.0715 / 0.0651; a clean part unchanged (no region kept). Done
-    /// before the smoothing of denoise_rounds, which smooths the faired vertices across creases.
+    /// farther than 2 local sample spacings, with an interior vertex or one farther than 5
+    /// (a spike), grown through the neighbours farther than 0.75 spacings, as far as 14 of the
+    /// cloud's median spacings along the mesh) take the smoothest surface that continues the
+    /// mesh around them (thin-plate fairing, the rest held), and are relaxed along it with the
+    /// two rings of held vertices around them. Measured on the noisy inputs with holes of
+    /// bench/peers (100k samples) when it came in (with a core of 2.5 and a band of 3 rings
+    /// beyond 1.5 spacings): symmetric Hausdorff to the truth, % of the diagonal, without /
+    /// with: sphere 0.48 / 0.37, plate 1.22 / 0.75, part 1.35 / 1.17; the shipped bunny scan,
+    /// Chamfer to bun_zipper 0.0715 / 0.0651 (0.0490 with today's rule). Done before the
+    /// smoothing of denoise_rounds, which smooths the faired vertices across creases.
     bool fair_unsupported = true;
     /// refine(): stop once the one-sided Hausdorff distance from the samples to M^J is below
     /// this, in world units (§5.2.4). 0 = estimate_sampling_density(samples)
