@@ -100,7 +100,9 @@ void print_refinement(const SemiRegularReport& r)
         if (r.refinement.unsupported.regions > 0)
             print_row("faired", std::to_string(r.refinement.unsupported.regions) +
                                     " regions no sample supports (filled holes and their "
-                                    "rims), " +
+                                    "rims; " +
+                                    std::to_string(r.refinement.unsupported.membranes) +
+                                    " as membranes, the rest as thin plates), " +
                                     std::to_string(r.refinement.unsupported.vertices) +
                                     " vertices; farthest move " +
                                     format_number(r.refinement.unsupported.max_move));

@@ -417,13 +417,49 @@ struct Patch
 /// Fairs `free` vertices (those of a filled hole) to the smoothest surface that continues the
 /// mesh around them: they minimise Σ ‖L x_i‖² over themselves and their neighbours i, with L the
 /// uniform Laplacian (the mean of the neighbours minus the vertex) and every other vertex held,
-/// so the patch meets its rim with the slope of the ring outside it (thin-plate fairing).
-/// Returns false, the vertices untouched, where the system is singular.
+/// so the patch meets its rim with the slope of the ring outside it (thin-plate fairing); or
+/// over themselves alone (a membrane) where their rim is flat and the surface around leaves its
+/// plane steeply (detail::fill_for_rim(): a face the scanner never saw, whose creases the mesh
+/// rounds). Returns false, the vertices untouched, where the system is singular.
 bool fair_bilaplacian(OmMesh& mesh, const std::vector<OmMesh::VertexHandle>& free)
 {
     std::vector<std::uint32_t> indices(free.size());
+    std::vector<char> is_free(mesh.n_vertices(), 0);
     for (std::size_t i = 0; i < free.size(); ++i)
+    {
         indices[i] = static_cast<std::uint32_t>(free[i].idx());
+        is_free[indices[i]] = 1;
+    }
+    // The rim (the held vertices next to the free ones) and the held surface's normals there
+    // (area-weighted, over the faces with no free vertex).
+    std::vector<char> on_rim(mesh.n_vertices(), 0);
+    std::vector<Vec3d> rim;
+    std::vector<Vec3d> rim_normals;
+    for (const auto v : free)
+        for (const auto w : mesh.vv_range(v))
+        {
+            const auto i = static_cast<std::size_t>(w.idx());
+            if (is_free[i] != 0 || on_rim[i] != 0)
+                continue;
+            on_rim[i] = 1;
+            Vec3d normal = Vec3d::Zero();
+            for (const auto f : mesh.vf_range(w))
+            {
+                std::array<Vec3d, 3> corner;
+                std::size_t c = 0;
+                bool held = true;
+                for (const auto u : mesh.fv_range(f))
+                {
+                    held = held && is_free[static_cast<std::size_t>(u.idx())] == 0;
+                    if (c < 3)
+                        corner[c++] = to_eigen(mesh.point(u));
+                }
+                if (held && c == 3)
+                    normal += (corner[1] - corner[0]).cross(corner[2] - corner[0]);
+            }
+            rim.push_back(to_eigen(mesh.point(w)));
+            rim_normals.push_back(normal);
+        }
     const std::optional<std::vector<Vec3d>> faired = detail::thin_plate_fairing(
         mesh.n_vertices(), indices,
         [&mesh](std::uint32_t v, const auto& visit) {
@@ -432,7 +468,8 @@ bool fair_bilaplacian(OmMesh& mesh, const std::vector<OmMesh::VertexHandle>& fre
         },
         [&mesh](std::uint32_t v) {
             return to_eigen(mesh.point(OmMesh::VertexHandle(static_cast<int>(v))));
-        });
+        },
+        detail::fill_for_rim(rim, rim_normals));
     if (!faired)
         return false;
     for (std::size_t i = 0; i < free.size(); ++i)

@@ -1347,9 +1347,53 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
         front = std::move(next);
     }
     // Regions of the free vertices; one with no held neighbour (a whole component far from
-    // the samples) has nothing to continue and stays.
+    // the samples) has nothing to continue and stays. Each is faired on its own, as a thin
+    // plate or a membrane as its rim says (choose_fill()).
+    const auto for_each_neighbour = [&](std::uint32_t v, const auto& visit) {
+        for (const std::uint32_t w : ring(v))
+            visit(w);
+    };
+    const auto position = [&](std::uint32_t v) {
+        return x[v];
+    };
+    // The held surface's normals (area-weighted, over the faces with no free vertex), for the
+    // rims' slopes.
+    std::vector<Vec3d> normal(n, Vec3d::Zero());
+    for (const Triangle& t : faces)
+    {
+        if (free[t[0]] != 0 || free[t[1]] != 0 || free[t[2]] != 0)
+            continue;
+        const Vec3d area = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
+        for (const std::uint32_t v : t)
+            normal[v] += area;
+    }
+    std::vector<char> on_rim(n, 0);
+    // The fill of one region (detail::fill_for_rim()), from its rim: the held vertices next to it.
+    const auto choose_fill = [&](std::span<const std::uint32_t> region_vertices) {
+        std::vector<std::uint32_t> rim;
+        for (const std::uint32_t v : region_vertices)
+            for (const std::uint32_t w : ring(v))
+                if (free[w] == 0 && on_rim[w] == 0)
+                {
+                    on_rim[w] = 1;
+                    rim.push_back(w);
+                }
+        for (const std::uint32_t w : rim)
+            on_rim[w] = 0;
+        std::sort(rim.begin(), rim.end());
+        std::vector<Vec3d> at(rim.size());
+        std::vector<Vec3d> normals(rim.size());
+        for (std::size_t i = 0; i < rim.size(); ++i)
+        {
+            at[i] = x[rim[i]];
+            normals[i] = normal[rim[i]];
+        }
+        return detail::fill_for_rim(at, normals);
+    };
     std::fill(region.begin(), region.end(), unset);
     std::vector<std::uint32_t> unknowns;
+    std::vector<Vec3d> before;
+    std::vector<char> flat_fill(n, 0);
     for (std::size_t seed = 0; seed < n; ++seed)
     {
         if (free[seed] == 0 || region[seed] != unset)
@@ -1376,54 +1420,56 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
         }
         if (!held)
             continue;
-        ++out.regions;
         std::sort(members.begin(), members.end());
-        unknowns.insert(unknowns.end(), members.begin(), members.end());
+        const detail::Fairing fill = choose_fill(members);
+        const std::optional<std::vector<Vec3d>> solution =
+            detail::thin_plate_fairing(n, members, for_each_neighbour, position, fill);
+        if (!solution)
+            continue;
+        ++out.regions;
+        if (fill == detail::Fairing::membrane)
+            ++out.membranes;
+        for (std::size_t i = 0; i < members.size(); ++i)
+        {
+            flat_fill[members[i]] = fill == detail::Fairing::membrane ? 1 : 0;
+            before.push_back(x[members[i]]);
+            x[members[i]] = (*solution)[i];
+            faired[members[i]] = 1;
+            unknowns.push_back(members[i]);
+        }
     }
     if (unknowns.empty())
         return out;
-    std::sort(unknowns.begin(), unknowns.end());
-    const std::optional<std::vector<Vec3d>> solution = detail::thin_plate_fairing(
-        n, unknowns,
-        [&](std::uint32_t v, const auto& visit) {
-            for (const std::uint32_t w : ring(v))
-                visit(w);
-        },
-        [&](std::uint32_t v) { return x[v]; });
-    if (!solution)
-    {
-        out.regions = 0;
-        return out;
-    }
     out.vertices = unknowns.size();
-    std::vector<Vec3d> before(unknowns.size());
-    for (std::size_t i = 0; i < unknowns.size(); ++i)
-    {
-        before[i] = x[unknowns[i]];
-        x[unknowns[i]] = (*solution)[i];
-        faired[unknowns[i]] = 1;
-    }
     // The faired vertices and the held ones around them (unsupported_relax_rings), but not the
-    // mesh's boundary.
-    std::vector<std::uint32_t> relaxed = unknowns;
+    // mesh's boundary: the membranes' first, towards their faces' centroids (RelaxTarget), then
+    // the thin plates'.
     std::vector<char> taken(faired.begin(), faired.end());
-    std::vector<std::uint32_t> ring_front = unknowns;
-    for (std::size_t r = 0; r < unsupported_relax_rings && !ring_front.empty(); ++r)
+    for (const bool membranes : {true, false})
     {
-        std::vector<std::uint32_t> next;
-        for (const std::uint32_t v : ring_front)
-            for (const std::uint32_t w : ring(v))
-                if (taken[w] == 0 && rings.boundary[w] == 0)
-                {
-                    taken[w] = 1;
-                    next.push_back(w);
-                }
-        relaxed.insert(relaxed.end(), next.begin(), next.end());
-        ring_front = std::move(next);
+        std::vector<std::uint32_t> relaxed;
+        for (const std::uint32_t v : unknowns)
+            if ((flat_fill[v] != 0) == membranes)
+                relaxed.push_back(v);
+        std::vector<std::uint32_t> ring_front = relaxed;
+        for (std::size_t r = 0; r < unsupported_relax_rings && !ring_front.empty(); ++r)
+        {
+            std::vector<std::uint32_t> next;
+            for (const std::uint32_t v : ring_front)
+                for (const std::uint32_t w : ring(v))
+                    if (taken[w] == 0 && rings.boundary[w] == 0)
+                    {
+                        taken[w] = 1;
+                        next.push_back(w);
+                    }
+            relaxed.insert(relaxed.end(), next.begin(), next.end());
+            ring_front = std::move(next);
+        }
+        std::sort(relaxed.begin(), relaxed.end());
+        detail::relax_tangentially(
+            x, faces, rings.offsets, rings.adjacent, relaxed, detail::faired_relax_rounds,
+            membranes ? detail::RelaxTarget::face_centroids : detail::RelaxTarget::neighbours_mean);
     }
-    std::sort(relaxed.begin(), relaxed.end());
-    detail::relax_tangentially(x, faces, rings.offsets, rings.adjacent, relaxed,
-                               detail::faired_relax_rounds);
     for (std::size_t i = 0; i < unknowns.size(); ++i)
         out.max_move = std::max(out.max_move, (x[unknowns[i]] - before[i]).norm());
     return out;

@@ -31,7 +31,7 @@ Vec3d area_normal(const Vec3d& a, const Vec3d& b, const Vec3d& c)
 void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces,
                         std::span<const std::uint32_t> ring_offsets,
                         std::span<const std::uint32_t> ring_adjacent,
-                        std::span<const std::uint32_t> free, int rounds)
+                        std::span<const std::uint32_t> free, int rounds, RelaxTarget target)
 {
     std::vector<std::uint32_t> slot(x.size(), std::numeric_limits<std::uint32_t>::max());
     for (std::size_t i = 0; i < free.size(); ++i)
@@ -68,17 +68,33 @@ void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces,
     const TriangleBvh surface(reference);
     std::vector<Vec3d> normal(free.size());
     std::vector<Vec3d> next(free.size());
+    // RelaxTarget::face_centroids: each free vertex's faces' centroids, weighted by the faces'
+    // areas (twice, as area_normal() gives them).
+    const bool by_area = target == RelaxTarget::face_centroids;
+    std::vector<Vec3d> centroid(by_area ? free.size() : 0);
+    std::vector<double> area(by_area ? free.size() : 0);
     for (int round = 0; round < rounds; ++round)
     {
         const bool project = round + 1 == rounds;
         std::fill(normal.begin(), normal.end(), Vec3d::Zero());
+        std::fill(centroid.begin(), centroid.end(), Vec3d::Zero());
+        std::fill(area.begin(), area.end(), 0.0);
         for (const std::uint32_t f : touching)
         {
             const Triangle& t = faces[f];
             const Vec3d n = area_normal(x[t[0]], x[t[1]], x[t[2]]);
+            const double a = n.norm();
+            const Vec3d c = (x[t[0]] + x[t[1]] + x[t[2]]) / 3.0;
             for (const std::uint32_t v : t)
                 if (slot[v] != std::numeric_limits<std::uint32_t>::max())
+                {
                     normal[slot[v]] += n;
+                    if (by_area)
+                    {
+                        centroid[slot[v]] += a * c;
+                        area[slot[v]] += a;
+                    }
+                }
         }
         parallel_blocks(free.size(), relax_block, [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i)
@@ -93,6 +109,8 @@ void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces,
                 for (std::uint32_t e = ring_offsets[v]; e < ring_offsets[v + 1]; ++e)
                     mean += x[ring_adjacent[e]];
                 mean /= static_cast<double>(ring_offsets[v + 1] - ring_offsets[v]);
+                if (by_area && area[i] > 0.0)
+                    mean = centroid[i] / area[i];
                 const Vec3d move = mean - x[v];
                 next[i] = x[v] + move - move.dot(n) * n;
                 if (project)

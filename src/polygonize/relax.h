@@ -20,6 +20,22 @@ namespace pointform::detail {
 /// unrelaxed, 1.91 / 2.00 / 1.50% after 50 rounds.
 constexpr int faired_relax_rounds = 50;
 
+/// Where relax_tangentially() moves a vertex towards: the mean of its neighbours (uniform), or
+/// the centroid of its faces' centroids weighted by their areas, which evens out the faces'
+/// areas. A flat fill of a region whose connectivity was made for a bulging surface (a
+/// membrane, RefineOptions::fair_unsupported) has more vertices than its area needs; the
+/// neighbours' mean is the membrane's own fixed point and leaves them crowded in its middle, in
+/// thin triangles, where the areas' centroids spread them: on the seventh simulated fandisk
+/// scan (bench/peers/virtual_scan.py), whose largest membrane has nearly all of its faces 19
+/// rings in under 20°, the finest level's triangles under 20° went 2.02% -> 1.62%, and over ten
+/// such scans the most 2.02% -> 1.83%. On thin plates it did not help (over twenty scans the
+/// most 1.83% -> 2.82%), so they keep the neighbours' mean.
+enum class RelaxTarget
+{
+    neighbours_mean,
+    face_centroids,
+};
+
 /// \brief Tangential relaxation of the `free` vertices (sorted, distinct) of a mesh: `rounds`
 /// Jacobi steps in parallel blocks (the same positions whatever the thread count), each moving
 /// a vertex towards the mean of its neighbours within its tangent plane (the area-weighted
@@ -36,7 +52,8 @@ constexpr int faired_relax_rounds = 50;
 void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces,
                         std::span<const std::uint32_t> ring_offsets,
                         std::span<const std::uint32_t> ring_adjacent,
-                        std::span<const std::uint32_t> free, int rounds);
+                        std::span<const std::uint32_t> free, int rounds,
+                        RelaxTarget target = RelaxTarget::neighbours_mean);
 
 /// \brief A vertex that stands `offset` off the plane of its neighbours, put back on the field
 /// from their centroid `centre` (world coordinates): the projection of the centroid along the

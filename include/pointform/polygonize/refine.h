@@ -163,9 +163,12 @@ struct RefineOptions
     /// and the band around it where the field extrapolates the rim's last, often noisy, fits:
     /// farther than 2 local sample spacings, with an interior vertex or one farther than 5
     /// (a spike), grown through the neighbours farther than 0.75 spacings, as far as 14 of the
-    /// cloud's median spacings along the mesh) take the smoothest surface that continues the
-    /// mesh around them (thin-plate fairing, the rest held), and are relaxed along it with the
-    /// two rings of held vertices around them. Measured on the noisy inputs with holes of
+    /// cloud's median spacings along the mesh) take, each on its own, the smoothest surface that
+    /// continues the mesh around them (thin-plate fairing, the rest held), or a membrane where
+    /// the region's rim is flat and the surface leaves its plane steeply (a face the scanner
+    /// never saw, whose creases the mesh rounds; see fill_for_rim() in
+    /// src/polygonize/thin_plate.h), and are relaxed along it with the two rings of held
+    /// vertices around them. Measured on the noisy inputs with holes of
     /// bench/peers (100k samples) when it came in (with a core of 2.5 and a band of 3 rings
     /// beyond 1.5 spacings): symmetric Hausdorff to the truth, % of the diagonal, without /
     /// with: sphere 0.48 / 0.37, plate 1.22 / 0.75, part 1.35 / 1.17; the shipped bunny scan,
@@ -195,9 +198,10 @@ struct RefineOptions
 /// (RefineOptions::fair_unsupported).
 struct UnsupportedFairing
 {
-    std::size_t regions = 0;  ///< connected regions faired
-    std::size_t vertices = 0; ///< their vertices
-    double max_move = 0.0;    ///< the farthest a vertex moved, world units
+    std::size_t regions = 0;   ///< connected regions faired
+    std::size_t membranes = 0; ///< of those, the ones faired as a membrane (the rest thin plates)
+    std::size_t vertices = 0;  ///< their vertices
+    double max_move = 0.0;     ///< the farthest a vertex moved, world units
 };
 
 /// \brief What one refinement M^i → M^(i+1) did.
