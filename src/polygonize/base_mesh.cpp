@@ -445,17 +445,11 @@ bool fair_bilaplacian(OmMesh& mesh, const std::vector<OmMesh::VertexHandle>& fre
             Vec3d normal = Vec3d::Zero();
             for (const auto f : mesh.vf_range(w))
             {
-                std::array<Vec3d, 3> corner;
-                std::size_t c = 0;
                 bool held = true;
                 for (const auto u : mesh.fv_range(f))
-                {
                     held = held && is_free[static_cast<std::size_t>(u.idx())] == 0;
-                    if (c < 3)
-                        corner[c++] = to_eigen(mesh.point(u));
-                }
-                if (held && c == 3)
-                    normal += (corner[1] - corner[0]).cross(corner[2] - corner[0]);
+                if (held)
+                    normal += area_normal(face_points(mesh, f));
             }
             rim.push_back(to_eigen(mesh.point(w)));
             rim_normals.push_back(normal);

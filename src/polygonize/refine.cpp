@@ -1363,7 +1363,7 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
     {
         if (free[t[0]] != 0 || free[t[1]] != 0 || free[t[2]] != 0)
             continue;
-        const Vec3d area = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
+        const Vec3d area = area_normal(x[t[0]], x[t[1]], x[t[2]]);
         for (const std::uint32_t v : t)
             normal[v] += area;
     }

@@ -117,8 +117,8 @@ template <class ForEachNeighbour, class Position>
     std::vector<char> in_rows(vertex_count, 0);
     for (const std::uint32_t v : free)
         in_rows[v] = 1;
-    for (const std::uint32_t v : free)
-        if (fairing == Fairing::thin_plate)
+    if (fairing == Fairing::thin_plate)
+        for (const std::uint32_t v : free)
             for_each_neighbour(v, [&](std::uint32_t w) {
                 if (in_rows[w] == 0)
                 {

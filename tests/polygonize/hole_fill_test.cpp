@@ -419,8 +419,9 @@ TEST(HoleFill, AFaceTheScannerNeverSawIsFilledFlat)
 {
     // The machined part (a block with a cylindrical boss of radius 0.35 on top, its top face at
     // z = 0.7) with no sample on the boss's top face, as a scanner that never looked down on it.
-    // The hole is filled, but a thin plate over it takes the boss's vertical walls on: the base
-    // mesh's patch rose to z = 1.97 and the finest level's faired region to 3.73 (measured).
+    // The hole is filled, but a thin plate over it takes the boss's vertical walls on: with
+    // thin plates alone (8a0283f) the base mesh's patch rose to z = 2.19 and the finest level
+    // to 3.41 (measured on these samples through the CLI).
     // The hole's rim is flat and the surface leaves its plane steeply, so both are membranes
     // (detail::fill_for_rim()) in the rim's plane: the rounded crease, a little below the face.
     const PointCloud all = sample_shape(Shape::Part, {.count = 60000, .seed = 1});
@@ -451,7 +452,7 @@ TEST(HoleFill, AFaceTheScannerNeverSawIsFilledFlat)
     }
     RecordProperty("worst", std::to_string(worst));
     EXPECT_GT(inside, 50U);
-    EXPECT_LT(worst, 0.05); // 0.032 measured (seed 7)
+    EXPECT_LT(worst, 0.05); // 0.030 measured
 }
 
 /// The share of `points` within `reach` of one of `centres`.
