@@ -4,6 +4,7 @@
 #include "relax.h"
 
 #include "pointform/core/parallel.h"
+#include "pointform/metrics/quality.h"
 #include "pointform/polygonize/projection.h"
 #include "pointform/spatial/triangle_bvh.h"
 
@@ -12,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <vector>
 
@@ -124,6 +126,45 @@ void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces,
         for (std::size_t i = 0; i < free.size(); ++i)
             x[free[i]] = next[i];
     }
+}
+
+int relax_membranes(std::span<Vec3d> x, std::span<const Triangle> faces,
+                    std::span<const std::uint32_t> ring_offsets,
+                    std::span<const std::uint32_t> ring_adjacent,
+                    std::span<const std::uint32_t> free, std::size_t depth)
+{
+    std::vector<char> moving(x.size(), 0);
+    for (const std::uint32_t v : free)
+        moving[v] = 1;
+    std::vector<std::uint32_t> around;
+    for (std::size_t f = 0; f < faces.size(); ++f)
+        if (moving[faces[f][0]] != 0 || moving[faces[f][1]] != 0 || moving[faces[f][2]] != 0)
+            around.push_back(static_cast<std::uint32_t>(f));
+    const double bound = 20.0 * std::numbers::pi / 180.0;
+    const auto thin_share = [&] {
+        if (around.empty())
+            return 0.0;
+        std::size_t thin = 0;
+        for (const std::uint32_t f : around)
+            if (triangle_min_angle(x[faces[f][0]], x[faces[f][1]], x[faces[f][2]]) < bound)
+                ++thin;
+        return static_cast<double>(thin) / static_cast<double>(around.size());
+    };
+    const std::size_t most =
+        std::max<std::size_t>(depth * depth, static_cast<std::size_t>(faired_relax_rounds));
+    double share = 1.0;
+    int rounds = 0;
+    while (static_cast<std::size_t>(rounds) < most)
+    {
+        relax_tangentially(x, faces, ring_offsets, ring_adjacent, free, faired_relax_rounds,
+                           RelaxTarget::face_centroids);
+        rounds += faired_relax_rounds;
+        const double now = thin_share();
+        if (!(now > membrane_thin_share) || !(now < (1.0 - membrane_round_gain) * share))
+            break;
+        share = now;
+    }
+    return rounds;
 }
 
 std::optional<Vec3d> project_from_centroid(const Field& field, const Vec3d& centre, double offset,

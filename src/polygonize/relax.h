@@ -55,6 +55,35 @@ void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces,
                         std::span<const std::uint32_t> free, int rounds,
                         RelaxTarget target = RelaxTarget::neighbours_mean);
 
+/// relax_membranes() relaxes in rounds of faired_relax_rounds for as long as a round leaves
+/// more than this share of the faces around the relaxed vertices under 20° (the share the
+/// finest level as a whole is held to) ...
+constexpr double membrane_thin_share = 0.02;
+/// ... and takes that share down by at least this fraction of itself.
+constexpr double membrane_round_gain = 0.1;
+
+/// \brief relax_tangentially() with RelaxTarget::face_centroids of a flat fill (a membrane,
+/// RefineOptions::fair_unsupported) `depth` rings deep (1: every free vertex next to a held
+/// one): faired_relax_rounds at first, then as many more, again and again, while
+/// membrane_thin_share and membrane_round_gain say so and fewer than depth² rounds are made
+/// (Jacobi steps spread a crowding over about the square root of their count in rings).
+///
+/// A membrane's first layout is Tutte's embedding of its connectivity (each vertex at its
+/// neighbours' mean), and that connectivity was made for the surface the field had there,
+/// which may bulge far out of the membrane's plane: a large one's middle is crowded. On the
+/// fifteenth simulated fandisk scan (bench/peers/virtual_scan.py, seed 15), whose membranes of
+/// 3,796 and 1,786 vertices lie up to 16 rings deep, 4.0% of the finest level's triangles were
+/// under 20° after 50 rounds, nearly all of them 10 rings or more inside; after 300 rounds
+/// (18% -> 4.4% of the faces around the membranes) 1.0%, with the same F@0.5% and Chamfer to
+/// the truth. Fandisk, spot and teapot scans at seeds 11-15 (4-8 for the teapot): triangles
+/// under 20° 0.67% -> 0.45% on average, 4.00% -> 1.85% at most; seeds 1-10 of the fandisk and
+/// spot: 0.61% -> 0.56%, 1.99% at most either way; F@0.5% and Chamfer the same to 0.0003.
+/// \return the rounds made
+int relax_membranes(std::span<Vec3d> x, std::span<const Triangle> faces,
+                    std::span<const std::uint32_t> ring_offsets,
+                    std::span<const std::uint32_t> ring_adjacent,
+                    std::span<const std::uint32_t> free, std::size_t depth);
+
 /// \brief A vertex that stands `offset` off the plane of its neighbours, put back on the field
 /// from their centroid `centre` (world coordinates): the projection of the centroid along the
 /// gradient there, within `reach`; nullopt unless the field at the centroid is defined and
