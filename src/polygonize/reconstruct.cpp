@@ -262,6 +262,27 @@ VertexResidual field_residual_at_vertices(const TriMesh& mesh, const Field& fiel
     return out;
 }
 
+double intermediate_face_limit(const PointField& field, double cell,
+                               const SemiRegularOptions& options, std::size_t samples)
+{
+    const double estimated = estimate_marching_cubes_faces(field.estimated_area(), cell);
+    std::size_t target = 0;
+    if (options.base_faces)
+    {
+        target = *options.base_faces;
+    }
+    else
+    {
+        target = std::clamp<std::size_t>(
+            static_cast<std::size_t>(std::min(estimated / default_base_share, 1e12)), 200,
+            max_default_base_faces);
+        if (samples > 0 && !options.levels && options.stop_rule == StopRule::Automatic)
+            target = fit_base_faces_to_budget(target, samples);
+    }
+    return std::min(max_intermediate_faces,
+                    intermediate_faces_per_base_face * static_cast<double>(target));
+}
+
 ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& options)
 {
     check_semi_regular_options(options.semi_regular);
@@ -303,7 +324,10 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
         IntermediateGrid intermediate{
             .cell = choose_cell_size(field, bounds, options.resolution, options.cell)};
         if (options.resolution <= 0 && !(options.cell > 0.0))
-            intermediate = intermediate_grid(field, intermediate.cell);
+            intermediate =
+                intermediate_grid(field, intermediate.cell,
+                                  intermediate_face_limit(field, intermediate.cell,
+                                                          options.semi_regular, samples.size()));
         const double cell = intermediate.cell;
         report.cell = cell;
         report.coarsening = intermediate.coarsening;

@@ -525,7 +525,10 @@ TEST(HoleFill, ThinningRimsAreFairedWithTheirHoles)
     // sample (measured: 638 vertices faired where 311 lie over the bare discs; 436 with the
     // earlier band of 3 rings beyond 1.5 spacings and a core at 2.5), and the mesh over the
     // holes and rims lies closer to the sphere (mean 0.00164 against 0.00207 then; the worst
-    // 0.0117 and 0.0177). On a sphere the field's quadrics extrapolate well, so this is not
+    // 0.0117 and 0.0177, on the base mesh of the field's own grid). The base mesh moves these:
+    // from intermediate grids of 6 to 20 faces per base face (intermediate_face_limit(), 8
+    // since the forty-second session) the mean was 0.00173-0.00203 and the worst 0.0134-0.0174,
+    // 683 vertices faired at 8. On a sphere the field's quadrics extrapolate well, so this is not
     // always so: with the bare discs 0.1 and the share growing as the fourth power out to 0.6
     // the worst was 0.0268 against 0.0146 (the mean 0.00230 against 0.00202); on twenty
     // simulated scans of a CAD part and a cow, whose rims' fits extrapolate worse, every one
@@ -577,7 +580,7 @@ TEST(HoleFill, ThinningRimsAreFairedWithTheirHoles)
     RecordProperty("worst", std::to_string(worst));
     RecordProperty("mean", std::to_string(mean));
     EXPECT_LT(worst, 0.02);
-    EXPECT_LT(mean, 0.0019);
+    EXPECT_LT(mean, 0.0022);
     // The held vertices next to the faired regions relax with them: few thin triangles.
     const AngleQuality angles = angle_quality(finest);
     RecordProperty("slivers", std::to_string(angles.sliver_share));

@@ -78,6 +78,33 @@ void expect_unit_sphere(const ReconstructReport& report, double tolerance = 0.0)
               tolerance > 0.0 ? tolerance : report.semi_regular.refinement.sampling_density);
 }
 
+TEST(Reconstruct, TheIntermediateMeshHasAFewFacesPerBaseFace)
+{
+    // The base mesh is simplified from a marching-cubes mesh of about
+    // intermediate_faces_per_base_face faces per base face, on a grid coarser than the field's
+    // where that would make more; the mesh is as closed and as close to the sphere.
+    const ReconstructReport report = reconstruct(sphere_surfels(20000));
+    const SemiRegularReport& semi = report.semi_regular;
+    ASSERT_TRUE(semi.base.has_value());
+    EXPECT_GT(report.coarsening, 1.0);
+    const double per_target = static_cast<double>(report.intermediate_faces) /
+                              static_cast<double>(semi.base->target_faces);
+    RecordProperty("per_target", std::to_string(per_target));
+    EXPECT_GT(per_target, 0.5 * intermediate_faces_per_base_face);
+    EXPECT_LT(per_target, 2.0 * intermediate_faces_per_base_face);
+    expect_unit_sphere(report);
+    // A picked face count sets the limit: 8 of the intermediate's faces each, and never fewer
+    // faces than the base mesh asks for.
+    const PointField field(sphere_surfels(20000), {});
+    const double cell = default_cell_size(field);
+    SemiRegularOptions picked;
+    picked.base_faces = 500;
+    EXPECT_DOUBLE_EQ(intermediate_face_limit(field, cell, picked, 20000),
+                     intermediate_faces_per_base_face * 500.0);
+    picked.base_faces = 1000000;
+    EXPECT_DOUBLE_EQ(intermediate_face_limit(field, cell, picked, 20000), max_intermediate_faces);
+}
+
 // A scan with one stray return far away (10^6 radii off the sphere): the stray was the whole
 // field's bounds and made marching cubes' cells larger than the sphere ("no triangles"); it is
 // left out (surfels_from_samples()), and the sphere comes out as without it.
