@@ -1132,16 +1132,6 @@ void relax_and_project(const OmMesh& mesh, const Field& field, bool relax, Verte
     state.no_crossing = std::move(next_none);
 }
 
-std::size_t default_base_faces(std::size_t faces, std::size_t components, std::size_t share,
-                               double coarsening)
-{
-    const std::size_t lower = std::max<std::size_t>(200, 8 * components);
-    const double equivalent = static_cast<double>(faces) * coarsening * coarsening;
-    const auto wanted =
-        static_cast<std::size_t>(std::min(equivalent / static_cast<double>(share), 1e12));
-    return std::min(std::clamp<std::size_t>(wanted, lower, max_default_base_faces), faces);
-}
-
 std::string describe_topology_change(const MeshTopology& before, const MeshTopology& after)
 {
     std::string out;
@@ -1174,6 +1164,16 @@ std::size_t fit_base_faces_to_budget(std::size_t target, std::size_t vertex_budg
         std::round(std::log(faces_wanted / static_cast<double>(target)) / std::log(4.0));
     const double fitted = faces_wanted / std::pow(4.0, levels);
     return std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(fitted)));
+}
+
+std::size_t default_base_faces(std::size_t faces, std::size_t components, std::size_t share,
+                               double coarsening)
+{
+    const std::size_t lower = std::max<std::size_t>(200, 8 * components);
+    const double equivalent = static_cast<double>(faces) * coarsening * coarsening;
+    const auto wanted =
+        static_cast<std::size_t>(std::min(equivalent / static_cast<double>(share), 1e12));
+    return std::min(std::clamp<std::size_t>(wanted, lower, max_default_base_faces), faces);
 }
 
 std::size_t default_base_faces(const TriMesh& intermediate, std::size_t share, double coarsening)

@@ -104,18 +104,28 @@ std::size_t target_for_affordable_levels(const MeshTopology& topology, std::size
     return static_cast<std::size_t>(std::llround(faces_wanted / std::pow(4.0, levels)));
 }
 
+/// The automatic base-face target for an intermediate mesh of `faces` faces in `components`
+/// pieces: default_base_faces(), fitted to a vertex budget of `samples` under the automatic
+/// stop without `levels` (at most `faces`).
+std::size_t automatic_base_faces(const SemiRegularOptions& options, std::size_t faces,
+                                 std::size_t components, std::size_t share, std::size_t samples,
+                                 double coarsening)
+{
+    const std::size_t target = default_base_faces(faces, components, share, coarsening);
+    if (samples == 0 || options.levels || options.stop_rule != StopRule::Automatic)
+        return target;
+    return std::min(faces, fit_base_faces_to_budget(target, samples));
+}
+
 } // namespace
 
 std::size_t base_face_target(const SemiRegularOptions& options, const TriMesh& intermediate,
                              std::size_t share, std::size_t samples, double coarsening)
 {
     if (!options.base_faces)
-    {
-        const std::size_t target = default_base_faces(intermediate, share, coarsening);
-        if (samples == 0 || options.levels || options.stop_rule != StopRule::Automatic)
-            return target;
-        return std::min(intermediate.face_count(), fit_base_faces_to_budget(target, samples));
-    }
+        return automatic_base_faces(options, intermediate.face_count(),
+                                    analyze_topology(intermediate).components, share, samples,
+                                    coarsening);
     const std::size_t wanted = *options.base_faces;
     if (wanted < 1)
         throw InvalidInput("--base-faces must be at least 1, not " + std::to_string(wanted));
@@ -266,19 +276,11 @@ double intermediate_face_limit(const PointField& field, double cell,
                                const SemiRegularOptions& options, std::size_t samples)
 {
     const double estimated = estimate_marching_cubes_faces(field.estimated_area(), cell);
-    std::size_t target = 0;
-    if (options.base_faces)
-    {
-        target = *options.base_faces;
-    }
-    else
-    {
-        target = std::clamp<std::size_t>(
-            static_cast<std::size_t>(std::min(estimated / default_base_share, 1e12)), 200,
-            max_default_base_faces);
-        if (samples > 0 && !options.levels && options.stop_rule == StopRule::Automatic)
-            target = fit_base_faces_to_budget(target, samples);
-    }
+    const std::size_t target =
+        options.base_faces
+            ? *options.base_faces
+            : automatic_base_faces(options, static_cast<std::size_t>(std::min(estimated, 1e15)), 1,
+                                   default_base_share, samples, 1.0);
     return std::min(max_intermediate_faces,
                     intermediate_faces_per_base_face * static_cast<double>(target));
 }

@@ -1203,45 +1203,6 @@ constexpr double unsupported_band = 0.75;
 /// with a band of 6 rings beyond 0.75 spacings: 0.62% and 2.02%).
 constexpr std::size_t unsupported_relax_rings = 2;
 
-/// The deepest membrane vertex's distance in rings from the held vertices (1 next to them), of
-/// the faired vertices `unknowns` that lie in membranes (`flat_fill`).
-std::size_t membrane_depth(const Rings& rings, std::span<const char> free,
-                           std::span<const char> flat_fill, std::span<const std::uint32_t> unknowns)
-{
-    std::vector<std::uint32_t> depth(free.size(), 0);
-    std::vector<std::uint32_t> front;
-    for (const std::uint32_t v : unknowns)
-    {
-        if (flat_fill[v] == 0)
-            continue;
-        for (std::uint32_t slot = rings.offsets[v]; slot < rings.offsets[v + 1]; ++slot)
-            if (free[rings.adjacent[slot]] == 0)
-            {
-                depth[v] = 1;
-                front.push_back(v);
-                break;
-            }
-    }
-    std::size_t deepest = front.empty() ? 0 : 1;
-    while (!front.empty())
-    {
-        std::vector<std::uint32_t> next;
-        for (const std::uint32_t v : front)
-            for (std::uint32_t slot = rings.offsets[v]; slot < rings.offsets[v + 1]; ++slot)
-            {
-                const std::uint32_t w = rings.adjacent[slot];
-                if (flat_fill[w] != 0 && free[w] != 0 && depth[w] == 0)
-                {
-                    depth[w] = depth[v] + 1;
-                    deepest = std::max<std::size_t>(deepest, depth[w]);
-                    next.push_back(w);
-                }
-            }
-        front = std::move(next);
-    }
-    return deepest;
-}
-
 /// Fairs the finest level where no sample supports it (RefineOptions::fair_unsupported): the
 /// regions of vertices far from every sample (filled holes and the rims around them, see
 /// unsupported_core) take the smoothest surface that continues the mesh around them, thin-plate
@@ -1513,8 +1474,9 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
             continue;
         }
         if (!relaxed.empty())
-            detail::relax_membranes(x, faces, rings.offsets, rings.adjacent, relaxed,
-                                    membrane_depth(rings, free, flat_fill, unknowns));
+            detail::relax_membranes(
+                x, faces, rings.offsets, rings.adjacent, relaxed,
+                detail::depth_in_rings(rings.offsets, rings.adjacent, flat_fill));
     }
     for (std::size_t i = 0; i < unknowns.size(); ++i)
         out.max_move = std::max(out.max_move, (x[unknowns[i]] - before[i]).norm());

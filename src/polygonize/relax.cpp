@@ -128,6 +128,44 @@ void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces,
     }
 }
 
+std::size_t depth_in_rings(std::span<const std::uint32_t> ring_offsets,
+                           std::span<const std::uint32_t> ring_adjacent,
+                           std::span<const char> inside)
+{
+    std::vector<std::uint32_t> depth(inside.size(), 0);
+    std::vector<std::uint32_t> front;
+    for (std::uint32_t v = 0; v < inside.size(); ++v)
+    {
+        if (inside[v] == 0)
+            continue;
+        for (std::uint32_t slot = ring_offsets[v]; slot < ring_offsets[v + 1]; ++slot)
+            if (inside[ring_adjacent[slot]] == 0)
+            {
+                depth[v] = 1;
+                front.push_back(v);
+                break;
+            }
+    }
+    std::size_t deepest = front.empty() ? 0 : 1;
+    while (!front.empty())
+    {
+        std::vector<std::uint32_t> next;
+        for (const std::uint32_t v : front)
+            for (std::uint32_t slot = ring_offsets[v]; slot < ring_offsets[v + 1]; ++slot)
+            {
+                const std::uint32_t w = ring_adjacent[slot];
+                if (inside[w] != 0 && depth[w] == 0)
+                {
+                    depth[w] = depth[v] + 1;
+                    deepest = std::max<std::size_t>(deepest, depth[w]);
+                    next.push_back(w);
+                }
+            }
+        front = std::move(next);
+    }
+    return deepest;
+}
+
 int relax_membranes(std::span<Vec3d> x, std::span<const Triangle> faces,
                     std::span<const std::uint32_t> ring_offsets,
                     std::span<const std::uint32_t> ring_adjacent,
@@ -140,7 +178,7 @@ int relax_membranes(std::span<Vec3d> x, std::span<const Triangle> faces,
     for (std::size_t f = 0; f < faces.size(); ++f)
         if (moving[faces[f][0]] != 0 || moving[faces[f][1]] != 0 || moving[faces[f][2]] != 0)
             around.push_back(static_cast<std::uint32_t>(f));
-    const double bound = 20.0 * std::numbers::pi / 180.0;
+    const double bound = default_sliver_degrees * std::numbers::pi / 180.0;
     const auto thin_share = [&] {
         if (around.empty())
             return 0.0;

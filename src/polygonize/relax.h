@@ -55,6 +55,13 @@ void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces,
                         std::span<const std::uint32_t> free, int rounds,
                         RelaxTarget target = RelaxTarget::neighbours_mean);
 
+/// \brief How deep a region lies, in rings: the largest distance along the rings' edges,
+/// walking through the region only, from a vertex outside it to one inside (1: next to one
+/// outside), over the vertices v with inside[v] != 0; 0 where none has a neighbour outside.
+[[nodiscard]] std::size_t depth_in_rings(std::span<const std::uint32_t> ring_offsets,
+                                         std::span<const std::uint32_t> ring_adjacent,
+                                         std::span<const char> inside);
+
 /// relax_membranes() relaxes in rounds of faired_relax_rounds for as long as a round leaves
 /// more than this share of the faces around the relaxed vertices under 20° (the share the
 /// finest level as a whole is held to) ...

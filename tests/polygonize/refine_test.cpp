@@ -633,36 +633,10 @@ TEST(RelaxMembranes, ATuttesLayoutOfABulgeIsSpreadOutInItsPlane)
         if (inside)
             free.push_back(v);
     }
-    // Depth in rings from the held vertices.
-    std::vector<std::size_t> depth(n, 0);
     std::vector<char> is_free(n, 0);
     for (const std::uint32_t v : free)
         is_free[v] = 1;
-    std::vector<std::uint32_t> front;
-    for (const std::uint32_t v : free)
-        for (std::uint32_t e = rings.offsets[v]; e < rings.offsets[v + 1]; ++e)
-            if (is_free[rings.adjacent[e]] == 0 && depth[v] == 0)
-            {
-                depth[v] = 1;
-                front.push_back(v);
-            }
-    std::size_t deepest = 1;
-    while (!front.empty())
-    {
-        std::vector<std::uint32_t> next;
-        for (const std::uint32_t v : front)
-            for (std::uint32_t e = rings.offsets[v]; e < rings.offsets[v + 1]; ++e)
-            {
-                const std::uint32_t w = rings.adjacent[e];
-                if (is_free[w] != 0 && depth[w] == 0)
-                {
-                    depth[w] = depth[v] + 1;
-                    deepest = std::max(deepest, depth[w]);
-                    next.push_back(w);
-                }
-            }
-        front = std::move(next);
-    }
+    const std::size_t deepest = detail::depth_in_rings(rings.offsets, rings.adjacent, is_free);
     const auto neighbours = [&](std::uint32_t v, const auto& visit) {
         for (std::uint32_t e = rings.offsets[v]; e < rings.offsets[v + 1]; ++e)
             visit(rings.adjacent[e]);

@@ -198,6 +198,12 @@ inline constexpr std::size_t max_default_base_faces = 80000;
                                              std::size_t share = default_base_share,
                                              double coarsening = 1.0);
 
+/// \brief default_base_faces() of an intermediate mesh of `faces` faces in `components`
+/// connected pieces (for one not built yet, from an estimate of its faces).
+[[nodiscard]] std::size_t default_base_faces(std::size_t faces, std::size_t components,
+                                             std::size_t share = default_base_share,
+                                             double coarsening = 1.0);
+
 /// The share of a vertex budget that a base mesh's refinement levels are planned to reach
 /// (fit_base_faces_to_budget()).
 inline constexpr double default_budget_fill = 0.6;
