@@ -6,8 +6,9 @@ paper's Fig. 4 claim), Open3D's Poisson at depth 9 and, with --bpa, ball pivotin
 
 Every tool starts from the same raw points (an analytic shape sampled by `pointform sample`,
 clean or with 0.2% noise and holes; the shipped bunny scan; or simulated multi-view range scans
-of a CAD part, data/meshes/fandisk.obj, by virtual_scan.py: occlusion, grazing dropout, range
-noise, holes and strays, measured against the mesh) and estimates its own normals: pointform inside its
+of a mesh of data/meshes/ (fandisk, a CAD part; spot, a smooth cow; teapot, with a thin spout
+and a handle) by virtual_scan.py: occlusion, grazing dropout, range noise, holes and strays,
+measured against the mesh) and estimates its own normals: pointform inside its
 commands, Open3D with estimate_normals + orient_normals_consistent_tangent_plane (k = 16), so
 times are end to end. Per tool: wall time, peak memory (/usr/bin/time), vertices, accuracy
 against the true analytic surface (symmetric Hausdorff and Chamfer in % of the diagonal,
@@ -134,7 +135,7 @@ def main(argv=None) -> int:
     ap.add_argument("--shapes", default="sphere,torus,blobby,part,plate,bunny,fandisk",
                     help="analytic shapes of `pointform sample`, bunny (the shipped scan, "
                          "clean only, against the Stanford reconstruction bun_zipper), and "
-                         "fandisk or spot (simulated scans of data/meshes/, against the mesh: "
+                         "fandisk, spot or teapot (simulated scans of data/meshes/, against the mesh: "
                          "--scan-seeds; --size and --variants do not apply)")
     ap.add_argument("--scan-seeds", default="1,2,3",
                     help="seeds of virtual_scan.py for each scanned mesh, comma-separated")

@@ -101,7 +101,8 @@ def _blobby_distance(p: np.ndarray) -> np.ndarray:
 BUNNY_MESH = HERE.parent.parent / "data" / "bunny" / "bun_zipper.ply"
 # Meshes that run_reconstruct_bench.py scans (virtual_scan.py): each is the truth of its scans.
 SCANNED_MESHES = {"fandisk": HERE.parent.parent / "data" / "meshes" / "fandisk.obj",
-                  "spot": HERE.parent.parent / "data" / "meshes" / "spot.obj"}
+                  "spot": HERE.parent.parent / "data" / "meshes" / "spot.obj",
+                  "teapot": HERE.parent.parent / "data" / "meshes" / "teapot.obj"}
 
 
 @functools.lru_cache(maxsize=None)
