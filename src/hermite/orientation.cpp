@@ -1348,16 +1348,37 @@ private:
     std::vector<std::uint32_t> size_;
 };
 
+/// The vote of a graph edge a–b between two patches on their relative orientation (> 0: the
+/// same), with the patches' signed normals: none for an edge off the sheet (off_sheet()), Hoppe's
+/// n_a·n_b where the normals are within the patches' own reliable turn, and the reflection
+/// rule's (OrientationRule::Reflection) where they turn more, across a crease: there Hoppe's
+/// agreement fades to nothing at a right angle and changes sign beyond it, so that at a crease
+/// sharper than 90° (a cone's rim, where a flat base meets a side at 76°) every edge across it
+/// voted to turn one face inside out, while the reflected normal follows the turn.
+float crossing_vote(const Vec3f& pa, const Vec3f& na, const Vec3f& pb, const Vec3f& nb,
+                    float reliable)
+{
+    if (off_sheet(pa, na, pb, nb))
+        return 0.0F;
+    const float hoppe = na.dot(nb);
+    if (std::abs(hoppe) >= reliable)
+        return hoppe;
+    return agreement_of(pa, na, pb, nb, OrientationRule::Reflection);
+}
+
 /// orient_normals_mst() for clean clouds under Hoppe's rule (noisy clouds keep the guided whole
 /// graph, orient_graph()): patches of consistently oriented samples, found block by block, are
 /// oriented against each other, and the signs spread to every sample.
 ///
 /// 1. Patches: in each block of patch_block samples (index order), the graph edges inside the
-///    block that are reliable (|n_a·n_b| at least 1 − patch_cost) and on the sheet (steep_edge)
-///    join their ends in signed disjoint sets, firm edges (firm_agreement) first: a patch's
-///    samples take their signs relative to its first sample from the edges that joined them.
-/// 2. Every graph edge between two patches votes on their relative orientation with its
-///    agreement (an edge off the sheet with none: it keeps the components whole but passes
+///    block that are reliable (|n_a·n_b| at least 1 − patch_cost), on the sheet (steep_edge) and
+///    between samples that are not creased (no neighbour's normal more than a reliable step
+///    away) join their ends in signed disjoint sets, firm edges (firm_agreement) first: a
+///    patch's samples take their signs relative to its first sample from the edges that joined
+///    them.
+/// 2. Every graph edge between two patches votes on their relative orientation
+///    (crossing_vote(): Hoppe's agreement within a reliable step, the reflection rule's across a
+///    crease; an edge off the sheet with none: it keeps the components whole but passes
 ///    nothing), summed per pair of patches, and a maximum spanning forest of the patch graph (by
 ///    the size of the vote) decides each patch's flip, as orient_graph() does with its patches.
 /// 3. Each component then faces +z at its highest sample and outwards by its flux; samples
@@ -1393,6 +1414,7 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
     parallel_blocks(blocks, 1, [&](std::size_t first, std::size_t last) {
         SignedSets sets;
         std::vector<std::uint32_t> later;
+        std::vector<std::uint8_t> creased;
         std::vector<std::uint32_t> local_id(patch_block);
         for (std::size_t b = first; b < last; ++b)
         {
@@ -1414,6 +1436,26 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
                     own =
                         sets.link(own.first, own.second, rj, oj, normals[i].dot(normals[j]) < 0.0F);
             };
+            //    Creased samples: some neighbour in the block has a normal more than a reliable
+            //    step from theirs. They join no patch: near a crease the estimated normals turn
+            //    from one face's to the other's the short way round as lines, which at a crease
+            //    sharper than 90° is the wrong way, and a chain of reliable steps through them
+            //    would join the two faces with one turned over. (Only the block's own samples
+            //    can chain within it, so only its own edges are looked at.)
+            creased.assign(end - begin, 0);
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                if (!usable(normals[i]))
+                    continue;
+                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                    if (j >= begin && j < end && j != i && usable(normals[j]) &&
+                        std::abs(normals[i].dot(normals[j])) < reliable)
+                    {
+                        creased[i - begin] = 1;
+                        creased[j - begin] = 1;
+                        break;
+                    }
+            }
             for (std::size_t i = begin; i < end; ++i)
             {
                 if (!usable(normals[i]))
@@ -1433,6 +1475,11 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
                     }
                     if (!usable(normals[j]))
                         continue;
+                    if (creased[i - begin] != 0 || creased[j - begin] != 0)
+                    {
+                        open.push_back(edge);
+                        continue;
+                    }
                     const float agree = std::abs(normals[i].dot(normals[j]));
                     if (agree >= firm)
                         join(i, c, j, own);
@@ -1507,8 +1554,7 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
                     continue;
                 const Vec3f ni = signed_normal(static_cast<std::uint32_t>(i));
                 const Vec3f nj = signed_normal(j);
-                const float weight =
-                    off_sheet(positions[i], ni, positions[j], nj) ? 0.0F : ni.dot(nj);
+                const float weight = crossing_vote(positions[i], ni, positions[j], nj, reliable);
                 const std::uint64_t pair =
                     (std::uint64_t{std::min(pi, pj)} << 32U) | std::max(pi, pj);
                 if (hit >= out.size() || out[hit].pair != pair)
