@@ -1350,20 +1350,22 @@ private:
 
 /// The vote of a graph edge a–b between two patches on their relative orientation (> 0: the
 /// same), with the patches' signed normals: none for an edge off the sheet (off_sheet()), Hoppe's
-/// n_a·n_b where the normals are within the patches' own reliable turn, and the reflection
-/// rule's (OrientationRule::Reflection) where they turn more, across a crease: there Hoppe's
-/// agreement fades to nothing at a right angle and changes sign beyond it, so that at a crease
-/// sharper than 90° (a cone's rim, where a flat base meets a side at 76°) every edge across it
-/// voted to turn one face inside out, while the reflected normal follows the turn.
+/// n_a·n_b where the normals are within the patches' own reliable turn and the reflection rule
+/// (OrientationRule::Reflection) orients b the same way, and the reflection rule's otherwise:
+/// across a crease, where Hoppe's agreement fades to nothing at a right angle and changes sign
+/// beyond it (at a cone's rim, where a flat base meets a side at 76°, every edge across voted
+/// to turn one face inside out, while the reflected normal follows the turn), and across a
+/// thin part (a knife edge), where the two sides' normals are nearly parallel as lines.
 float crossing_vote(const Vec3f& pa, const Vec3f& na, const Vec3f& pb, const Vec3f& nb,
                     float reliable)
 {
     if (off_sheet(pa, na, pb, nb))
         return 0.0F;
     const float hoppe = na.dot(nb);
-    if (std::abs(hoppe) >= reliable)
+    const float reflected = agreement_of(pa, na, pb, nb, OrientationRule::Reflection);
+    if (std::abs(hoppe) >= reliable && (hoppe < 0.0F) == (reflected < 0.0F))
         return hoppe;
-    return agreement_of(pa, na, pb, nb, OrientationRule::Reflection);
+    return reflected;
 }
 
 /// orient_normals_mst() for clean clouds under Hoppe's rule (noisy clouds keep the guided whole
@@ -1373,7 +1375,8 @@ float crossing_vote(const Vec3f& pa, const Vec3f& na, const Vec3f& pb, const Vec
 /// 1. Patches: in each block of patch_block samples (index order), the graph edges inside the
 ///    block that are reliable (|n_a·n_b| at least 1 − patch_cost), on the sheet (steep_edge) and
 ///    between samples that are not creased (no neighbour's normal more than a reliable step
-///    away) join their ends in signed disjoint sets, firm edges (firm_agreement) first: a
+///    away, nor one that the reflection rule orients otherwise than Hoppe's) join their ends in
+///    signed disjoint sets, firm edges (firm_agreement) first: a
 ///    patch's samples take their signs relative to its first sample from the edges that joined
 ///    them.
 /// 2. Every graph edge between two patches votes on their relative orientation
@@ -1437,24 +1440,33 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
                         sets.link(own.first, own.second, rj, oj, normals[i].dot(normals[j]) < 0.0F);
             };
             //    Creased samples: some neighbour in the block has a normal more than a reliable
-            //    step from theirs. They join no patch: near a crease the estimated normals turn
-            //    from one face's to the other's the short way round as lines, which at a crease
-            //    sharper than 90° is the wrong way, and a chain of reliable steps through them
-            //    would join the two faces with one turned over. (Only the block's own samples
-            //    can chain within it, so only its own edges are looked at.)
+            //    step from theirs, or one that Hoppe's rule and the reflection rule orient
+            //    differently (a steep edge between nearly parallel normals: the two sides of a
+            //    knife edge or a thin part). They join no patch: near a crease the estimated
+            //    normals turn from one face's to the other's the short way round as lines,
+            //    which at a crease sharper than 90° is the wrong way, and a chain of reliable
+            //    steps through them would join the two faces with one turned over. (Only the
+            //    block's own samples can chain within it, so only its own edges are looked at.)
             creased.assign(end - begin, 0);
             for (std::size_t i = begin; i < end; ++i)
             {
                 if (!usable(normals[i]))
                     continue;
                 for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
-                    if (j >= begin && j < end && j != i && usable(normals[j]) &&
-                        std::abs(normals[i].dot(normals[j])) < reliable)
+                {
+                    if (j < begin || j >= end || j == i || !usable(normals[j]))
+                        continue;
+                    const float hoppe = normals[i].dot(normals[j]);
+                    if (std::abs(hoppe) < reliable ||
+                        (hoppe < 0.0F) !=
+                            (agreement_of(positions[i], normals[i], positions[j], normals[j],
+                                          OrientationRule::Reflection) < 0.0F))
                     {
                         creased[i - begin] = 1;
                         creased[j - begin] = 1;
                         break;
                     }
+                }
             }
             for (std::size_t i = begin; i < end; ++i)
             {

@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -379,6 +380,85 @@ TEST(OrientNormalsMst, ACreaseSharperThanARightAngleKeepsBothFacesOutward)
                               result.surfels.normals.size() * sizeof(Vec3f)),
                   0);
     }
+}
+
+/// A closed prism whose cross-section is a triangle with a 30° corner at the origin (sides 4
+/// long to x = 4, half-height h = 4 tan 15°), extruded along z over [0, 2], with its true
+/// outward normals: a knife edge, where the two faces come closer than a neighbourhood.
+PointCloud sampled_knife(std::size_t count, std::uint32_t seed)
+{
+    const double h = 4.0 * std::tan(std::numbers::pi / 12.0);
+    const double side = std::hypot(4.0, h);
+    const std::array<double, 5> area{2.0 * side, 2.0 * side, 4.0 * h, 4.0 * h, 4.0 * h};
+    const double total = area[0] + area[1] + area[2] + area[3] + area[4];
+    std::mt19937 random(seed);
+    const auto uniform = [&random] {
+        return static_cast<double>(random() >> 8U) * 0x1p-24;
+    };
+    PointCloud knife;
+    for (std::size_t i = 0; i < count; ++i)
+    {
+        double pick = uniform() * total;
+        std::size_t face = 0;
+        while (face + 1 < area.size() && pick >= area[face])
+            pick -= area[face++];
+        const double u = uniform();
+        const double v = uniform();
+        const double z = 2.0 * v;
+        if (face < 2) // the two long faces, from the edge at x = 0 to x = 4
+        {
+            const double sign = face == 0 ? 1.0 : -1.0;
+            knife.positions.emplace_back(static_cast<float>(4.0 * u),
+                                         static_cast<float>(sign * h * u), static_cast<float>(z));
+            knife.normals.emplace_back(static_cast<float>(-h / side),
+                                       static_cast<float>(sign * 4.0 / side), 0.0F);
+        }
+        else if (face == 2) // the back, x = 4
+        {
+            knife.positions.emplace_back(4.0F, static_cast<float>(h * (2.0 * u - 1.0)),
+                                         static_cast<float>(z));
+            knife.normals.emplace_back(1.0F, 0.0F, 0.0F);
+        }
+        else // the two triangular ends, z = 0 and z = 2
+        {
+            // Area-uniform in the triangle: x = 4 √u, y across at that x.
+            const double x = 4.0 * std::sqrt(u);
+            const double y = (2.0 * v - 1.0) * h * x / 4.0;
+            const bool top = face == 4;
+            knife.positions.emplace_back(static_cast<float>(x), static_cast<float>(y),
+                                         top ? 2.0F : 0.0F);
+            knife.normals.emplace_back(0.0F, 0.0F, top ? 1.0F : -1.0F);
+        }
+    }
+    return knife;
+}
+
+/// At a knife edge the two faces lie within a neighbourhood of each other, as a thin plate's
+/// do, and their estimated normals there are nearly parallel as lines: Hoppe's rule joined them
+/// into one patch with one face turned over (84% of the samples outward; 92% with creased
+/// samples kept out of patches). An edge whose ends Hoppe's rule and the reflection rule orient
+/// differently now marks both ends as creased (they join no patch), and it votes by the
+/// reflection rule. Within about a sampling step of the edge, where the two faces' samples
+/// interleave, no rule can tell them apart: those are left out of the strict count.
+TEST(OrientNormalsMst, AKnifeEdgeKeepsBothFacesOutward)
+{
+    const PointCloud knife = sampled_knife(40000, 3);
+    PointCloud points;
+    points.positions = knife.positions;
+    const SurfelResult result = compute_surfels(points);
+    EXPECT_EQ(result.orientation.components, 1U);
+    EXPECT_GE(test::oriented_fraction(result.surfels.normals, knife.normals), 0.98);
+    // Away from the edge (the faces 0.13 apart at x = 0.25, about six sampling steps).
+    std::size_t away = 0;
+    std::size_t outward = 0;
+    for (std::size_t i = 0; i < knife.positions.size(); ++i)
+    {
+        if (knife.positions[i].x() < 0.25F)
+            continue;
+        ++away;
+        outward += result.surfels.normals[i].dot(knife.normals[i]) > 0.0F ? 1U : 0U;
+    }
+    EXPECT_GE(static_cast<double>(outward), 0.999 * static_cast<double>(away));
 }
 
 TEST(OrientNormalsMst, DegenerateSamplesInheritAndAreCounted)
