@@ -1348,24 +1348,34 @@ private:
     std::vector<std::uint32_t> size_;
 };
 
+/// Whether Hoppe's rule can be trusted on the edge a–b: the normals are within a reliable step
+/// (|n_a·n_b| at least `reliable`) and the reflection rule (OrientationRule::Reflection) orients
+/// b the same way. Not across a crease, where Hoppe's agreement fades to nothing at a right
+/// angle and changes sign beyond it (at a cone's rim, where a flat base meets a side at 76°,
+/// every edge across voted to turn one face inside out, while the reflected normal follows the
+/// turn), nor across a thin part (a knife edge), where the two sides' normals are nearly
+/// parallel as lines and the edge is steep to both. `reflected`, unless null, gets the
+/// reflection rule's agreement.
+bool hoppe_trusted(const Vec3f& pa, const Vec3f& na, const Vec3f& pb, const Vec3f& nb,
+                   float reliable, float* reflected = nullptr)
+{
+    const float hoppe = na.dot(nb);
+    const float reflection = agreement_of(pa, na, pb, nb, OrientationRule::Reflection);
+    if (reflected != nullptr)
+        *reflected = reflection;
+    return std::abs(hoppe) >= reliable && (hoppe < 0.0F) == (reflection < 0.0F);
+}
+
 /// The vote of a graph edge a–b between two patches on their relative orientation (> 0: the
 /// same), with the patches' signed normals: none for an edge off the sheet (off_sheet()), Hoppe's
-/// n_a·n_b where the normals are within the patches' own reliable turn and the reflection rule
-/// (OrientationRule::Reflection) orients b the same way, and the reflection rule's otherwise:
-/// across a crease, where Hoppe's agreement fades to nothing at a right angle and changes sign
-/// beyond it (at a cone's rim, where a flat base meets a side at 76°, every edge across voted
-/// to turn one face inside out, while the reflected normal follows the turn), and across a
-/// thin part (a knife edge), where the two sides' normals are nearly parallel as lines.
+/// n_a·n_b where hoppe_trusted(), the reflection rule's otherwise.
 float crossing_vote(const Vec3f& pa, const Vec3f& na, const Vec3f& pb, const Vec3f& nb,
                     float reliable)
 {
     if (off_sheet(pa, na, pb, nb))
         return 0.0F;
-    const float hoppe = na.dot(nb);
-    const float reflected = agreement_of(pa, na, pb, nb, OrientationRule::Reflection);
-    if (std::abs(hoppe) >= reliable && (hoppe < 0.0F) == (reflected < 0.0F))
-        return hoppe;
-    return reflected;
+    float reflected = 0.0F;
+    return hoppe_trusted(pa, na, pb, nb, reliable, &reflected) ? na.dot(nb) : reflected;
 }
 
 /// orient_normals_mst() for clean clouds under Hoppe's rule (noisy clouds keep the guided whole
@@ -1374,16 +1384,15 @@ float crossing_vote(const Vec3f& pa, const Vec3f& na, const Vec3f& pb, const Vec
 ///
 /// 1. Patches: in each block of patch_block samples (index order), the graph edges inside the
 ///    block that are reliable (|n_a·n_b| at least 1 − patch_cost), on the sheet (steep_edge) and
-///    between samples that are not creased (no neighbour's normal more than a reliable step
-///    away, nor one that the reflection rule orients otherwise than Hoppe's) join their ends in
-///    signed disjoint sets, firm edges (firm_agreement) first: a
-///    patch's samples take their signs relative to its first sample from the edges that joined
-///    them.
+///    between samples that are not creased (every edge to a neighbour in the block
+///    hoppe_trusted()) join their ends in signed disjoint sets, firm edges (firm_agreement)
+///    first: a patch's samples take their signs relative to its first sample from the edges
+///    that joined them.
 /// 2. Every graph edge between two patches votes on their relative orientation
-///    (crossing_vote(): Hoppe's agreement within a reliable step, the reflection rule's across a
-///    crease; an edge off the sheet with none: it keeps the components whole but passes
-///    nothing), summed per pair of patches, and a maximum spanning forest of the patch graph (by
-///    the size of the vote) decides each patch's flip, as orient_graph() does with its patches.
+///    (crossing_vote(): Hoppe's agreement where hoppe_trusted(), the reflection rule's across a
+///    crease or a thin part; an edge off the sheet with none: it keeps the components whole but
+///    passes nothing), summed per pair of patches, and a maximum spanning forest of the patch graph
+///    (by the size of the vote) decides each patch's flip, as orient_graph() does with its patches.
 /// 3. Each component then faces +z at its highest sample and outwards by its flux; samples
 ///    without a normal inherit one over the graph's edges. (A sweep in which every sample
 ///    followed its neighbours changed no sign on the test shapes, the bunny scans or the 1M and
@@ -1439,14 +1448,14 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
                     own =
                         sets.link(own.first, own.second, rj, oj, normals[i].dot(normals[j]) < 0.0F);
             };
-            //    Creased samples: some neighbour in the block has a normal more than a reliable
-            //    step from theirs, or one that Hoppe's rule and the reflection rule orient
-            //    differently (a steep edge between nearly parallel normals: the two sides of a
-            //    knife edge or a thin part). They join no patch: near a crease the estimated
-            //    normals turn from one face's to the other's the short way round as lines,
-            //    which at a crease sharper than 90° is the wrong way, and a chain of reliable
-            //    steps through them would join the two faces with one turned over. (Only the
-            //    block's own samples can chain within it, so only its own edges are looked at.)
+            //    Creased samples: Hoppe's rule is not trusted (hoppe_trusted()) on the edge to
+            //    some neighbour in the block (a normal more than a reliable step away, or the
+            //    other side of a knife edge or a thin part). They join no patch: near a crease
+            //    the estimated normals turn from one face's to the other's the short way round
+            //    as lines, which at a crease sharper than 90° is the wrong way, and a chain of
+            //    reliable steps through them would join the two faces with one turned over.
+            //    (Only the block's own samples can chain within it, so only its own edges are
+            //    looked at.)
             creased.assign(end - begin, 0);
             for (std::size_t i = begin; i < end; ++i)
             {
@@ -1456,11 +1465,8 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
                 {
                     if (j < begin || j >= end || j == i || !usable(normals[j]))
                         continue;
-                    const float hoppe = normals[i].dot(normals[j]);
-                    if (std::abs(hoppe) < reliable ||
-                        (hoppe < 0.0F) !=
-                            (agreement_of(positions[i], normals[i], positions[j], normals[j],
-                                          OrientationRule::Reflection) < 0.0F))
+                    if (!hoppe_trusted(positions[i], normals[i], positions[j], normals[j],
+                                       reliable))
                     {
                         creased[i - begin] = 1;
                         creased[j - begin] = 1;
