@@ -1262,6 +1262,9 @@ constexpr std::size_t patch_block = 4096;
 /// within about 18°); the other reliable edges (up to OrientationOptions::patch_cost) join after
 /// them, so that a patch grows over the smoothest steps first, as a spanning tree would.
 constexpr float firm_agreement = 0.95F;
+/// The nearest neighbours of a creased sample of orient_by_patches() that vote in pairs across
+/// it (at most this many, so that a large k does not square the cost).
+constexpr std::size_t hop_ends = 16;
 /// An edge passes no orientation when it leaves both ends' tangent planes more steeply (|n·ê|)
 /// than this plus the sine of half the angle between their normals: along one smooth sheet an
 /// edge tilts by about half the turn of the normals, while an edge across a thin part (the two
@@ -1385,14 +1388,16 @@ float crossing_vote(const Vec3f& pa, const Vec3f& na, const Vec3f& pb, const Vec
 /// 1. Patches: in each block of patch_block samples (index order), the graph edges inside the
 ///    block that are reliable (|n_a·n_b| at least 1 − patch_cost), on the sheet (steep_edge) and
 ///    between samples that are not creased (every edge to a neighbour in the block
-///    hoppe_trusted()) join their ends in signed disjoint sets, firm edges (firm_agreement)
-///    first: a patch's samples take their signs relative to its first sample from the edges
-///    that joined them.
+///    hoppe_trusted(), and no two such neighbours more than a reliable step apart) join their ends
+///    in signed disjoint sets, firm edges (firm_agreement) first: a patch's samples take their
+///    signs relative to its first sample from the edges that joined them.
 /// 2. Every graph edge between two patches votes on their relative orientation
 ///    (crossing_vote(): Hoppe's agreement where hoppe_trusted(), the reflection rule's across a
 ///    crease or a thin part; an edge off the sheet with none: it keeps the components whole but
-///    passes nothing), summed per pair of patches, and a maximum spanning forest of the patch graph
-///    (by the size of the vote) decides each patch's flip, as orient_graph() does with its patches.
+///    passes nothing), and so does every pair of a creased sample's nearest uncreased
+///    neighbours (hop_ends) in different patches, summed per pair of patches, and a maximum
+///    spanning forest of the patch graph (by the size of the vote) decides each patch's flip, as
+///    orient_graph() does with its patches.
 /// 3. Each component then faces +z at its highest sample and outwards by its flux; samples
 ///    without a normal inherit one over the graph's edges. (A sweep in which every sample
 ///    followed its neighbours changed no sign on the test shapes, the bunny scans or the 1M and
@@ -1418,6 +1423,8 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
     //    used), hence not filled first.
     const auto patch = std::make_unique_for_overwrite<std::uint32_t[]>(n);
     auto opposite = std::make_unique_for_overwrite<std::uint8_t[]>(n);
+    //    Whether a sample is creased (below), each block writing its own samples.
+    std::vector<std::uint8_t> creased(n, 0);
     std::vector<std::uint32_t> block_start(blocks + 1, 0);
     //    Each block also keeps the edges that may join two patches (those leaving the block,
     //    the unreliable ones and those off the sheet), for the votes: edge i * columns + c of
@@ -1426,7 +1433,6 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
     parallel_blocks(blocks, 1, [&](std::size_t first, std::size_t last) {
         SignedSets sets;
         std::vector<std::uint32_t> later;
-        std::vector<std::uint8_t> creased;
         std::vector<std::uint32_t> local_id(patch_block);
         for (std::size_t b = first; b < last; ++b)
         {
@@ -1454,25 +1460,50 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
             //    the estimated normals turn from one face's to the other's the short way round
             //    as lines, which at a crease sharper than 90° is the wrong way, and a chain of
             //    reliable steps through them would join the two faces with one turned over.
-            //    (Only the block's own samples can chain within it, so only its own edges are
-            //    looked at.)
-            creased.assign(end - begin, 0);
+            //    A sample is creased too where two of its neighbours in the block are more than
+            //    a reliable step apart (its neighbourhood spans the turn, in steps each small
+            //    enough to pass: the head of an arrow, whose rim turns by 124°, was joined to
+            //    its shaft inside out, 73% of the samples). (Only the block's own samples can
+            //    chain within it, so only its own edges are looked at.)
             for (std::size_t i = begin; i < end; ++i)
             {
                 if (!usable(normals[i]))
                     continue;
-                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                const auto row = neighbors.neighbors(i).first(columns);
+                float farthest = 1.0F;
+                std::uint32_t apart = none;
+                for (const std::uint32_t j : row)
                 {
                     if (j < begin || j >= end || j == i || !usable(normals[j]))
                         continue;
                     if (!hoppe_trusted(positions[i], normals[i], positions[j], normals[j],
                                        reliable))
                     {
-                        creased[i - begin] = 1;
-                        creased[j - begin] = 1;
+                        creased[i] = 1;
+                        creased[j] = 1;
+                        apart = none;
                         break;
                     }
+                    const float agree = std::abs(normals[i].dot(normals[j]));
+                    if (agree < farthest)
+                    {
+                        farthest = agree;
+                        apart = j;
+                    }
                 }
+                //    The neighbour farthest from i against the others (unless all are within a
+                //    firm step of i, and so of each other within a reliable one).
+                if (apart != none && farthest < firm)
+                    for (const std::uint32_t j : row)
+                    {
+                        if (j < begin || j >= end || j == i || !usable(normals[j]))
+                            continue;
+                        if (std::abs(normals[apart].dot(normals[j])) < reliable)
+                        {
+                            creased[i] = 1;
+                            break;
+                        }
+                    }
             }
             for (std::size_t i = begin; i < end; ++i)
             {
@@ -1493,7 +1524,7 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
                     }
                     if (!usable(normals[j]))
                         continue;
-                    if (creased[i - begin] != 0 || creased[j - begin] != 0)
+                    if (creased[i] != 0 || creased[j] != 0)
                     {
                         open.push_back(edge);
                         continue;
@@ -1556,25 +1587,21 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
         // the pairs of a scattered one (samples not in spatial order) are sorted at the end.
         constexpr std::size_t searched = 64;
         std::vector<std::pair<std::uint64_t, float>> rest;
+        std::vector<std::uint32_t> ends;
         for (std::size_t b = first; b < last; ++b)
         {
             rest.clear();
             auto& out = block_votes[b];
             std::size_t hit = 0;
             const std::size_t begin = b * patch_block;
-            for (const std::uint32_t edge : crossing[b])
-            {
-                const std::size_t i = begin + edge / columns;
-                const std::uint32_t j = neighbors.neighbors(i)[edge % columns];
-                const std::uint32_t pi = patch[i];
-                const std::uint32_t pj = patch[j];
-                if (pi == none || pj == none || pj == pi)
-                    continue;
-                const Vec3f ni = signed_normal(static_cast<std::uint32_t>(i));
-                const Vec3f nj = signed_normal(j);
-                const float weight = crossing_vote(positions[i], ni, positions[j], nj, reliable);
+            //    Adds the vote of samples a and c, of different patches, on their patches.
+            const auto vote = [&](std::uint32_t a, std::uint32_t c) {
+                const std::uint32_t pa = patch[a];
+                const std::uint32_t pc = patch[c];
+                const float weight = crossing_vote(positions[a], signed_normal(a), positions[c],
+                                                   signed_normal(c), reliable);
                 const std::uint64_t pair =
-                    (std::uint64_t{std::min(pi, pj)} << 32U) | std::max(pi, pj);
+                    (std::uint64_t{std::min(pa, pc)} << 32U) | std::max(pa, pc);
                 if (hit >= out.size() || out[hit].pair != pair)
                     hit = static_cast<std::size_t>(
                         std::find_if(out.begin(), out.end(),
@@ -1586,8 +1613,36 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
                     out.push_back({pair, static_cast<double>(weight)});
                 else
                     rest.emplace_back(pair, weight);
+            };
+            for (const std::uint32_t edge : crossing[b])
+            {
+                const std::size_t i = begin + edge / columns;
+                const std::uint32_t j = neighbors.neighbors(i)[edge % columns];
+                if (patch[i] == none || patch[j] == none || patch[j] == patch[i])
+                    continue;
+                vote(static_cast<std::uint32_t>(i), j);
             }
             std::vector<std::uint32_t>().swap(crossing[b]);
+            //    Across each creased sample, every two of its nearest neighbours that are not
+            //    creased and lie in different patches vote as if they were an edge: the creased
+            //    samples' own normals are the blend of a crease's two faces, turned the short way
+            //    round, so a vote through them alone would turn one face over (a cone whose base
+            //    meets its side at 45°: 41% of it inside out), while a pair across the crease
+            //    votes by the reflection rule between the faces' own normals.
+            const std::size_t end = std::min(n, begin + patch_block);
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                if (creased[i] == 0)
+                    continue;
+                ends.clear();
+                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                    if (j != i && patch[j] != none && creased[j] == 0 && ends.size() < hop_ends)
+                        ends.push_back(j);
+                for (std::size_t x = 0; x < ends.size(); ++x)
+                    for (std::size_t y = x + 1; y < ends.size(); ++y)
+                        if (patch[ends[x]] != patch[ends[y]])
+                            vote(ends[x], ends[y]);
+            }
             std::sort(rest.begin(), rest.end());
             for (std::size_t v = 0; v < rest.size();)
             {
