@@ -344,6 +344,38 @@ PointCloud sampled_cone(std::size_t count, std::uint32_t seed, double height = 4
     return cone;
 }
 
+/// Orients a sampled cone's positions through compute_surfels() at every thread count (the same
+/// bytes at each) and expects one component, at least `oriented` of the samples outward and at
+/// least `base_outward` of the base's (x = 0), which has more than `min_base` samples.
+void expect_cone_outward(const PointCloud& cone, double oriented, double base_outward,
+                         std::size_t min_base)
+{
+    PointCloud points;
+    points.positions = cone.positions;
+    const auto runs = test::at_thread_counts([&] { return compute_surfels(points); },
+                                             {.min_multi_block_loops = 4});
+    for (const SurfelResult& result : runs)
+    {
+        ASSERT_EQ(result.surfels.normals.size(), cone.normals.size());
+        EXPECT_EQ(result.orientation.components, 1U);
+        EXPECT_GE(test::oriented_fraction(result.surfels.normals, cone.normals), oriented);
+        std::size_t base = 0;
+        std::size_t outward = 0;
+        for (std::size_t i = 0; i < cone.positions.size(); ++i)
+        {
+            if (cone.positions[i].x() != 0.0F)
+                continue;
+            ++base;
+            outward += result.surfels.normals[i].x() < 0.0F ? 1U : 0U;
+        }
+        ASSERT_GT(base, min_base);
+        EXPECT_GE(static_cast<double>(outward), base_outward * static_cast<double>(base));
+        EXPECT_EQ(std::memcmp(result.surfels.normals.data(), runs[0].surfels.normals.data(),
+                              result.surfels.normals.size() * sizeof(Vec3f)),
+                  0);
+    }
+}
+
 /// Hoppe's rule cannot pass orientation across a crease sharper than a right angle: the normals
 /// estimated near the cone's rim turn from the base's to the side's the short way round (by 76°,
 /// as lines), so a chain of small steps through them hands the side the base's orientation
@@ -354,31 +386,7 @@ PointCloud sampled_cone(std::size_t count, std::uint32_t seed, double height = 4
 /// reflection rule (all 40 seeds at least 99.9% outward).
 TEST(OrientNormalsMst, ACreaseSharperThanARightAngleKeepsBothFacesOutward)
 {
-    const PointCloud cone = sampled_cone(40000, 4);
-    PointCloud points;
-    points.positions = cone.positions;
-    const auto runs = test::at_thread_counts([&] { return compute_surfels(points); },
-                                             {.min_multi_block_loops = 4});
-    for (const SurfelResult& result : runs)
-    {
-        ASSERT_EQ(result.surfels.normals.size(), cone.normals.size());
-        EXPECT_EQ(result.orientation.components, 1U);
-        EXPECT_GE(test::oriented_fraction(result.surfels.normals, cone.normals), 0.995);
-        std::size_t base = 0;
-        std::size_t base_outward = 0;
-        for (std::size_t i = 0; i < cone.positions.size(); ++i)
-        {
-            if (cone.positions[i].x() != 0.0F)
-                continue;
-            ++base;
-            base_outward += result.surfels.normals[i].x() < 0.0F ? 1U : 0U;
-        }
-        ASSERT_GT(base, 5000U);
-        EXPECT_GE(static_cast<double>(base_outward), 0.99 * static_cast<double>(base));
-        EXPECT_EQ(std::memcmp(result.surfels.normals.data(), runs[0].surfels.normals.data(),
-                              result.surfels.normals.size() * sizeof(Vec3f)),
-                  0);
-    }
+    expect_cone_outward(sampled_cone(40000, 4), 0.995, 0.99, 5000);
 }
 
 /// A cone as wide as it is high: the base meets the side at 45° and the normals turn by 135°, so
@@ -390,33 +398,7 @@ TEST(OrientNormalsMst, ACreaseSharperThanARightAngleKeepsBothFacesOutward)
 TEST(OrientNormalsMst, ACreaseAt45DegreesKeepsTheBaseOutward)
 {
     for (const std::uint32_t seed : {1U, 2U})
-    {
-        const PointCloud cone = sampled_cone(40000, seed, 1.0, 1.0);
-        PointCloud points;
-        points.positions = cone.positions;
-        const auto runs = test::at_thread_counts([&] { return compute_surfels(points); },
-                                                 {.min_multi_block_loops = 4});
-        for (const SurfelResult& result : runs)
-        {
-            ASSERT_EQ(result.surfels.normals.size(), cone.normals.size());
-            EXPECT_EQ(result.orientation.components, 1U);
-            EXPECT_GE(test::oriented_fraction(result.surfels.normals, cone.normals), 0.98);
-            std::size_t base = 0;
-            std::size_t base_outward = 0;
-            for (std::size_t i = 0; i < cone.positions.size(); ++i)
-            {
-                if (cone.positions[i].x() != 0.0F)
-                    continue;
-                ++base;
-                base_outward += result.surfels.normals[i].x() < 0.0F ? 1U : 0U;
-            }
-            ASSERT_GT(base, 10000U);
-            EXPECT_GE(static_cast<double>(base_outward), 0.97 * static_cast<double>(base));
-            EXPECT_EQ(std::memcmp(result.surfels.normals.data(), runs[0].surfels.normals.data(),
-                                  result.surfels.normals.size() * sizeof(Vec3f)),
-                      0);
-        }
-    }
+        expect_cone_outward(sampled_cone(40000, seed, 1.0, 1.0), 0.98, 0.97, 10000);
 }
 
 /// A closed prism whose cross-section is a triangle with a 30° corner at the origin (sides 4
