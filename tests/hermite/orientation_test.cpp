@@ -392,12 +392,16 @@ TEST(OrientNormalsMst, ACreaseSharperThanARightAngleKeepsBothFacesOutward)
 /// A cone as wide as it is high: the base meets the side at 45° and the normals turn by 135°, so
 /// that every estimated normal from the base's to the side's is within a reliable step of its
 /// neighbours' and of both faces' (as lines), and no edge is creased by its own two ends. The
-/// samples whose neighbours span the turn are creased, and pairs of their neighbours vote
-/// across them by the reflection rule: at 9bfed08 the base came out inside out on each of
-/// seeds 1-12 (58-59% of the samples outward), now 98.7-98.9% (the rest within the rim's blend).
+/// samples whose neighbours span the turn are creased, so are those next to them, and pairs of
+/// their neighbours vote across them by the reflection rule: at 9bfed08 the base came out
+/// inside out on each of seeds 1-12 (58-59% of the samples outward), now 98.7-98.9% (the rest
+/// within the rim's blend). Seed 13 needs the ring next to the creased samples (a patch
+/// chained round the rim without it). Of seeds 1-40, 39 reach 97% at this height (not seed
+/// 24), 39 at height 1.2 (a rim of 50°) and 34 at height 0.9 (42°); without that ring 30, 39
+/// and 22.
 TEST(OrientNormalsMst, ACreaseAt45DegreesKeepsTheBaseOutward)
 {
-    for (const std::uint32_t seed : {1U, 2U})
+    for (const std::uint32_t seed : {1U, 2U, 13U})
         expect_cone_outward(sampled_cone(40000, seed, 1.0, 1.0), 0.98, 0.97, 10000);
 }
 
