@@ -1262,8 +1262,8 @@ constexpr std::size_t patch_block = 4096;
 /// within about 18°); the other reliable edges (up to OrientationOptions::patch_cost) join after
 /// them, so that a patch grows over the smoothest steps first, as a spanning tree would.
 constexpr float firm_agreement = 0.95F;
-/// The nearest neighbours of a creased sample of orient_by_patches() that vote in pairs across
-/// it (at most this many, so that a large k does not square the cost).
+/// The samples that vote in pairs across a creased sample of orient_by_patches(), nearest
+/// first (at most this many, so that a large k does not square the cost).
 constexpr std::size_t hop_ends = 16;
 /// An edge passes no orientation when it leaves both ends' tangent planes more steeply (|n·ê|)
 /// than this plus the sine of half the angle between their normals: along one smooth sheet an
@@ -1381,6 +1381,21 @@ float crossing_vote(const Vec3f& pa, const Vec3f& na, const Vec3f& pb, const Vec
     return hoppe_trusted(pa, na, pb, nb, reliable, &reflected) ? na.dot(nb) : reflected;
 }
 
+/// The vote of samples a and b on either side of a crease or a thin part on their relative
+/// orientation (> 0: the same), with the patches' signed normals: Hoppe's n_a·n_b where
+/// hoppe_trusted(), else the tilt rule, −(n_a·ê)(n_b·ê): at a convex crease each sample lies
+/// on the inner side of the other's tangent plane, at a concave one on the outer side, and
+/// across a thin part each faces the other, so the two tilts have opposite signs when the
+/// normals agree. Unlike the reflection rule it holds for samples at unequal distances from a
+/// crease: at a rim of 42° the reflected normal turns the wrong way once one sample is about
+/// 2.5 times as far from it as the other.
+float across_vote(const Vec3f& pa, const Vec3f& na, const Vec3f& pb, const Vec3f& nb)
+{
+    const Vec3f e = pb - pa;
+    const float len2 = e.squaredNorm();
+    return len2 > 0.0F ? -na.dot(e) * nb.dot(e) / len2 : 0.0F;
+}
+
 /// orient_normals_mst() for clean clouds under Hoppe's rule (noisy clouds keep the guided whole
 /// graph, orient_graph()): patches of consistently oriented samples, found block by block, are
 /// oriented against each other, and the signs spread to every sample.
@@ -1395,8 +1410,8 @@ float crossing_vote(const Vec3f& pa, const Vec3f& na, const Vec3f& pb, const Vec
 /// 2. Every graph edge between two patches votes on their relative orientation
 ///    (crossing_vote(): Hoppe's agreement where hoppe_trusted(), the reflection rule's across a
 ///    crease or a thin part; an edge off the sheet with none: it keeps the components whole but
-///    passes nothing), and so does every pair of a creased sample's nearest uncreased
-///    neighbours (hop_ends) in different patches, summed per pair of patches, and a maximum
+///    passes nothing), and so does every pair of samples in different patches across a
+///    creased sample (across_vote()), summed per pair of patches, and a maximum
 ///    spanning forest of the patch graph (by the size of the vote) decides each patch's flip, as
 ///    orient_graph() does with its patches.
 /// 3. Each component then faces +z at its highest sample and outwards by its flux; samples
@@ -1467,6 +1482,7 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
             //    enough to pass: the head of an arrow, whose rim turns by 124°, was joined to
             //    its shaft inside out, 73% of the samples). (Only the block's own samples can
             //    chain within it, so only its own edges are looked at.)
+            bool any_creased = false;
             for (std::size_t i = begin; i < end; ++i)
             {
                 if (!usable(normals[i]))
@@ -1483,6 +1499,7 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
                     {
                         creased[i] = 1;
                         creased[j] = 1;
+                        any_creased = true;
                         apart = none;
                         break;
                     }
@@ -1503,6 +1520,7 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
                         if (std::abs(normals[apart].dot(normals[j])) < reliable)
                         {
                             creased[i] = 1;
+                            any_creased = true;
                             break;
                         }
                     }
@@ -1511,7 +1529,7 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
             //    crease's normals is wider than the neighbourhoods that find it, and a patch
             //    chained past it through samples each within a reliable step turned the base
             //    of a cone as wide as high over (41% of the samples inside out).
-            for (std::size_t i = begin; i < end; ++i)
+            for (std::size_t i = begin; i < end && any_creased; ++i)
                 if (creased[i] == 0)
                     for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
                         if (j >= begin && j < end && creased[j] == 1)
@@ -1609,11 +1627,15 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
             std::size_t hit = 0;
             const std::size_t begin = b * patch_block;
             //    Adds the vote of samples a and c, of different patches, on their patches.
-            const auto vote = [&](std::uint32_t a, std::uint32_t c) {
+            //    (by crossing_vote(), or across_vote() for a pair across a creased sample).
+            const auto vote = [&](std::uint32_t a, std::uint32_t c, bool across) {
                 const std::uint32_t pa = patch[a];
                 const std::uint32_t pc = patch[c];
-                const float weight = crossing_vote(positions[a], signed_normal(a), positions[c],
-                                                   signed_normal(c), reliable);
+                const float weight = across
+                                         ? across_vote(positions[a], signed_normal(a), positions[c],
+                                                       signed_normal(c))
+                                         : crossing_vote(positions[a], signed_normal(a),
+                                                         positions[c], signed_normal(c), reliable);
                 const std::uint64_t pair =
                     (std::uint64_t{std::min(pa, pc)} << 32U) | std::max(pa, pc);
                 if (hit >= out.size() || out[hit].pair != pair)
@@ -1634,28 +1656,40 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
                 const std::uint32_t j = neighbors.neighbors(i)[edge % columns];
                 if (patch[i] == none || patch[j] == none || patch[j] == patch[i])
                     continue;
-                vote(static_cast<std::uint32_t>(i), j);
+                vote(static_cast<std::uint32_t>(i), j, false);
             }
             std::vector<std::uint32_t>().swap(crossing[b]);
-            //    Across each creased sample, every two of its nearest neighbours that are not
-            //    creased and lie in different patches vote as if they were an edge: the creased
-            //    samples' own normals are the blend of a crease's two faces, turned the short way
-            //    round, so a vote through them alone would turn one face over (a cone whose base
-            //    meets its side at 45°: 41% of it inside out), while a pair across the crease
-            //    votes by the reflection rule between the faces' own normals.
+            //    Across each creased sample, every two of the samples that are not creased or
+            //    next to a creased one among its neighbours (and, for a creased sample, its
+            //    neighbours' of those next to one) that lie in different patches vote by
+            //    across_vote(), at most hop_ends of them: the creased samples' own normals are
+            //    the blend of a crease's two faces, turned the short way round, so a vote
+            //    through them alone would turn one face over (a cone whose base meets its side
+            //    at 45°: 41% of it inside out), while a pair across the crease votes by the
+            //    faces' own normals. (The ring next to the creased samples would leave no pairs
+            //    across them without its neighbours.)
             const std::size_t end = std::min(n, begin + patch_block);
             for (std::size_t i = begin; i < end; ++i)
             {
                 if (creased[i] == 0)
                     continue;
                 ends.clear();
-                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
-                    if (j != i && patch[j] != none && creased[j] == 0 && ends.size() < hop_ends)
+                const auto add = [&](std::uint32_t j) {
+                    if (j != i && patch[j] != none && creased[j] == 0 && ends.size() < hop_ends &&
+                        std::find(ends.begin(), ends.end(), j) == ends.end())
                         ends.push_back(j);
+                };
+                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                    add(j);
+                if (creased[i] == 1)
+                    for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                        if (creased[j] == 2)
+                            for (const std::uint32_t q : neighbors.neighbors(j).first(columns))
+                                add(q);
                 for (std::size_t x = 0; x < ends.size(); ++x)
                     for (std::size_t y = x + 1; y < ends.size(); ++y)
                         if (patch[ends[x]] != patch[ends[y]])
-                            vote(ends[x], ends[y]);
+                            vote(ends[x], ends[y], true);
             }
             std::sort(rest.begin(), rest.end());
             for (std::size_t v = 0; v < rest.size();)

@@ -393,12 +393,12 @@ TEST(OrientNormalsMst, ACreaseSharperThanARightAngleKeepsBothFacesOutward)
 /// that every estimated normal from the base's to the side's is within a reliable step of its
 /// neighbours' and of both faces' (as lines), and no edge is creased by its own two ends. The
 /// samples whose neighbours span the turn are creased, so are those next to them, and pairs of
-/// their neighbours vote across them by the reflection rule: at 9bfed08 the base came out
-/// inside out on each of seeds 1-12 (58-59% of the samples outward), now 98.7-98.9% (the rest
+/// samples across them vote by the tilt rule (across_vote()): at 9bfed08 the base came out
+/// inside out on each of seeds 1-12 (58-59% of the samples outward), now about 99% (the rest
 /// within the rim's blend). Seed 13 needs the ring next to the creased samples (a patch
-/// chained round the rim without it). Of seeds 1-40, 39 reach 97% at this height (not seed
-/// 24), 39 at height 1.2 (a rim of 50°) and 34 at height 0.9 (42°); without that ring 30, 39
-/// and 22.
+/// chained round the rim without it). Of seeds 1-40 at heights 0.7, 0.9, 1 and 1.2 (rims of
+/// 35°, 42°, 45° and 50°) all reach 97%; with the reflection rule across the creased samples
+/// 16, 34, 39 and 39 did, and without the ring 22 at height 0.9 and 30 at height 1.
 TEST(OrientNormalsMst, ACreaseAt45DegreesKeepsTheBaseOutward)
 {
     for (const std::uint32_t seed : {1U, 2U, 13U})
@@ -482,6 +482,27 @@ TEST(OrientNormalsMst, AKnifeEdgeKeepsBothFacesOutward)
         outward += result.surfels.normals[i].dot(knife.normals[i]) > 0.0F ? 1U : 0U;
     }
     EXPECT_GE(static_cast<double>(outward), 0.999 * static_cast<double>(away));
+}
+
+/// A plate 0.02 thick (side 2, 100,000 samples: about two sampling steps): edges across it join
+/// parallel normals steeply and pass nothing, and its rims are creases at which the faces turn
+/// by 90° twice within a step, so the faces are oriented against each other only by votes
+/// across creased samples. By the reflection rule a pair far apart along the plate votes for
+/// the same orientation as Hoppe's rule (one face inside out, half the samples: seed 23 at
+/// 9bfed08, seeds 22 and 23 at 2ac7d14); the tilt rule (across_vote()) orients both, but for
+/// about 1% of the samples along the rims.
+TEST(OrientNormalsMst, APlateTwoStepsThickKeepsBothFacesOutward)
+{
+    for (const std::uint32_t seed : {22U, 23U})
+    {
+        const PointCloud plate =
+            sample_shape(Shape::Plate, {.count = 100000, .seed = seed, .thickness = 0.02});
+        PointCloud points;
+        points.positions = plate.positions;
+        const SurfelResult result = compute_surfels(points);
+        EXPECT_EQ(result.orientation.components, 1U);
+        EXPECT_GE(test::oriented_fraction(result.surfels.normals, plate.normals), 0.98) << seed;
+    }
 }
 
 TEST(OrientNormalsMst, DegenerateSamplesInheritAndAreCounted)
@@ -685,9 +706,12 @@ namespace {
 /// components, and the bunny's thin ears (before edges off the sheet passed no orientation, the
 /// earlier subsample scheme turned one whole ear inside out: 294 of 8904 samples). The samples
 /// are in random order here, so a block's patches are scattered (compute_surfels() sorts them
-/// first): the scheme must hold either way. At most one
-/// sample in 10,000 may take the other sign (the plate's corners, where the normal turns through
-/// 90° twice within a step, differ in 3 of 40,000), and never more of them against the truth.
+/// first): the scheme must hold either way. At most one sample in 4,000 may take the other
+/// sign, and at most one in 4,000 more of them be against the truth: at the plate's corners,
+/// where the normal turns through 90° twice within a step, and at the part's, the votes across
+/// creased samples (across_vote()) turn a few samples otherwise than the whole graph (9 and 5
+/// of 40,000, all against the truth), where they orient plates 2 sampling steps thick and
+/// cones whose rims the whole graph and the earlier votes turned inside out.
 TEST(OrientNormalsMst, PatchesOrientCleanCloudsAsTheWholeGraph)
 {
     std::vector<std::pair<std::string, PointCloud>> clouds;
@@ -715,12 +739,12 @@ TEST(OrientNormalsMst, PatchesOrientCleanCloudsAsTheWholeGraph)
             std::size_t differ = 0;
             for (std::size_t i = 0; i < sub.normals.size(); ++i)
                 differ += sub.normals[i].dot(whole.normals[i]) < 0.0F ? 1U : 0U;
-            EXPECT_LE(differ, sub.normals.size() / 10000) << name;
+            EXPECT_LE(differ, sub.normals.size() / 4000) << name;
             EXPECT_EQ(sub.components, whole.components) << name;
             if (!cloud.normals.empty())
             {
                 EXPECT_GE(test::oriented_fraction(sub.normals, cloud.normals),
-                          test::oriented_fraction(whole.normals, cloud.normals) - 1e-4)
+                          test::oriented_fraction(whole.normals, cloud.normals) - 2.5e-4)
                     << name;
             }
             EXPECT_EQ(std::memcmp(sub.normals.data(), runs[0].normals.data(),
