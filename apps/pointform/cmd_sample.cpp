@@ -54,9 +54,11 @@ void register_sample(CLI::App& app, const GlobalOptions& global)
         "sample",
         "Sample an analytic shape with its exact outward normals (test and benchmark "
         "inputs)");
-    cmd->add_option("shape", options->shape, "sphere, torus, two-spheres, plate, blobby or part")
+    cmd->add_option("shape", options->shape,
+                    "sphere, torus, two-spheres, plate, blobby, part or cone")
         ->required()
-        ->check(CLI::IsMember({"sphere", "torus", "two-spheres", "plate", "blobby", "part"}));
+        ->check(
+            CLI::IsMember({"sphere", "torus", "two-spheres", "plate", "blobby", "part", "cone"}));
     cmd->add_option("-o,--output", options->output, "Output file (.ply or .xyz)")->required();
     cmd->add_option("-n,--count", options->sampling.count, "Samples before holes are cut")
         ->capture_default_str()

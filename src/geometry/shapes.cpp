@@ -246,6 +246,22 @@ Sample sample_part(std::mt19937_64& rng)
     }
 }
 
+/// Area-uniform sample of Shape::Cone: the side (area π√2) or the base (area π) picked by area,
+/// the distance from the apex or the centre as √u of the radius.
+Sample sample_cone(std::mt19937_64& rng)
+{
+    std::uniform_real_distribution<double> uni(0.0, 1.0);
+    const double slant = std::sqrt(2.0);
+    const double pick = uni(rng) * (slant + 1.0);
+    const double t = std::sqrt(uni(rng));
+    const double angle = 2.0 * std::numbers::pi * uni(rng);
+    const double c = std::cos(angle);
+    const double s = std::sin(angle);
+    if (pick < slant)
+        return {Vec3d(t * c, t * s, 1.0 - t), Vec3d(c, s, 1.0) / slant};
+    return {Vec3d(t * c, t * s, 0.0), Vec3d(0.0, 0.0, -1.0)};
+}
+
 Sample sample_one(Shape shape, std::mt19937_64& rng, const SampleOptions& options)
 {
     switch (shape)
@@ -269,6 +285,8 @@ Sample sample_one(Shape shape, std::mt19937_64& rng, const SampleOptions& option
             return sample_blobby(rng);
         case Shape::Part:
             return sample_part(rng);
+        case Shape::Cone:
+            return sample_cone(rng);
     }
     throw InvalidInput("unknown shape");
 }
@@ -348,8 +366,10 @@ Shape parse_shape(const std::string& name)
         return Shape::Blobby;
     if (name == "part")
         return Shape::Part;
+    if (name == "cone")
+        return Shape::Cone;
     throw InvalidInput("unknown shape '" + name +
-                       "' (expected sphere, torus, two-spheres, plate, blobby or part)");
+                       "' (expected sphere, torus, two-spheres, plate, blobby, part or cone)");
 }
 
 } // namespace pointform

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -74,6 +75,7 @@ double surface_distance(Shape shape, const Vec3d& p, double thickness)
         }
         case Shape::Blobby:
         case Shape::Part:
+        case Shape::Cone:
             break;
     }
     return 1e9;
@@ -220,6 +222,36 @@ TEST(Shapes, SamplesLieOnTheSurfaceWithUnitOutwardNormals)
             EXPECT_NEAR(surface_distance(shape, out, 0.05), 1e-3, 1e-4);
         }
     }
+}
+
+/// The cone's signed distance bound: max(−z, (r + z − 1)/√2), zero on its surface, negative
+/// inside, the exact distance off a face (away from the rim and the apex).
+double cone_value(const Vec3d& p)
+{
+    return std::max(-p.z(), (std::hypot(p.x(), p.y()) + p.z() - 1.0) / std::sqrt(2.0));
+}
+
+TEST(Shapes, ConeSamplesLieOnItsSurfaceWithOutwardNormalsAndUniformArea)
+{
+    const PointCloud cone = sample_shape(Shape::Cone, {.count = 100000, .seed = 5});
+    ASSERT_EQ(cone.size(), 100000U);
+    std::size_t outward = 0;
+    std::size_t base = 0;
+    for (std::size_t i = 0; i < cone.size(); ++i)
+    {
+        const Vec3d p = cone.positions[i].cast<double>();
+        const Vec3d n = cone.normals[i].cast<double>();
+        ASSERT_LT(std::abs(cone_value(p)), 1e-6);
+        ASSERT_GE(p.z(), -1e-7);
+        EXPECT_NEAR(n.norm(), 1.0, 1e-6);
+        outward += cone_value(p + 1e-3 * n) > 0.0 && cone_value(p - 1e-3 * n) < 0.0 ? 1 : 0;
+        base += p.z() == 0.0 ? 1 : 0;
+    }
+    EXPECT_GT(static_cast<double>(outward), 0.995 * static_cast<double>(cone.size()));
+    // The base's share of the area: π / (π + π√2).
+    EXPECT_NEAR(static_cast<double>(base) / static_cast<double>(cone.size()),
+                1.0 / (1.0 + std::sqrt(2.0)), 0.005);
+    EXPECT_EQ(parse_shape("cone"), Shape::Cone);
 }
 
 TEST(Shapes, TorusSamplingIsAreaUniform)

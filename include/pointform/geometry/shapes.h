@@ -27,6 +27,11 @@ enum class Shape
     /// A machined part: a block 2 × 1.2 × 0.6 with a cylindrical boss on top and a round hole
     /// through it: flat faces, convex and concave 90° creases and a genus-1 surface (part_solid()).
     Part,
+    /// A closed cone as wide as it is high: a base disc of radius 1 at z = 0 and the apex at
+    /// z = 1. Its rim is a crease sharper than a right angle (the base meets the side at 45°, the
+    /// normals turn by 135°) and its apex a point: features that estimated normals blend the
+    /// short way round and that test orientation and the field.
+    Cone,
 };
 
 /// \brief A ball of the Blobby shape.
