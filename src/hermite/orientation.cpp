@@ -1382,13 +1382,15 @@ float crossing_vote(const Vec3f& pa, const Vec3f& na, const Vec3f& pb, const Vec
 }
 
 /// The vote of samples a and b on either side of a crease or a thin part on their relative
-/// orientation (> 0: the same), with the patches' signed normals: Hoppe's n_a·n_b where
-/// hoppe_trusted(), else the tilt rule, −(n_a·ê)(n_b·ê): at a convex crease each sample lies
-/// on the inner side of the other's tangent plane, at a concave one on the outer side, and
-/// across a thin part each faces the other, so the two tilts have opposite signs when the
-/// normals agree. Unlike the reflection rule it holds for samples at unequal distances from a
-/// crease: at a rim of 42° the reflected normal turns the wrong way once one sample is about
-/// 2.5 times as far from it as the other.
+/// orientation (> 0: the same), with the patches' signed normals, by the tilt rule alone,
+/// −(n_a·ê)(n_b·ê): at a convex crease each sample lies on the inner side of the other's
+/// tangent plane, at a concave one on the outer side, and across a thin part each faces the
+/// other, so the two tilts have opposite signs when the normals agree. Unlike the reflection
+/// rule it holds for samples at unequal distances from a crease (at a rim of 42° the reflected
+/// normal turns the wrong way once one sample is about 2.5 times as far from it as the other),
+/// and unlike Hoppe's rule across a thin part, whose faces' normals agree as lines even for a
+/// pair far apart along it (taking Hoppe's n_a·n_b where hoppe_trusted() turned a face of a
+/// plate two sampling steps thick over again).
 float across_vote(const Vec3f& pa, const Vec3f& na, const Vec3f& pb, const Vec3f& nb)
 {
     const Vec3f e = pb - pa;
@@ -1483,6 +1485,10 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
             //    its shaft inside out, 73% of the samples). (Only the block's own samples can
             //    chain within it, so only its own edges are looked at.)
             bool any_creased = false;
+            //    Whether j is a neighbour of i in the block with a normal.
+            const auto in_block = [&](std::size_t i, std::uint32_t j) {
+                return j >= begin && j < end && j != i && usable(normals[j]);
+            };
             for (std::size_t i = begin; i < end; ++i)
             {
                 if (!usable(normals[i]))
@@ -1492,7 +1498,7 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
                 std::uint32_t apart = none;
                 for (const std::uint32_t j : row)
                 {
-                    if (j < begin || j >= end || j == i || !usable(normals[j]))
+                    if (!in_block(i, j))
                         continue;
                     if (!hoppe_trusted(positions[i], normals[i], positions[j], normals[j],
                                        reliable))
@@ -1515,9 +1521,7 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
                 if (apart != none && farthest < firm)
                     for (const std::uint32_t j : row)
                     {
-                        if (j < begin || j >= end || j == i || !usable(normals[j]))
-                            continue;
-                        if (std::abs(normals[apart].dot(normals[j])) < reliable)
+                        if (in_block(i, j) && std::abs(normals[apart].dot(normals[j])) < reliable)
                         {
                             creased[i] = 1;
                             any_creased = true;
@@ -1626,8 +1630,8 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
             auto& out = block_votes[b];
             std::size_t hit = 0;
             const std::size_t begin = b * patch_block;
-            //    Adds the vote of samples a and c, of different patches, on their patches.
-            //    (by crossing_vote(), or across_vote() for a pair across a creased sample).
+            //    Adds the vote of samples a and c, of different patches, on their patches (by
+            //    crossing_vote(), or by across_vote() for a pair across a creased sample).
             const auto vote = [&](std::uint32_t a, std::uint32_t c, bool across) {
                 const std::uint32_t pa = patch[a];
                 const std::uint32_t pc = patch[c];
