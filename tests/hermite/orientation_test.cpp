@@ -344,17 +344,35 @@ PointCloud sampled_cone(std::size_t count, std::uint32_t seed, double height = 4
     return cone;
 }
 
+/// compute_surfels() of `shape`'s positions alone at each thread count (more than one parallel
+/// block running), each run expected to give the first one's normals bit for bit.
+std::vector<SurfelResult> surfels_at_thread_counts(const PointCloud& shape)
+{
+    PointCloud points;
+    points.positions = shape.positions;
+    auto runs = test::at_thread_counts([&] { return compute_surfels(points); },
+                                       {.min_multi_block_loops = 4});
+    for (const SurfelResult& result : runs)
+    {
+        EXPECT_EQ(result.surfels.normals.size(), shape.size());
+        EXPECT_EQ(result.surfels.normals.size(), runs[0].surfels.normals.size());
+        if (result.surfels.normals.size() == runs[0].surfels.normals.size())
+        {
+            EXPECT_EQ(std::memcmp(result.surfels.normals.data(), runs[0].surfels.normals.data(),
+                                  result.surfels.normals.size() * sizeof(Vec3f)),
+                      0);
+        }
+    }
+    return runs;
+}
+
 /// Orients a sampled cone's positions through compute_surfels() at every thread count (the same
 /// bytes at each) and expects one component, at least `oriented` of the samples outward and at
 /// least `base_outward` of the base's (x = 0), which has more than `min_base` samples.
 void expect_cone_outward(const PointCloud& cone, double oriented, double base_outward,
                          std::size_t min_base)
 {
-    PointCloud points;
-    points.positions = cone.positions;
-    const auto runs = test::at_thread_counts([&] { return compute_surfels(points); },
-                                             {.min_multi_block_loops = 4});
-    for (const SurfelResult& result : runs)
+    for (const SurfelResult& result : surfels_at_thread_counts(cone))
     {
         ASSERT_EQ(result.surfels.normals.size(), cone.normals.size());
         EXPECT_EQ(result.orientation.components, 1U);
@@ -370,9 +388,6 @@ void expect_cone_outward(const PointCloud& cone, double oriented, double base_ou
         }
         ASSERT_GT(base, min_base);
         EXPECT_GE(static_cast<double>(outward), base_outward * static_cast<double>(base));
-        EXPECT_EQ(std::memcmp(result.surfels.normals.data(), runs[0].surfels.normals.data(),
-                              result.surfels.normals.size() * sizeof(Vec3f)),
-                  0);
     }
 }
 
@@ -403,6 +418,39 @@ TEST(OrientNormalsMst, ACreaseAt45DegreesKeepsTheBaseOutward)
 {
     for (const std::uint32_t seed : {1U, 2U, 13U})
         expect_cone_outward(sampled_cone(40000, seed, 1.0, 1.0), 0.98, 0.97, 10000);
+}
+
+/// The same crease under noise, where orientation follows the guide normals (guide_normals()):
+/// near the rim every scale of a sample's neighbourhood spans the turn, so its guide is the axis
+/// of the wedge between the two faces, and a chain of reliable steps through such guides joined
+/// the base to the side inside out: 38% of the samples of `pointform sample cone` with noise 0.2%
+/// of the diagonal came out wrong at 2db1240 (the whole base), on every seed tried. The band of
+/// samples whose guide is thick at every scale now parts base and side, and the base turns over
+/// because that brings the winding number of the oriented samples to about ½ on them.
+TEST(OrientNormalsMst, ANoisyCreaseAt45DegreesKeepsTheBaseOutward)
+{
+    for (const std::uint64_t seed : {3U, 4U})
+    {
+        const PointCloud cone =
+            sample_shape(Shape::Cone, {.count = 40000, .seed = seed, .noise = 0.002});
+        for (const SurfelResult& result : surfels_at_thread_counts(cone))
+        {
+            ASSERT_EQ(result.surfels.normals.size(), cone.normals.size());
+            EXPECT_EQ(result.orientation.components, 1U);
+            EXPECT_GE(test::oriented_fraction(result.surfels.normals, cone.normals), 0.96)
+                << "seed " << seed;
+            std::vector<Vec3f> base;
+            std::vector<Vec3f> truth;
+            for (std::size_t i = 0; i < cone.size(); ++i)
+                if (cone.normals[i].z() < -0.9F)
+                {
+                    base.push_back(result.surfels.normals[i]);
+                    truth.push_back(cone.normals[i]);
+                }
+            ASSERT_GT(base.size(), 10000U);
+            EXPECT_GE(test::oriented_fraction(base, truth), 0.95) << "seed " << seed;
+        }
+    }
 }
 
 /// A closed prism whose cross-section is a triangle with a 30° corner at the origin (sides 4

@@ -157,7 +157,13 @@ struct OrientedNormals
 /// orientation nor votes, so the two faces of a noisy thin plate, whose outliers meet in the gap
 /// with parallel guides, are not oriented alike (faces at least about 8 noise deviations apart:
 /// closer ones share outliers that no test of positions tells apart), and a patch left without
-/// votes takes the sign of its neighbours. Finally, so that
+/// votes takes the sign of its neighbours. Guided clouds are then checked by the generalized
+/// winding number of the oriented samples: samples whose guide is thick at every scale (1.5
+/// times the median flatness, with their neighbours) part the cloud into regions, and a region
+/// is turned over where that brings the winding number on the samples clearly closer to ½ (at a
+/// noisy crease sharper than a right angle every guide near it is the wedge's axis, and a chain
+/// of them turns one face inside out); the samples outside those regions then follow their
+/// neighbours. Finally, so that
 /// closed surfaces come out with outward normals whatever their shape, the component's normals are
 /// flipped if the area-weighted flux Σ a_i n_i·(p_i − c) (3 × the enclosed volume for a closed
 /// surface, by the divergence theorem) is clearly negative; for open, flat components the flux says
