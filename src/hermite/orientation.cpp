@@ -1061,9 +1061,15 @@ std::vector<std::uint8_t> crease_band(std::span<const Vec3f> positions, const Kn
 /// region over negates its share of w everywhere. So the energy Σ_q (w(q) ∓ ½)² over query
 /// samples q (the sign for a surface oriented inwards, which the flux test settles later) is
 /// lowered region by region, the largest first, where turning one lowers it by more than
-/// winding_gain of it; then the samples outside the regions tried take the side of their
-/// neighbours, round by round from the regions. On a cloud where no region turns nothing
-/// changes: on 90 simulated scans of fandisk, spot and the teapot not one sample did.
+/// winding_gain of it. A turn says the band beside the region is such a crease, whose guides
+/// are no face's normal: the samples outside the regions tried then take the tangent plane of
+/// the region sample they lie nearest to, carried round by round from the regions (on the noisy
+/// cones the mean angle error 2.8-2.9° -> 2.3°, and `reconstruct`'s Euler characteristic -46 to
+/// -78 -> -24 to -28). On a cloud where no region turns nothing changes: on 90 simulated scans
+/// of fandisk, spot and the teapot not one sample did. (Taking the planes on every noisy cloud
+/// halved the normals more than 30° off on the bench's noisy blobby and part, but its plate, whose
+/// rims are narrower than the band, came out with 4x the vertices and twice the Hausdorff
+/// distance.)
 ///
 /// Sums run over every stride-th sample in index order (spatially sorted) and each query's sum is
 /// serial, so the result does not depend on the thread count.
@@ -1207,45 +1213,68 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
     if (!any)
         return;
 
-    // 4. The turned regions turn; every sample outside the regions tried takes the side of its
-    //    neighbours on its sheet decided before it, round by round from those regions.
-    constexpr std::uint32_t not_yet = 0xFFFFFFFFU;
-    std::vector<std::uint32_t> stamp(n, not_yet);
+    // 4. The turned regions turn. The band between a turned region and its neighbours is then a
+    //    crease sharper than a right angle, whose guides are the wedge's axes, not either face's
+    //    normal: every sample outside the regions tried takes the tangent plane (normal and
+    //    side) of the region sample it lies nearest to, among those its neighbours on its sheet
+    //    took before it, round by round from the regions; where its neighbourhood does not lie
+    //    on that plane (the median distance more than plane_fit deviations of the noise: a face
+    //    narrower than the band, as a plate's rim) it keeps its own normal, on that plane's side.
+    constexpr float plane_fit = 1.5F;
+    std::vector<std::uint32_t> source(n, none);
     for (std::size_t i = 0; i < n; ++i)
     {
         const std::int32_t t = tried_index(static_cast<std::uint32_t>(i));
         if (t < 0)
             continue;
-        stamp[i] = 0;
+        source[i] = static_cast<std::uint32_t>(i);
         if (turned[static_cast<std::size_t>(t)] != 0)
             normals[i] = -normals[i];
     }
+    std::vector<Vec3f> adopted(normals);
+    std::vector<std::uint32_t> stamp(n, none);
+    for (std::size_t i = 0; i < n; ++i)
+        stamp[i] = source[i] != none ? 0 : none;
     for (std::uint32_t round = 1;; ++round)
     {
         std::atomic<bool> progressed{false};
         parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+            std::vector<float> residual(neighbors.k);
             bool local = false;
             for (std::size_t i = begin; i < end; ++i)
             {
-                if (stamp[i] != not_yet || !usable(normals[i]))
+                if (stamp[i] != none || !usable(normals[i]))
                     continue;
-                float side = 0.0F;
-                bool reached = false;
+                const auto a = static_cast<std::uint32_t>(i);
+                float nearest = std::numeric_limits<float>::infinity();
+                std::uint32_t from = none;
                 for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
                 {
                     // Samples decided in this round are skipped whichever thread got there first.
                     const std::uint32_t decided =
                         std::atomic_ref<std::uint32_t>(stamp[j]).load(std::memory_order_relaxed);
-                    if (j == i || decided >= round || !usable(normals[j]) ||
-                        guide.jumps(positions, neighbors, static_cast<std::uint32_t>(i), j))
+                    if (j == i || decided >= round || guide.jumps(positions, neighbors, a, j))
                         continue;
-                    reached = true;
-                    side += normals[j].dot(normals[i]);
+                    const std::uint32_t s = source[j];
+                    const float distance = std::abs((positions[i] - positions[s]).dot(normals[s]));
+                    if (distance < nearest || (distance == nearest && s < from))
+                    {
+                        nearest = distance;
+                        from = s;
+                    }
                 }
-                if (!reached)
+                if (from == none)
                     continue;
-                if (side < 0.0F)
-                    normals[i] = -normals[i];
+                source[i] = from;
+                const Vec3f& plane = normals[from];
+                const auto row = neighbors.neighbors(i);
+                for (std::size_t c = 0; c < row.size(); ++c)
+                    residual[c] = std::abs((positions[row[c]] - positions[from]).dot(plane));
+                const bool fits = middle_value(std::span<float>(residual).first(row.size())) <=
+                                  plane_fit * guide.reach[i] / off_sheet_deviations;
+                adopted[i] = fits                           ? plane
+                             : plane.dot(normals[i]) < 0.0F ? Vec3f(-normals[i])
+                                                            : normals[i];
                 std::atomic_ref<std::uint32_t>(stamp[i]).store(round, std::memory_order_relaxed);
                 local = true;
             }
@@ -1255,6 +1284,7 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
         if (!progressed.load())
             break;
     }
+    normals.swap(adopted);
 }
 
 /// Steps 1 to 5 of orient_normals_mst() over the whole graph of `neighbors`: spanning forest,

@@ -426,7 +426,9 @@ TEST(OrientNormalsMst, ACreaseAt45DegreesKeepsTheBaseOutward)
 /// the base to the side inside out: 38% of the samples of `pointform sample cone` with noise 0.2%
 /// of the diagonal came out wrong at 2db1240 (the whole base), on every seed tried. The band of
 /// samples whose guide is thick at every scale now parts base and side, and the base turns over
-/// because that brings the winding number of the oriented samples to about ½ on them.
+/// because that brings the winding number of the oriented samples to about ½ on them; the rim's
+/// samples then take the plane of a face (95% of the normals within 11° of the truth as lines
+/// with the wedge's axes for normals at 9a33ba4, within 4.1° now).
 TEST(OrientNormalsMst, ANoisyCreaseAt45DegreesKeepsTheBaseOutward)
 {
     for (const std::uint64_t seed : {3U, 4U})
@@ -438,6 +440,9 @@ TEST(OrientNormalsMst, ANoisyCreaseAt45DegreesKeepsTheBaseOutward)
             ASSERT_EQ(result.surfels.normals.size(), cone.normals.size());
             EXPECT_EQ(result.orientation.components, 1U);
             EXPECT_GE(test::oriented_fraction(result.surfels.normals, cone.normals), 0.96)
+                << "seed " << seed;
+            EXPECT_LE(test::line_angle_quantile_deg(result.surfels.normals, cone.normals, 0.95),
+                      6.0)
                 << "seed " << seed;
             std::vector<Vec3f> base;
             std::vector<Vec3f> truth;

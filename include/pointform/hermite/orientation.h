@@ -162,8 +162,8 @@ struct OrientedNormals
 /// times the median flatness, with their neighbours) part the cloud into regions, and a region
 /// is turned over where that brings the winding number on the samples clearly closer to ½ (at a
 /// noisy crease sharper than a right angle every guide near it is the wedge's axis, and a chain
-/// of them turns one face inside out); the samples outside those regions then follow their
-/// neighbours. Finally, so that
+/// of them turns one face inside out); where one turns, the samples outside those regions then
+/// take the tangent plane of the region sample they lie nearest to. Finally, so that
 /// closed surfaces come out with outward normals whatever their shape, the component's normals are
 /// flipped if the area-weighted flux Σ a_i n_i·(p_i − c) (3 × the enclosed volume for a closed
 /// surface, by the divergence theorem) is clearly negative; for open, flat components the flux says
