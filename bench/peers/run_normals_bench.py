@@ -41,7 +41,7 @@ VARIANTS = {
     "clean": {"noise": 0.0, "holes": 0, "hole_radius": 0.0},
     "noisy+holes": {"noise": 0.002, "holes": 8, "hole_radius": 0.04},
 }
-SHAPES = ("sphere", "torus", "two-spheres", "plate")
+SHAPES = ("sphere", "torus", "two-spheres", "plate", "cone")
 
 
 # --------------------------------------------------------------------------------------------
@@ -115,11 +115,25 @@ def _sample_plate(rng, n, half=(1.0, 1.0, 0.05)):
     return p, nrm
 
 
+def _sample_cone(rng, n):
+    """Shape::Cone: radius 1, apex 1 above the base's centre (a 45° rim), area-uniform."""
+    slant = np.sqrt(2.0)
+    side = rng.uniform(0.0, slant + 1.0, n) < slant
+    t = np.sqrt(rng.uniform(0.0, 1.0, n))
+    angle = rng.uniform(0.0, 2.0 * np.pi, n)
+    c, s = np.cos(angle), np.sin(angle)
+    p = np.stack([t * c, t * s, np.where(side, 1.0 - t, 0.0)], axis=1)
+    nrm = np.where(side[:, None], np.stack([c, s, np.ones(n)], axis=1) / slant,
+                   np.array([0.0, 0.0, -1.0]))
+    return p, nrm
+
+
 def numpy_sample(shape, n, noise, holes, hole_radius, seed):
     """Fallback sampler with the semantics of `pointform sample` (used when it is absent)."""
     rng = np.random.default_rng(seed)
     sampler = {"sphere": _sample_sphere, "torus": _sample_torus,
-               "two-spheres": _sample_two_spheres, "plate": _sample_plate}[shape]
+               "two-spheres": _sample_two_spheres, "plate": _sample_plate,
+               "cone": _sample_cone}[shape]
     p, nrm = sampler(rng, n)
     diag = float(np.linalg.norm(p.max(axis=0) - p.min(axis=0)))
     if holes > 0:
