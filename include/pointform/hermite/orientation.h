@@ -160,10 +160,11 @@ struct OrientedNormals
 /// votes takes the sign of its neighbours. Guided clouds are then checked by the generalized
 /// winding number of the oriented samples: samples whose guide is thick at every scale (1.5
 /// times the median flatness, with their neighbours) part the cloud into regions, and a region
-/// is turned over where that brings the winding number on the samples clearly closer to ½ (at a
-/// noisy crease sharper than a right angle every guide near it is the wedge's axis, and a chain
-/// of them turns one face inside out); where one turns, the samples outside those regions then
-/// take the tangent plane of the region sample they lie nearest to. Finally, so that
+/// is turned over where that brings the winding number on the samples clearly closer to ½, and
+/// leaves them a closed surface by it (at a noisy crease sharper than a right angle every guide
+/// near it is the wedge's axis, and a chain of them turns one face inside out); where one turns,
+/// the samples outside those regions then take the tangent plane of the region sample they lie
+/// nearest to. Finally, so that
 /// closed surfaces come out with outward normals whatever their shape, the component's normals are
 /// flipped if the area-weighted flux Σ a_i n_i·(p_i − c) (3 × the enclosed volume for a closed
 /// surface, by the divergence theorem) is clearly negative; for open, flat components the flux says
