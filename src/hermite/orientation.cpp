@@ -1006,15 +1006,16 @@ constexpr double least_region_share = 0.005;
 constexpr std::size_t min_region = 64;
 /// At most this many regions are tried, the largest first.
 constexpr std::size_t most_regions = 64;
-/// The winding number is summed over about this many samples at about this many queries (half
-/// each turned the same regions on the noisy cones in 0.10 s instead of 0.16 s at 100k samples,
-/// but left the arrow of the sweep at noise 0.2%, seed 2, with 4.1% of its area facing away
-/// instead of 1.0%).
+/// The winding number is summed over about this many samples at about this many queries (4,096
+/// and 1,024 turned the same regions on the noisy cones in 0.10 s instead of 0.16 s at 100k
+/// samples, but left the arrow of the sweep at noise 0.2%, seed 2, with 4.1% of its area facing
+/// away instead of 1.0%).
 constexpr std::size_t winding_sources = 8192;
 constexpr std::size_t winding_queries = 2048;
-/// Sources nearer a query than this many times the spacing of the sources are left out of its
-/// sum: the surface through the query contributes nothing there for a smooth sheet, while single
-/// noisy samples close by would each add a large term.
+/// Sources nearer a query than this many times its k-th neighbour's distance, scaled by the
+/// square root of the stride between sources (so about the sources' own spacing), are left out
+/// of its sum: the surface through the query contributes nothing there for a smooth sheet, while
+/// single noisy samples close by would each add a large term.
 constexpr float winding_exclusion = 2.0F;
 /// A region is turned when that lowers the winding energy by more than this share of it.
 constexpr double winding_gain = 0.2;
