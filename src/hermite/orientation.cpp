@@ -104,6 +104,17 @@ constexpr std::size_t noise_test_stride = 8;
 constexpr std::size_t noise_test_sampled = 65536;
 constexpr std::size_t noise_test_most = std::size_t{1} << 17U;
 
+/// The guide's neighbourhoods grow past OrientationOptions::guide_rings while the median flatness
+/// of the last ring's neighbourhoods (over the noise test's samples) is above this: about noise of
+/// a seventh of the grown neighbourhood's radius (see noisy_flatness). Each ring adds about one
+/// step of the neighbour table to the radius in quadrature (a ring is a walk of one step), so the
+/// flatness of noise falls as about 1 / rings: the bench's noisy clouds at 100k samples (noise of
+/// 0.6 sampling steps) score 0.06-0.08 at ring 4 and keep 4 rings, while at 1M (2 steps) they
+/// score 0.21-0.23 there and need 11-12. A crease band (crease_band()) forms only once the faces
+/// are flatter than a crease: the base of a 1M-sample noisy cone stayed inside out up to 8 rings
+/// (median 0.167) and was right from 9 (0.156); with 4 rings, 41% of its normals were wrong.
+constexpr float guide_target_flatness = 0.12F;
+
 /// A point lies off a sample's sheet when its height along the sample's guide is more than this
 /// many robust standard deviations of the noise from the median height of the sample's
 /// neighbours (mark_sheets()): under Gaussian noise 3 keeps 99.7% of a sheet's own samples,
@@ -324,8 +335,24 @@ void mark_sheets(std::span<const Vec3f> positions, const KnnTable& neighbors, Gu
     });
 }
 
+/// The median of flatness() over every stride-th neighbourhood of `moments` (stride as the noise
+/// test's), the same for any thread count.
+float median_flatness(const std::vector<Moments>& moments)
+{
+    const std::size_t n = moments.size();
+    const std::size_t stride =
+        n >= noise_test_sampled ? std::max(noise_test_stride, n / noise_test_most) : 1;
+    std::vector<float> values((n + stride - 1) / stride);
+    parallel_blocks(values.size(), 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t t = begin; t < end; ++t)
+            values[t] = flatness(moments[t * stride].covariance);
+    });
+    return values.empty() ? 0.0F : middle_value(values);
+}
+
 /// The normals that orientation follows: for each sample, the PCA normal of its neighbourhood
-/// grown ring by ring through the neighbour table (up to `rings` rings) at the scale where the
+/// grown ring by ring through the neighbour table (at least `rings` rings, and more, up to
+/// `most_rings`, while the median flatness is above guide_target_flatness) at the scale where the
 /// points are flattest (least flatness()). Noise makes a small neighbourhood thick, and growing it
 /// averages the noise out, whereas curvature and nearby sheets make a larger one thicker: so the
 /// scale follows the noise where there is noise and stays at the normal's own neighbourhood on
@@ -335,7 +362,7 @@ void mark_sheets(std::span<const Vec3f> positions, const KnnTable& neighbors, Gu
 /// Empty when the cloud is clean (noisy_flatness). Zero where `normals` is. With the guides, the
 /// band of each sample's sheet (mark_sheets()).
 Guide guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
-                    const KnnTable& neighbors, std::size_t rings)
+                    const KnnTable& neighbors, std::size_t rings, std::size_t most_rings)
 {
     const std::size_t n = positions.size();
     // Sums of d and d dᵀ about `shift`, turned into a centroid and covariance.
@@ -406,8 +433,9 @@ Guide guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> nor
             best_flatness[i] = flatness(best[i]);
         }
     });
-    std::vector<Moments> next(rings > 0 ? n : 0);
-    for (std::size_t ring = 0; ring < rings; ++ring)
+    most_rings = std::max(rings, most_rings);
+    std::vector<Moments> next(most_rings > 0 ? n : 0);
+    for (std::size_t ring = 0; ring < most_rings; ++ring)
     {
         parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i)
@@ -437,6 +465,8 @@ Guide guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> nor
             }
         });
         current.swap(next);
+        if (ring + 1 >= rings && median_flatness(current) <= guide_target_flatness)
+            break;
     }
     std::vector<Moments>().swap(current);
     std::vector<Moments>().swap(next);
@@ -1017,15 +1047,17 @@ constexpr std::size_t winding_queries = 2048;
 /// of its sum: the surface through the query contributes nothing there for a smooth sheet, while
 /// single noisy samples close by would each add a large term.
 constexpr float winding_exclusion = 2.0F;
-/// A region is turned when that lowers the winding energy by more than this share of it.
+/// A region is turned when that lowers the fitted winding energy by more than this share of it
+/// (and does not raise the plain one; see turn_regions_by_winding()).
 constexpr double winding_gain = 0.2;
-/// ... and the turns stand only if they leave the energy, per query, below this: the samples
-/// then make a closed, consistently oriented surface. Such surfaces score about 0.01 to 0.07 (the
-/// noisy part and blobby of the bench, the noisy cones once turned: noise, holes and the near
-/// sources left out), an open sheet about 0.15 to 0.22 (a LiDAR terrain, whose winding number is
-/// about 0 on it, turned 61% of its normals down with no such bound), and so does a plate
-/// thinner than the sources left out.
-constexpr double closed_energy = 0.1;
+/// ... and the turns stand only if they leave the fitted energy, per query, below this: the
+/// samples then make a closed, consistently oriented surface. Such surfaces score 0.001 to 0.03
+/// (the bench's noisy two spheres, blobby and part at 100k and 1M, the noisy cones once turned:
+/// noise, holes and the near sources left out); the LiDAR terrain of data/ (open, with roofs,
+/// walls and trees), once its largest region was turned down, 0.084, which is a winding number
+/// that is about the same everywhere but is no surface's (its plain energy, 0.087, was under the
+/// 0.1 that bounded it before the fit).
+constexpr double closed_energy = 0.05;
 
 /// The samples of a guided cloud in a crease band (crease_band_flatness) or next to one.
 std::vector<std::uint8_t> crease_band(std::span<const Vec3f> positions, const KnnTable& neighbors,
@@ -1069,19 +1101,27 @@ std::vector<std::uint8_t> crease_band(std::span<const Vec3f> positions, const Kn
 /// flat guides. Each oriented sample j, with area a_j ≈ π r_j² / k (r_j its k-th neighbour's
 /// distance), is a dipole of the winding number w(q) = Σ_j a_j n_j·(p_j − q) / (4π |p_j − q|³),
 /// which is 1 inside a closed, consistently oriented surface, 0 outside and ½ on it; turning a
-/// region over negates its share of w everywhere. So the energy Σ_q (w(q) ∓ ½)² over query
-/// samples q (the sign for a surface oriented inwards, which the flux test settles later) is
-/// lowered region by region, the largest first, where turning one lowers it by more than
-/// winding_gain of it. A turn says the band beside the region is such a crease, whose guides
-/// are no face's normal: the samples outside the regions tried then take the tangent plane of
-/// the region sample they lie nearest to, carried round by round from the regions (on the noisy
-/// cones the mean angle error 2.8-2.9° -> 2.3°, and `reconstruct`'s Euler characteristic -46 to
-/// -78 -> -24 to -28). The turns stand only if the energy they leave is that of a closed surface
-/// (closed_energy). On a cloud where no region turns nothing changes: on 90 simulated scans of
-/// fandisk, spot and the teapot not one sample did, nor on the LiDAR terrain of data/. (Taking the
-/// planes on every noisy cloud halved the normals more than 30° off on the bench's noisy blobby and
-/// part, but its plate, whose rims are narrower than the band, came out with 4x the vertices and
-/// twice the Hausdorff distance.)
+/// region over negates its share of w everywhere. So the energy Σ_q (s w(q) − ½)² over query
+/// samples q, at the scale s that makes it least (its sign settles a surface oriented inwards,
+/// which the flux test turns later), is lowered region by region, the largest first, where
+/// turning one lowers it by more than winding_gain of it and does not raise the plain energy
+/// Σ_q (w(q) ∓ ½)². The scale takes up the bias of the areas: noise of two sampling steps puts
+/// the k-th neighbour farther off, and a 1M-sample noisy blobby, rightly oriented, had w about
+/// 0.78 at the median, so that the plain energy (0.136) fell to 0.087 by turning its largest
+/// region inside out (a third of the samples wrong), while the fitted energy rose from 0.011 to
+/// 0.086. The plain energy keeps the level: on two simulated scans of the teapot (open, with
+/// holes), turning a region of 4,284-5,460 samples wrongly made w more even (fitted 0.015 ->
+/// 0.012) but further from ½ (plain 0.021 -> 0.026-0.029). Turns lower both where a face is inside
+/// out (the noisy cones: fitted 0.18 -> 0.03, plain 0.19-0.25 -> 0.03-0.10). A turn says the band
+/// beside the region is such a crease, whose guides are no face's normal: the samples outside the
+/// regions tried then take the tangent plane of the region sample they lie nearest to, carried
+/// round by round from the regions (on the noisy cones the mean angle error 2.8-2.9° -> 2.3°, and
+/// `reconstruct`'s Euler characteristic -46 to -78 -> -24 to -28). The turns stand only if the
+/// fitted energy they leave is that of a closed surface (closed_energy). On a cloud where no region
+/// turns nothing changes: on 90 simulated scans of fandisk, spot and the teapot not one sample did,
+/// nor on the LiDAR terrain of data/. (Taking the planes on every noisy cloud halved the normals
+/// more than 30° off on the bench's noisy blobby and part, but its plate, whose rims are narrower
+/// than the band, came out with 4x the vertices and twice the Hausdorff distance.)
 ///
 /// Sums run over every stride-th sample in index order (spatially sorted) and each query's sum is
 /// serial, so the result does not depend on the thread count.
@@ -1189,7 +1229,14 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
 
     // 3. Turn regions, the largest first, while that lowers the energy by winding_gain.
     std::vector<std::uint8_t> turned(count, 0);
+    struct Energy
+    {
+        double fitted;
+        double plain;
+    };
     const auto energy = [&] {
+        double sum = 0.0;
+        double squares = 0.0;
         double outward = 0.0;
         double inward = 0.0;
         for (std::size_t qi = 0; qi < queries.size(); ++qi)
@@ -1198,12 +1245,17 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
             for (std::size_t t = 0; t < count; ++t)
                 if (turned[t] != 0)
                     w -= 2.0 * share[qi * count + t];
+            sum += w;
+            squares += w * w;
             outward += (w - 0.5) * (w - 0.5);
             inward += (w + 0.5) * (w + 0.5);
         }
-        return std::min(outward, inward);
+        // min over s of Σ (s w − ½)², at s = Σ w / (2 Σ w²).
+        const double all = 0.25 * static_cast<double>(queries.size());
+        return Energy{squares > 0.0 ? all - 0.25 * sum * sum / squares : all,
+                      std::min(outward, inward)};
     };
-    double current = energy();
+    Energy current = energy();
     bool any = false;
     for (bool changed = true; changed;)
     {
@@ -1211,8 +1263,9 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
         for (std::size_t t = 0; t < count; ++t)
         {
             turned[t] ^= 1U;
-            const double trial = energy();
-            if (trial < (1.0 - winding_gain) * current)
+            const Energy trial = energy();
+            if (trial.fitted < (1.0 - winding_gain) * current.fitted &&
+                trial.plain <= current.plain)
             {
                 current = trial;
                 changed = true;
@@ -1222,7 +1275,7 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
                 turned[t] ^= 1U;
         }
     }
-    if (!any || current > closed_energy * static_cast<double>(queries.size()))
+    if (!any || current.fitted > closed_energy * static_cast<double>(queries.size()))
         return;
 
     // 4. The turned regions turn. The band between a turned region and its neighbours is then a
@@ -2251,7 +2304,8 @@ OrientedNormals detail::orient_checked_table(std::span<const Vec3f> positions,
     // no orientation.
     Guide guide;
     if (options.rule == OrientationRule::Hoppe && options.guide_rings > 0 && !positions.empty())
-        guide = guide_normals(positions, fine_normals, neighbors, options.guide_rings);
+        guide = guide_normals(positions, fine_normals, neighbors, options.guide_rings,
+                              options.guide_most_rings);
     if (options.patches && options.rule == OrientationRule::Hoppe && guide.normals.empty() &&
         positions.size() >= min_patched)
         return orient_by_patches(positions, fine_normals, neighbors, options);
