@@ -1287,19 +1287,18 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
     //    narrower than the band, as a plate's rim) it keeps its own normal, on that plane's side.
     constexpr float plane_fit = 1.5F;
     std::vector<std::uint32_t> source(n, none);
+    std::vector<std::uint32_t> stamp(n, none); // the round a sample took its plane in
     for (std::size_t i = 0; i < n; ++i)
     {
         const std::int32_t t = tried_index(static_cast<std::uint32_t>(i));
         if (t < 0)
             continue;
         source[i] = static_cast<std::uint32_t>(i);
+        stamp[i] = 0;
         if (turned[static_cast<std::size_t>(t)] != 0)
             normals[i] = -normals[i];
     }
     std::vector<Vec3f> adopted(normals);
-    std::vector<std::uint32_t> stamp(n, none);
-    for (std::size_t i = 0; i < n; ++i)
-        stamp[i] = source[i] != none ? 0 : none;
     for (std::uint32_t round = 1;; ++round)
     {
         std::atomic<bool> progressed{false};
