@@ -110,7 +110,7 @@ constexpr std::size_t noise_test_most = std::size_t{1} << 17U;
 /// step of the neighbour table to the radius in quadrature (a ring is a walk of one step), so the
 /// flatness of noise falls as about 1 / rings: the bench's noisy clouds at 100k samples (noise of
 /// 0.6 sampling steps) score 0.06-0.08 at ring 4 and keep 4 rings, while at 1M (2 steps) they
-/// score 0.21-0.23 there and need 11-12. A crease band (crease_band()) forms only once the faces
+/// score 0.21-0.23 there and need 12-14. A crease band (crease_band()) forms only once the faces
 /// are flatter than a crease: the base of a 1M-sample noisy cone stayed inside out up to 8 rings
 /// (median 0.167) and was right from 9 (0.156); with 4 rings, 41% of its normals were wrong.
 constexpr float guide_target_flatness = 0.12F;

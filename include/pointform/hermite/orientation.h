@@ -66,8 +66,8 @@ struct OrientationOptions
     /// (median flatness above about that of noise of a seventh of the grown neighbourhood's
     /// radius) grow them further, up to this many rings in all: the denser the samples are for
     /// their noise, the more rings averaging it out takes. A 1M-sample cone with noise of twice the
-    /// sampling step took 12 and went from 41% of its normals inside out (its base) to 1.2%; the
-    /// bench's noisy spheres, tori and plates at 1M from 516-1,855 wrong normals and 6.4-8.4° mean
+    /// sampling step took 14 and went from 41% of its normals inside out (its base) to 1.2%; the
+    /// bench's noisy spheres, tori and plates at 1M from 516-1,855 wrong normals and 6.4-7.7° mean
     /// error to 0-222 and 2.1-3.9°, for about 0.05 s per ring per million samples. Noisy clouds of
     /// 100k samples (noise of 0.6 sampling steps) stop at 4. Values below guide_rings count as
     /// guide_rings.
