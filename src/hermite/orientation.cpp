@@ -104,6 +104,12 @@ constexpr std::size_t noise_test_stride = 8;
 constexpr std::size_t noise_test_sampled = 65536;
 constexpr std::size_t noise_test_most = std::size_t{1} << 17U;
 
+/// The stride of the noise test's samples in a cloud of n.
+std::size_t noise_test_stride_for(std::size_t n)
+{
+    return n >= noise_test_sampled ? std::max(noise_test_stride, n / noise_test_most) : 1;
+}
+
 /// The guide's neighbourhoods grow past OrientationOptions::guide_rings while the median flatness
 /// of the last ring's neighbourhoods (over the noise test's samples) is above this: about noise of
 /// a seventh of the grown neighbourhood's radius (see noisy_flatness). Each ring adds about one
@@ -340,8 +346,7 @@ void mark_sheets(std::span<const Vec3f> positions, const KnnTable& neighbors, Gu
 float median_flatness(const std::vector<Moments>& moments)
 {
     const std::size_t n = moments.size();
-    const std::size_t stride =
-        n >= noise_test_sampled ? std::max(noise_test_stride, n / noise_test_most) : 1;
+    const std::size_t stride = noise_test_stride_for(n);
     std::vector<float> values((n + stride - 1) / stride);
     parallel_blocks(values.size(), 4096, [&](std::size_t begin, std::size_t end) {
         for (std::size_t t = begin; t < end; ++t)
@@ -408,8 +413,7 @@ Guide guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> nor
     // and nothing kept for a clean cloud, whose samples' own normals are the best guide. Counted
     // on every stride-th sample (in Morton order, an even spread over the surface).
     {
-        const std::size_t stride =
-            n >= noise_test_sampled ? std::max(noise_test_stride, n / noise_test_most) : 1;
+        const std::size_t stride = noise_test_stride_for(n);
         const std::size_t tested = (n + stride - 1) / stride;
         constexpr std::size_t block = 4096;
         std::vector<std::size_t> flatter((tested + block - 1) / block, 0);
