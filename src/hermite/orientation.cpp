@@ -144,11 +144,15 @@ struct Guide
     std::vector<float> centre;
     /// How far from `centre` a point may lie and still be on the sample's sheet.
     std::vector<float> reach;
-    /// How well a plane fits the neighbourhood the guide was taken from: (1 - flatness)², 0 for
-    /// an isotropic blob (flatness()).
-    std::vector<float> confidence;
-    /// The flatness (flatness()) of that neighbourhood: 0 on a plane.
+    /// The flatness (flatness()) of the neighbourhood the guide was taken from: 0 on a plane.
     std::vector<float> flatness;
+
+    /// How well a plane fits sample i's neighbourhood: (1 - flatness)², 0 for an isotropic blob.
+    [[nodiscard]] float confidence(std::size_t i) const
+    {
+        const float fit = std::max(0.0F, 1.0F - flatness[i]);
+        return fit * fit;
+    }
 
     /// Whether `to` lies off the band of `from`'s sheet (false without guides).
     [[nodiscard]] bool off_sheet(std::span<const Vec3f> positions, std::uint32_t from,
@@ -223,10 +227,9 @@ Eigen::Matrix3f adjugate(const Eigen::Matrix3f& m)
 /// λ0 ≤ λ1 ≤ λ2): 3 det C / (I2 tr C), I2 = tr adj C the sum of C's principal 2×2 minors, that
 /// is 3 / ((1/λ0 + 1/λ1 + 1/λ2)(λ0 + λ1 + λ2)): 0 on a plane, 1 for an isotropic blob, about
 /// 3 λ0 / (λ1 + λ2) (Pauly's surface variation, times 3) when thin; no eigen-solve needed.
-float flatness(const std::array<float, 6>& covariance)
+/// From the covariance's normalized_matrix() `m` (tr = 1) and its adjugate.
+float flatness(const Eigen::Matrix3f& m, const Eigen::Matrix3f& adj)
 {
-    const Eigen::Matrix3f m = normalized_matrix(covariance); // tr = 1
-    const Eigen::Matrix3f adj = adjugate(m);
     const float minors = adj.trace();
     const float det = m.row(0).dot(adj.col(0));
     if (!(minors > 0.0F))
@@ -234,23 +237,30 @@ float flatness(const std::array<float, 6>& covariance)
     return std::max(0.0F, 3.0F * det / minors);
 }
 
+float flatness(const std::array<float, 6>& covariance)
+{
+    const Eigen::Matrix3f m = normalized_matrix(covariance);
+    return flatness(m, adjugate(m));
+}
+
 /// The eigenvector of the least eigenvalue of a covariance (unit; arbitrary sign; zero if there
 /// is none): the dominant eigenvector of its adjugate, started from the adjugate's longest column
 /// (exact when λ0 = 0) and refined by power iteration, each step shrinking the error by λ0 / λ1.
-/// Cheaper than an eigen-solve, and the guide needs only a direction.
-Vec3f least_axis(const std::array<float, 6>& covariance)
+/// Cheaper than an eigen-solve, and the guide needs only a direction. From the adjugate of the
+/// covariance's normalized_matrix().
+Vec3f least_axis(const Eigen::Matrix3f& adj)
 {
-    const Eigen::Matrix3f adj = adjugate(normalized_matrix(covariance));
     Eigen::Index longest = 0;
     adj.colwise().squaredNorm().maxCoeff(&longest);
+    // Two steps, scaled once: adj's eigenvalues lie in [0, 1/4] (m's in [0, 1]), and the start
+    // divided by its largest entry keeps the steps far from float's range limits. The guide
+    // takes an axis at every ring that a sample's neighbourhood gets flatter, so this is a hot
+    // path: one square root and two divisions instead of three and three.
     Vec3f v = adj.col(longest);
-    for (int step = 0; step < 2; ++step)
-    {
-        const float length = v.norm();
-        if (!(length > 0.0F) || !std::isfinite(length))
-            return Vec3f::Zero();
-        v = adj * (v / length);
-    }
+    const float scale = v.cwiseAbs().maxCoeff();
+    if (!(scale > 0.0F) || !std::isfinite(scale))
+        return Vec3f::Zero();
+    v = adj * (adj * (v / scale));
     const float length = v.norm();
     if (!(length > 0.0F) || !std::isfinite(length))
         return Vec3f::Zero();
@@ -426,15 +436,27 @@ Guide guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> nor
         if (std::accumulate(flatter.begin(), flatter.end(), std::size_t{0}) > tested / 2)
             return {};
     }
+    // The flattest scale's flatness and least axis so far (the axis taken when the scale is, not
+    // its covariance kept: half the memory).
     std::vector<Moments> current(n);
-    std::vector<std::array<float, 6>> best(n);
+    std::vector<Vec3f> best_axis(n);
     std::vector<float> best_flatness(n);
+    const auto take_if_flatter = [&](std::size_t i, const std::array<float, 6>& covariance) {
+        const Eigen::Matrix3f m = normalized_matrix(covariance);
+        const Eigen::Matrix3f adj = adjugate(m);
+        const float f = flatness(m, adj);
+        if (f < best_flatness[i])
+        {
+            best_flatness[i] = f;
+            best_axis[i] = least_axis(adj);
+        }
+    };
     parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
         {
             current[i] = own_moments(i);
-            best[i] = current[i].covariance;
-            best_flatness[i] = flatness(best[i]);
+            best_flatness[i] = std::numeric_limits<float>::infinity();
+            take_if_flatter(i, current[i].covariance);
         }
     });
     most_rings = std::max(rings, most_rings);
@@ -460,12 +482,7 @@ Guide guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> nor
                 for (std::size_t e = 0; e < 6; ++e)
                     outer[e] += within[e];
                 next[i] = finish(c, sum, outer, static_cast<float>(row.size()));
-                const float f = flatness(next[i].covariance);
-                if (f < best_flatness[i])
-                {
-                    best_flatness[i] = f;
-                    best[i] = next[i].covariance;
-                }
+                take_if_flatter(i, next[i].covariance);
             }
         });
         current.swap(next);
@@ -475,19 +492,16 @@ Guide guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> nor
     std::vector<Moments>().swap(current);
     std::vector<Moments>().swap(next);
     Guide result;
-    result.normals.assign(n, Vec3f::Zero());
-    result.confidence.resize(n);
+    result.normals.swap(best_axis);
     result.flatness.swap(best_flatness);
     parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
         {
-            const float confidence = std::max(0.0F, 1.0F - result.flatness[i]);
-            result.confidence[i] = confidence * confidence;
-            if (usable(normals[i]))
-            {
-                const Vec3f axis = least_axis(best[i]);
-                result.normals[i] = result.flatness[i] < 1.0F && usable(axis) ? axis : normals[i];
-            }
+            Vec3f& axis = result.normals[i];
+            if (!usable(normals[i]))
+                axis = Vec3f::Zero();
+            else if (!(result.flatness[i] < 1.0F && usable(axis)))
+                axis = normals[i];
         }
     });
     mark_sheets(positions, neighbors, result);
@@ -528,16 +542,26 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
     const std::size_t columns = graph_columns(options, neighbors);
 
     // 1. The Riemannian graph's edges, each once, in the neighbour table's layout: {i, j} is
-    //    edge (i, c) when j is column c of row i, unless row j lists i too and j < i. Its cost
-    //    is stored there (not_an_edge elsewhere); no edge list is built.
+    //    edge (i, c) when j is column c of row i, unless row j lists i too and j < i. No edge
+    //    list is built.
     constexpr std::size_t block = 8192;
-    constexpr std::uint32_t not_an_edge = 0xFFFFFFFFU;
     if (static_cast<double>(n) * static_cast<double>(columns) >= 0x1p33)
         throw InvalidInput("orientation: too many points times graph neighbours (" +
                            std::to_string(n) + " x " + std::to_string(columns) + ")");
-    //    Written in full by the first round (in parallel, so the pages are touched where they
-    //    are used), hence not zeroed first.
-    auto cost_bits = std::make_unique_for_overwrite<std::uint32_t[]>(n * columns);
+    //    Which entries are edges still leaving their component is one bit each (`live`, a row's
+    //    bits in row_bytes bytes); a live edge's cost is worked out again whenever a round looks
+    //    at it (the same pure function, so the same bits), which takes 2 bytes a sample for the
+    //    default 10 columns where stored costs took 40 (and the guided path's peak memory with
+    //    them). Written in full by the first round (in parallel, so the pages are touched where
+    //    they are used), hence not zeroed first.
+    const std::size_t row_bytes = (columns + 7) / 8;
+    auto live = std::make_unique_for_overwrite<std::uint8_t[]>(n * row_bytes);
+    const auto cost_of = [&](std::uint32_t a, std::uint32_t b) {
+        return std::bit_cast<std::uint32_t>(
+            guide.jumps(positions, neighbors, a, b)
+                ? 2.0F
+                : edge_cost(positions, normals, options.rule, a, b));
+    };
 
     // 2. Borůvka: each round, every component takes its cheapest edge to another component,
     //    found in parallel by atomic minima of 64-bit keys (cost, then edge index: the order of
@@ -573,21 +597,16 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
         {
             const auto a = static_cast<std::uint32_t>(i);
             const auto row = neighbors.neighbors(i).first(columns);
+            std::uint8_t* bits = live.get() + i * row_bytes;
+            std::fill(bits, bits + row_bytes, std::uint8_t{0});
             std::uint64_t own = no_key;
             for (std::size_t c = 0; c < columns; ++c)
             {
                 const std::uint32_t b = row[c];
-                const std::uint32_t bits =
-                    b == a || (b < a && row_contains(neighbors, b, columns, a))
-                        ? not_an_edge
-                        : std::bit_cast<std::uint32_t>(
-                              guide.jumps(positions, neighbors, a, b)
-                                  ? 2.0F
-                                  : edge_cost(positions, normals, options.rule, a, b));
-                cost_bits[i * columns + c] = bits;
-                if (bits == not_an_edge)
+                if (b == a || (b < a && row_contains(neighbors, b, columns, a)))
                     continue;
-                const std::uint64_t key = key_of(bits, i * columns + c);
+                bits[c / 8] |= static_cast<std::uint8_t>(1U << (c % 8));
+                const std::uint64_t key = key_of(cost_of(a, b), i * columns + c);
                 own = std::min(own, key);
                 lower(cheapest[b], key);
             }
@@ -606,22 +625,24 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
                 if (internal[i] != 0)
                     continue;
                 const std::uint32_t la = label[i];
+                const auto a = static_cast<std::uint32_t>(i);
                 const auto row = neighbors.neighbors(i).first(columns);
-                std::uint32_t* costs = cost_bits.get() + i * columns;
+                std::uint8_t* bits = live.get() + i * row_bytes;
                 std::uint64_t own = no_key; // the row's cheapest edge out of la
                 bool leaves = false;
                 for (std::size_t c = 0; c < columns; ++c)
                 {
-                    if (costs[c] == not_an_edge)
+                    const auto bit = static_cast<std::uint8_t>(1U << (c % 8));
+                    if ((bits[c / 8] & bit) == 0)
                         continue;
                     const std::uint32_t lb = label[row[c]];
                     if (lb == la)
                     {
-                        costs[c] = not_an_edge; // inside a component from now on
+                        bits[c / 8] &= static_cast<std::uint8_t>(~bit); // inside from now on
                         continue;
                     }
                     leaves = true;
-                    const std::uint64_t key = key_of(costs[c], i * columns + c);
+                    const std::uint64_t key = key_of(cost_of(a, row[c]), i * columns + c);
                     own = std::min(own, key);
                     lower(cheapest[lb], key);
                 }
@@ -710,7 +731,7 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
         });
         alive.swap(next);
     }
-    cost_bits.reset();
+    live.reset();
     std::vector<std::uint32_t>().swap(up);
     std::vector<std::uint32_t>().swap(alive);
     std::vector<std::uint64_t>().swap(cheapest);
@@ -991,7 +1012,7 @@ void vote_normals(std::span<const Vec3f> positions, const KnnTable& neighbors, c
                     continue;
                 const float along = normals[j].dot(normals[i]);
                 support += j != a && along * along > supporting_cos2 ? 1U : 0U;
-                const float weight = guide.confidence[j];
+                const float weight = guide.confidence(j);
                 tensor.noalias() += weight * normals[j] * normals[j].transpose();
                 sum += weight * normals[j];
                 if (weight > heaviest)
