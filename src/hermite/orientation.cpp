@@ -20,11 +20,14 @@
 #include <memory>
 #include <numbers>
 #include <numeric>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
 namespace pointform {
 namespace {
+
+using detail::Guide;
 
 /// The flux test overrides the seed's +z only when |flux| exceeds this fraction of
 /// Σ a_i |p_i − c|. A closed convex surface scores 1, closed non-convex shapes (bunny, torus)
@@ -133,63 +136,6 @@ constexpr float off_sheet_deviations = 3.0F;
 /// farthest neighbour: on a clean, flat part of a noisy cloud the deviations are about zero, and
 /// rounding would decide.
 constexpr float min_height_limit = 0.05F;
-
-/// Guide normals (guide_normals()) and, for each sample, the band of heights along its guide that
-/// its own sheet fills (mark_sheets()).
-struct Guide
-{
-    /// One a sample; empty for a clean cloud.
-    std::vector<Vec3f> normals;
-    /// The median height of each sample's neighbours along its guide, relative to the sample.
-    std::vector<float> centre;
-    /// How far from `centre` a point may lie and still be on the sample's sheet.
-    std::vector<float> reach;
-    /// The flatness (flatness()) of the neighbourhood the guide was taken from: 0 on a plane.
-    std::vector<float> flatness;
-
-    /// How well a plane fits sample i's neighbourhood: (1 - flatness)², 0 for an isotropic blob.
-    [[nodiscard]] float confidence(std::size_t i) const
-    {
-        const float fit = std::max(0.0F, 1.0F - flatness[i]);
-        return fit * fit;
-    }
-
-    /// Whether `to` lies off the band of `from`'s sheet (false without guides).
-    [[nodiscard]] bool off_sheet(std::span<const Vec3f> positions, std::uint32_t from,
-                                 std::uint32_t to) const
-    {
-        if (reach.empty())
-            return false;
-        const float height = (positions[to] - positions[from]).dot(normals[from]);
-        return std::abs(height - centre[from]) > reach[from];
-    }
-    /// Whether the edge a–b of the neighbour table jumps between sheets: b is one of a's
-    /// neighbours and lies off a's sheet, or the other way round. Such edges would pass the
-    /// orientation of one face of a thin plate to the opposite face unchanged, since their guides
-    /// are parallel.
-    [[nodiscard]] bool jumps(std::span<const Vec3f> positions, const KnnTable& table,
-                             std::uint32_t a, std::uint32_t b) const
-    {
-        // The row is searched only where off the band, which is rare.
-        const auto off = [&](std::uint32_t from, std::uint32_t to) {
-            return off_sheet(positions, from, to) && entry(table, from, to) != no_entry;
-        };
-        return off(a, b) || off(b, a);
-    }
-
-private:
-    static constexpr std::size_t no_entry = ~std::size_t{0};
-    /// The table entry (row-major) of `to` in `from`'s row, or no_entry.
-    [[nodiscard]] static std::size_t entry(const KnnTable& table, std::uint32_t from,
-                                           std::uint32_t to)
-    {
-        const auto row = table.neighbors(from);
-        for (std::size_t c = 0; c < row.size(); ++c)
-            if (row[c] == to)
-                return from * table.k + c;
-        return no_entry;
-    }
-};
 
 /// A neighbourhood's centroid and covariance (upper triangle: xx xy xz yy yz zz), in float: the
 /// guide needs a direction, not digits.
@@ -374,10 +320,10 @@ float median_flatness(const std::vector<Moments>& moments)
 /// clean, curved or thin-walled parts. The moments of the union (with multiplicity) of the
 /// neighbourhoods of i's neighbours follow from theirs: mean of the centroids, and mean
 /// covariance plus the covariance of the centroids; so each ring costs one pass over the table.
-/// Empty when the cloud is clean (noisy_flatness). Zero where `normals` is. With the guides, the
-/// band of each sample's sheet (mark_sheets()).
-Guide guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
-                    const KnnTable& neighbors, std::size_t rings, std::size_t most_rings)
+/// Empty when the cloud is clean (noisy_flatness). The normals go into `scratch` when it has a
+/// slot for every sample. Needs no fine normals: finish_guide() brings them in.
+Guide guide_normals(std::span<const Vec3f> positions, const KnnTable& neighbors, std::size_t rings,
+                    std::size_t most_rings, std::span<Vec3f> scratch)
 {
     const std::size_t n = positions.size();
     // Sums of d and d dᵀ about `shift`, turned into a centroid and covariance.
@@ -439,7 +385,15 @@ Guide guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> nor
     // The flattest scale's flatness and least axis so far (the axis taken when the scale is, not
     // its covariance kept: half the memory).
     std::vector<Moments> current(n);
-    std::vector<Vec3f> best_axis(n);
+    Guide result;
+    if (scratch.size() >= n)
+        result.normals = scratch.first(n);
+    else
+    {
+        result.storage.resize(n);
+        result.normals = result.storage;
+    }
+    const std::span<Vec3f> best_axis = result.normals;
     std::vector<float> best_flatness(n);
     const auto take_if_flatter = [&](std::size_t i, const std::array<float, 6>& covariance) {
         const Eigen::Matrix3f m = normalized_matrix(covariance);
@@ -491,10 +445,20 @@ Guide guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> nor
     }
     std::vector<Moments>().swap(current);
     std::vector<Moments>().swap(next);
-    Guide result;
-    result.normals.swap(best_axis);
     result.flatness.swap(best_flatness);
-    parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+    return result;
+}
+
+/// The guide's normals where they are no use: zero where the sample's own normal is, the own
+/// normal where no scale gave a plane. Then the band of each sample's sheet (mark_sheets()).
+void finish_guide(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
+                  const KnnTable& neighbors, Guide& result)
+{
+    if (result.normals.empty())
+        return;
+    if (result.normals.size() != positions.size() || result.flatness.size() != positions.size())
+        throw std::logic_error("orientation: a guide of another cloud");
+    parallel_blocks(positions.size(), 4096, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
         {
             Vec3f& axis = result.normals[i];
@@ -505,7 +469,6 @@ Guide guide_normals(std::span<const Vec3f> positions, std::span<const Vec3f> nor
         }
     });
     mark_sheets(positions, neighbors, result);
-    return result;
 }
 
 std::size_t count_flipped(std::span<const Vec3f> before, std::span<const Vec3f> after)
@@ -534,8 +497,6 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
     if (n >= RiemannianForest::none)
         throw InvalidInput("orientation: too many points for 32-bit indices");
     RiemannianForest forest;
-    forest.parent.assign(n, RiemannianForest::none);
-    forest.component.assign(n, RiemannianForest::none);
     if (n == 0)
         return forest;
     ProgressReporter progress(options.progress, "orientation");
@@ -750,13 +711,14 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
     for (const std::uint64_t key : tree_keys)
         forest.total_cost +=
             static_cast<double>(std::bit_cast<float>(static_cast<std::uint32_t>(key >> 33)));
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> tree_edges(tree_keys.size());
+    //    The edges' ends are looked up again from their keys where needed, and `degree` serves
+    //    as the scatter's cursors too (then shifted back): the forest's peak memory is its
+    //    adjacency being built, 8 bytes a sample fewer so.
     std::vector<std::uint32_t> degree(n + 1, 0);
     parallel_blocks(tree_keys.size(), block, [&](std::size_t begin, std::size_t end) {
         for (std::size_t e = begin; e < end; ++e)
         {
-            tree_edges[e] = ends_of(tree_keys[e]);
-            const auto [a, b] = tree_edges[e];
+            const auto [a, b] = ends_of(tree_keys[e]);
             std::atomic_ref<std::uint32_t>(degree[a + 1]).fetch_add(1, std::memory_order_relaxed);
             std::atomic_ref<std::uint32_t>(degree[b + 1]).fetch_add(1, std::memory_order_relaxed);
         }
@@ -766,20 +728,19 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
     std::vector<std::uint32_t> adjacent(degree[n]);
     {
         auto adjacent_keys = std::make_unique_for_overwrite<std::uint64_t[]>(degree[n]);
-        {
-            std::vector<std::uint32_t> fill(degree.begin(), degree.end() - 1);
-            parallel_blocks(tree_keys.size(), block, [&](std::size_t begin, std::size_t end) {
-                for (std::size_t e = begin; e < end; ++e)
-                {
-                    const auto [a, b] = tree_edges[e];
-                    for (const std::uint32_t v : {a, b})
-                        adjacent_keys[std::atomic_ref<std::uint32_t>(fill[v]).fetch_add(
-                            1, std::memory_order_relaxed)] = tree_keys[e];
-                }
-            });
-        }
+        //    Each sample's cursor starts at its first slot and ends at the next sample's.
+        parallel_blocks(tree_keys.size(), block, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t e = begin; e < end; ++e)
+            {
+                const auto [a, b] = ends_of(tree_keys[e]);
+                for (const std::uint32_t v : {a, b})
+                    adjacent_keys[std::atomic_ref<std::uint32_t>(degree[v]).fetch_add(
+                        1, std::memory_order_relaxed)] = tree_keys[e];
+            }
+        });
+        std::move_backward(degree.begin(), degree.end() - 2, degree.end() - 1);
+        degree[0] = 0;
         std::vector<std::uint64_t>().swap(tree_keys);
-        std::vector<std::pair<std::uint32_t, std::uint32_t>>().swap(tree_edges);
         parallel_blocks(n, block, [&](std::size_t begin, std::size_t end) {
             for (std::size_t v = begin; v < end; ++v)
             {
@@ -796,6 +757,8 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
     }
 
     // 3. Components numbered by smallest sample; root = highest sample with a usable normal.
+    forest.parent.assign(n, RiemannianForest::none);
+    forest.component.assign(n, RiemannianForest::none);
     std::vector<std::uint32_t> label_of_set(n, RiemannianForest::none);
     for (std::size_t i = 0; i < n; ++i)
     {
@@ -1155,28 +1118,30 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
                              std::vector<Vec3f>& normals)
 {
     const std::size_t n = positions.size();
-    const std::vector<std::uint8_t> band = crease_band(positions, neighbors, guide, columns);
-    if (band.empty())
-        return;
     constexpr std::uint32_t none = 0xFFFFFFFFU;
-    const auto in_region = [&](std::size_t i) {
-        return band[i] == 0 && usable(normals[i]);
-    };
-    // 1. Regions: the samples outside the band joined by reliable steps on one sheet.
-    DisjointSets sets(n);
-    for (std::size_t i = 0; i < n; ++i)
-    {
-        if (!in_region(i))
-            continue;
-        for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
-            if (j != i && in_region(j) &&
-                std::abs(guide.normals[i].dot(guide.normals[j])) >= reliable &&
-                !guide.jumps(positions, neighbors, static_cast<std::uint32_t>(i), j))
-                sets.unite(i, j);
-    }
-    std::vector<std::uint32_t> region(n, none);
+    // 1. Regions: the samples outside the band joined by reliable steps on one sheet (the band
+    //    and the sets go once the regions are numbered: step 4 is the peak of memory).
+    std::vector<std::uint32_t> region;
     std::vector<std::uint32_t> size;
     {
+        const std::vector<std::uint8_t> band = crease_band(positions, neighbors, guide, columns);
+        if (band.empty())
+            return;
+        region.assign(n, none);
+        const auto in_region = [&](std::size_t i) {
+            return band[i] == 0 && usable(normals[i]);
+        };
+        DisjointSets sets(n);
+        for (std::size_t i = 0; i < n; ++i)
+        {
+            if (!in_region(i))
+                continue;
+            for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                if (j != i && in_region(j) &&
+                    std::abs(guide.normals[i].dot(guide.normals[j])) >= reliable &&
+                    !guide.jumps(positions, neighbors, static_cast<std::uint32_t>(i), j))
+                    sets.unite(i, j);
+        }
         std::vector<std::uint32_t> id(n, none);
         for (std::size_t i = 0; i < n; ++i)
         {
@@ -1605,6 +1570,9 @@ OrientedNormals orient_graph(std::span<const Vec3f> positions, std::span<const V
         });
     }
     std::vector<Vec3f>().swap(snapshot);
+    std::vector<std::uint8_t>().swap(changed);
+    std::vector<std::uint8_t>().swap(changed_before);
+    std::vector<std::uint32_t>().swap(patch);
 
     //    The oriented guides are the output where the sample has a normal of its own, after a
     //    vote of their neighbours on the same sheet (vote_normals()).
@@ -2323,13 +2291,29 @@ OrientedNormals detail::orient_checked_table(std::span<const Vec3f> positions,
                                              const OrientationOptions& options)
 {
     check_sizes(positions, fine_normals, neighbors);
+    return orient_with_guide(positions, fine_normals, neighbors, options,
+                             grow_guide(positions, neighbors, options));
+}
+
+Guide detail::grow_guide(std::span<const Vec3f> positions, const KnnTable& neighbors,
+                         const OrientationOptions& options, std::span<Vec3f> scratch)
+{
     // On noisy clouds, orientation follows normals at a coarser scale and hands their signs to
     // the samples' own normals at the end. Edges that jump between sheets (Guide::jumps()) pass
     // no orientation.
-    Guide guide;
-    if (options.rule == OrientationRule::Hoppe && options.guide_rings > 0 && !positions.empty())
-        guide = guide_normals(positions, fine_normals, neighbors, options.guide_rings,
-                              options.guide_most_rings);
+    if (options.rule != OrientationRule::Hoppe || options.guide_rings == 0 || positions.empty())
+        return {};
+    return guide_normals(positions, neighbors, options.guide_rings, options.guide_most_rings,
+                         scratch);
+}
+
+OrientedNormals detail::orient_with_guide(std::span<const Vec3f> positions,
+                                          std::span<const Vec3f> fine_normals,
+                                          const KnnTable& neighbors,
+                                          const OrientationOptions& options, Guide guide)
+{
+    check_sizes(positions, fine_normals, neighbors);
+    finish_guide(positions, fine_normals, neighbors, guide);
     if (options.patches && options.rule == OrientationRule::Hoppe && guide.normals.empty() &&
         positions.size() >= min_patched)
         return orient_by_patches(positions, fine_normals, neighbors, options);

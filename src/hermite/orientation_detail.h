@@ -5,7 +5,91 @@
 
 #include "pointform/hermite/orientation.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
 namespace pointform::detail {
+
+/// Guide normals (grow_guide()) and, for each sample, the band of heights along its guide that
+/// its own sheet fills (set by orient_with_guide()). Moves, never copies: `normals` views either
+/// `storage` or an array a caller lent to grow_guide().
+struct Guide
+{
+    Guide() = default;
+    Guide(Guide&&) noexcept = default;
+    Guide& operator=(Guide&&) noexcept = default;
+    Guide(const Guide&) = delete;
+    Guide& operator=(const Guide&) = delete;
+    ~Guide() = default;
+
+    /// One a sample; empty for a clean cloud.
+    std::span<Vec3f> normals;
+    /// The normals' array, unless a caller lent one.
+    std::vector<Vec3f> storage;
+    /// The median height of each sample's neighbours along its guide, relative to the sample.
+    std::vector<float> centre;
+    /// How far from `centre` a point may lie and still be on the sample's sheet.
+    std::vector<float> reach;
+    /// The flatness (flatness() in orientation.cpp) of the neighbourhood the guide was taken from:
+    /// 0 on a plane.
+    std::vector<float> flatness;
+
+    /// How well a plane fits sample i's neighbourhood: (1 - flatness)², 0 for an isotropic blob.
+    [[nodiscard]] float confidence(std::size_t i) const
+    {
+        const float fit = std::max(0.0F, 1.0F - flatness[i]);
+        return fit * fit;
+    }
+
+    /// Whether `to` lies off the band of `from`'s sheet (false without guides).
+    [[nodiscard]] bool off_sheet(std::span<const Vec3f> positions, std::uint32_t from,
+                                 std::uint32_t to) const
+    {
+        if (reach.empty())
+            return false;
+        const float height = (positions[to] - positions[from]).dot(normals[from]);
+        return std::abs(height - centre[from]) > reach[from];
+    }
+    /// Whether the edge a–b of the neighbour table jumps between sheets: b is one of a's
+    /// neighbours and lies off a's sheet, or the other way round. Such edges would pass the
+    /// orientation of one face of a thin plate to the opposite face unchanged, since their guides
+    /// are parallel.
+    [[nodiscard]] bool jumps(std::span<const Vec3f> positions, const KnnTable& table,
+                             std::uint32_t a, std::uint32_t b) const
+    {
+        // The row is searched only where off the band, which is rare.
+        const auto off = [&](std::uint32_t from, std::uint32_t to) {
+            return off_sheet(positions, from, to) && entry(table, from, to) != no_entry;
+        };
+        return off(a, b) || off(b, a);
+    }
+
+private:
+    static constexpr std::size_t no_entry = ~std::size_t{0};
+    /// The table entry (row-major) of `to` in `from`'s row, or no_entry.
+    [[nodiscard]] static std::size_t entry(const KnnTable& table, std::uint32_t from,
+                                           std::uint32_t to)
+    {
+        const auto row = table.neighbors(from);
+        for (std::size_t c = 0; c < row.size(); ++c)
+            if (row[c] == to)
+                return from * table.k + c;
+        return no_entry;
+    }
+};
+
+/// The guide's normals of a noisy cloud (the first step of orient_normals_mst() under the Hoppe
+/// rule), from the positions and the neighbour table alone: so a caller can grow them before it
+/// has the fine normals, and the two never take memory at once. Empty for a clean cloud, or when
+/// `options` asks for no guide. The normals are written into `scratch` when it has a slot for
+/// every sample (its contents are overwritten and it must outlive the guide), else into the
+/// guide's own storage.
+[[nodiscard]] Guide grow_guide(std::span<const Vec3f> positions, const KnnTable& neighbors,
+                               const OrientationOptions& options, std::span<Vec3f> scratch = {});
 
 /// orient_normals_mst() of a neighbour table already checked against the positions (every row
 /// whole, every index below their count), as compute_surfels() has it: knn_batch() made it and
@@ -15,5 +99,12 @@ namespace pointform::detail {
                                                    std::span<const Vec3f> fine_normals,
                                                    const KnnTable& neighbors,
                                                    const OrientationOptions& options);
+
+/// orient_checked_table() along a guide that grow_guide() made from the same positions, table
+/// and options (the same result).
+[[nodiscard]] OrientedNormals orient_with_guide(std::span<const Vec3f> positions,
+                                                std::span<const Vec3f> fine_normals,
+                                                const KnnTable& neighbors,
+                                                const OrientationOptions& options, Guide guide);
 
 } // namespace pointform::detail

@@ -38,11 +38,18 @@ class StageTimer
 public:
     explicit StageTimer(std::vector<std::pair<std::string, double>>& log) : log_(log) {}
 
-    void lap(const std::string& stage)
+    /// Logs the time since the last lap (plus `earlier`, taken from this stage's other parts).
+    void lap(const std::string& stage, double earlier = 0.0)
+    {
+        log_.emplace_back(stage, take() + earlier);
+    }
+    /// The time since the last lap, not logged.
+    double take()
     {
         const auto now = std::chrono::steady_clock::now();
-        log_.emplace_back(stage, std::chrono::duration<double>(now - last_).count());
+        const double seconds = std::chrono::duration<double>(now - last_).count();
         last_ = now;
+        return seconds;
     }
 
 private:
@@ -180,6 +187,64 @@ void check_surfel_input(const PointCloudView& cloud, std::size_t k)
 
 namespace {
 
+/// The position array of the cloud that compute_surfels() was given to own, lent to the work
+/// while `sorted` holds the same points in Morton order (sorted[j] is the owner's point order[j]):
+/// the guide's normals are written into it, so that the points are not held twice during the
+/// orientation's peak. Given back in the owner's order, the points exactly as they were, when the
+/// work is done or when anything throws (no allocation: the owner's cloud is unchanged).
+class LentPositions
+{
+public:
+    LentPositions(PointCloud* owner, const std::vector<Vec3f>& sorted,
+                  const std::vector<std::uint32_t>& order)
+        : owner_(owner), sorted_(sorted), order_(order)
+    {
+        if (owner_ != nullptr)
+            buffer_ = std::move(owner_->positions);
+    }
+    LentPositions(const LentPositions&) = delete;
+    LentPositions& operator=(const LentPositions&) = delete;
+    LentPositions(LentPositions&&) = delete;
+    LentPositions& operator=(LentPositions&&) = delete;
+    ~LentPositions()
+    {
+        if (owner_ != nullptr)
+            put_back(sorted_.size());
+    }
+
+    /// A slot for every sample, or none when nothing was lent.
+    [[nodiscard]] std::span<Vec3f> scratch() { return buffer_; }
+
+    /// Puts the points back in the owner's order (in parallel) and returns the array to it.
+    void give_back()
+    {
+        if (owner_ == nullptr)
+            return;
+        parallel_blocks(sorted_.size(), gather_block,
+                        [&](std::size_t begin, std::size_t end) { scatter(begin, end); });
+        put_back(0);
+    }
+
+private:
+    // Points [begin, end) of `sorted` go back to their places; the rest were put back already.
+    void scatter(std::size_t begin, std::size_t end) noexcept
+    {
+        for (std::size_t j = begin; j < end; ++j)
+            buffer_[order_[j]] = sorted_[j];
+    }
+    void put_back(std::size_t unscattered) noexcept
+    {
+        scatter(0, unscattered);
+        owner_->positions = std::move(buffer_);
+        owner_ = nullptr;
+    }
+
+    PointCloud* owner_;
+    const std::vector<Vec3f>& sorted_;
+    const std::vector<std::uint32_t>& order_;
+    std::vector<Vec3f> buffer_;
+};
+
 /// compute_surfels() of `cloud`; when `owner` is given (the cloud that `cloud` views, no longer
 /// needed by the caller), its positions and colours are moved into the result, not copied.
 SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& options,
@@ -235,6 +300,7 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
             result.copies.push_back(c.copy);
     }
     timer.lap("spatial sort");
+    LentPositions lent(owner, sorted, order);
     const std::span<const Vec3f> positions =
         place.empty() ? std::span<const Vec3f>(sorted) : std::span<const Vec3f>(distinct);
 
@@ -248,6 +314,17 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
                           {.farthest_distance_only = true, .progress = options.progress});
     }
     timer.lap("knn");
+    // The orientation's guide (noisy clouds) before the fine normals, so that the two never take
+    // memory at once; its normals go into the lent array.
+    const bool by_graph = options.orient == OrientMode::Mst || options.orient == OrientMode::Flip;
+    const OrientationOptions graph_options{
+        .k = options.graph_k == 0 ? std::min<std::size_t>(options.k, 10) : options.graph_k,
+        .rule = options.rule,
+        .progress = options.progress};
+    detail::Guide guide;
+    if (by_graph)
+        guide = detail::grow_guide(positions, table, graph_options, lent.scratch());
+    const double guide_seconds = timer.take();
     Normals normals = estimate_normals(positions, table, options.progress);
     result.degenerate = normals.degenerate.size();
     timer.lap("normals");
@@ -258,12 +335,9 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
         case OrientMode::Mst:
         case OrientMode::Flip:
         {
-            const std::size_t graph_k =
-                options.graph_k == 0 ? std::min<std::size_t>(options.k, 10) : options.graph_k;
             // estimate_normals() checked every row of the table.
-            oriented = detail::orient_checked_table(
-                positions, normals.normals, table,
-                {.k = graph_k, .rule = options.rule, .progress = options.progress});
+            oriented = detail::orient_with_guide(positions, normals.normals, table, graph_options,
+                                                 std::move(guide));
             if (options.orient == OrientMode::Flip)
             {
                 OrientedNormals flipped = flip_normals(oriented.normals);
@@ -283,7 +357,7 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
             oriented = orient_normals_along(normals.normals, options.orient_target);
             break;
     }
-    timer.lap("orientation");
+    timer.lap("orientation", guide_seconds);
 
     std::vector<float> radii = influence_radii(table, options.radius_scale);
     radii = apply_radius_regions(positions, cloud.origin, std::move(radii), options.radius_regions);
@@ -327,6 +401,7 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
     result.surfels.radii.resize(n);
     //    Nothing throws from here on, so the owner's cloud is unchanged if anything did.
     const bool moved = owner != nullptr;
+    lent.give_back();
     if (moved)
     {
         result.surfels.positions = std::move(owner->positions);

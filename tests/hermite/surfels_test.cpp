@@ -133,6 +133,39 @@ TEST(ComputeSurfels, CloudHandedOverGivesTheSameSurfels)
     EXPECT_EQ(few.size(), 10U); // NOLINT(bugprone-use-after-move): unchanged when it throws
 }
 
+// On a noisy cloud the orientation's guide normals are written into the handed cloud's position
+// array while the work holds the points in Morton order: the array comes back with the points
+// exactly as they were, both when the work is done and when it is cancelled after the guide grew.
+// Torus, 30,000 samples, noise twice the sampling step: a guided cloud (see
+// OrientNormalsMst.NoisyTorusNoiseTwiceTheSamplingStep).
+TEST(ComputeSurfels, NoisyCloudHandedOverComesBackWhole)
+{
+    const PointCloud cloud =
+        sample_shape(Shape::Torus, {.count = 30000, .seed = 9, .noise = 0.011});
+    const SurfelResult viewed = compute_surfels(cloud);
+    PointCloud handed = cloud;
+    const Vec3f* const positions = handed.positions.data();
+    const SurfelResult moved = compute_surfels(std::move(handed));
+    EXPECT_EQ(moved.surfels.positions, cloud.positions);
+    EXPECT_EQ(moved.surfels.positions.data(), positions);
+    EXPECT_EQ(moved.surfels.normals, viewed.surfels.normals);
+    EXPECT_EQ(moved.surfels.radii, viewed.surfels.radii);
+
+    PointCloud cancelled = cloud;
+    const Vec3f* const cancelled_positions = cancelled.positions.data();
+    bool asked = false;
+    const ProgressCallback stop = [&](std::string_view stage, double) {
+        asked = asked || stage == "orientation";
+        return stage != "orientation";
+    };
+    EXPECT_THROW((void)compute_surfels(std::move(cancelled), {.progress = stop}), Cancelled);
+    EXPECT_TRUE(asked);
+    // NOLINTBEGIN(bugprone-use-after-move): unchanged when it throws
+    EXPECT_EQ(cancelled.positions, cloud.positions);
+    EXPECT_EQ(cancelled.positions.data(), cancelled_positions);
+    // NOLINTEND(bugprone-use-after-move)
+}
+
 // One point very far away makes the whole cloud's covariance a line (its spread 1e28 against the
 // sphere's 1/3): the input check looks at the bulk then, and the sphere gets its normals. Points
 // on a line stay a line with a far point beside them. Beyond 1e18 float distances overflow: a
