@@ -5,6 +5,12 @@
 
 #include "pointform/core/error.h"
 
+#if defined(__linux__)
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
+
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <optional>
@@ -159,6 +165,24 @@ void check_memory(double need_bytes, const std::string& what, const std::string&
     std::snprintf(text, sizeof text, " would need about %.3g GiB, more than the %.3g GiB",
                   need_bytes / gib, have / gib);
     throw InvalidInput(what + text + " this process may use (" + limit.source + "); " + advice);
+}
+
+void advise_sparse(void* begin, std::size_t bytes) noexcept
+{
+#if defined(__linux__) && defined(MADV_NOHUGEPAGE)
+    const long page_size = sysconf(_SC_PAGESIZE);
+    if (page_size <= 0 || begin == nullptr)
+        return;
+    const auto page = static_cast<std::uintptr_t>(page_size);
+    const auto start = reinterpret_cast<std::uintptr_t>(begin);
+    const std::uintptr_t first = (start + page - 1) & ~(page - 1);
+    const std::uintptr_t last = (start + bytes) & ~(page - 1);
+    if (last > first)
+        (void)madvise(reinterpret_cast<void*>(first), last - first, MADV_NOHUGEPAGE);
+#else
+    (void)begin;
+    (void)bytes;
+#endif
 }
 
 } // namespace pointform

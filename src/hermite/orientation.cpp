@@ -382,8 +382,11 @@ Guide guide_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
         if (std::accumulate(flatter.begin(), flatter.end(), std::size_t{0}) > tested / 2)
             return {};
     }
-    // The flattest scale's flatness and least axis so far (the axis taken when the scale is, not
-    // its covariance kept: half the memory).
+    // The flattest scale's flatness and least axis so far (the axis taken from the moments, not
+    // their covariance kept: half the memory). The axis is taken once the next ring is no
+    // flatter, from the moments still at hand (or after the last ring): a sign bit on the
+    // flatness marks it owed. Most noisy samples get flatter ring after ring, and the axis was
+    // most of a ring's arithmetic when it was taken at each.
     std::vector<Moments> current(n);
     Guide result;
     if (scratch.size() >= n)
@@ -395,22 +398,27 @@ Guide guide_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
     }
     const std::span<Vec3f> best_axis = result.normals;
     std::vector<float> best_flatness(n);
-    const auto take_if_flatter = [&](std::size_t i, const std::array<float, 6>& covariance) {
-        const Eigen::Matrix3f m = normalized_matrix(covariance);
-        const Eigen::Matrix3f adj = adjugate(m);
-        const float f = flatness(m, adj);
-        if (f < best_flatness[i])
-        {
-            best_flatness[i] = f;
-            best_axis[i] = least_axis(adj);
-        }
+    const auto settle = [&](std::size_t i, const Moments& flattest) {
+        best_axis[i] = least_axis(adjugate(normalized_matrix(flattest.covariance)));
+        best_flatness[i] = -best_flatness[i];
+    };
+    // `latest` is sample i's newest ring, `before` the ring before it (none at the start).
+    const auto take_if_flatter = [&](std::size_t i, const Moments& latest, const Moments* before) {
+        const Eigen::Matrix3f m = normalized_matrix(latest.covariance);
+        const float f = flatness(m, adjugate(m));
+        float& best = best_flatness[i];
+        const bool owed = std::signbit(best);
+        if (f < std::abs(best))
+            best = -f;
+        else if (owed && before != nullptr)
+            settle(i, *before);
     };
     parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
         {
             current[i] = own_moments(i);
             best_flatness[i] = std::numeric_limits<float>::infinity();
-            take_if_flatter(i, current[i].covariance);
+            take_if_flatter(i, current[i], nullptr);
         }
     });
     most_rings = std::max(rings, most_rings);
@@ -436,13 +444,18 @@ Guide guide_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
                 for (std::size_t e = 0; e < 6; ++e)
                     outer[e] += within[e];
                 next[i] = finish(c, sum, outer, static_cast<float>(row.size()));
-                take_if_flatter(i, next[i].covariance);
+                take_if_flatter(i, next[i], &current[i]);
             }
         });
         current.swap(next);
         if (ring + 1 >= rings && median_flatness(current) <= guide_target_flatness)
             break;
     }
+    parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+            if (std::signbit(best_flatness[i]))
+                settle(i, current[i]);
+    });
     std::vector<Moments>().swap(current);
     std::vector<Moments>().swap(next);
     result.flatness.swap(best_flatness);

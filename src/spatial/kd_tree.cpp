@@ -4,6 +4,7 @@
 #include "pointform/spatial/kd_tree.h"
 
 #include "pointform/core/error.h"
+#include "pointform/core/memory.h"
 #include "pointform/core/parallel.h"
 #include "pointform/spatial/spatial_sort.h"
 
@@ -430,6 +431,7 @@ void KdTree::Impl::build_in_order(std::span<std::uint64_t> keys)
         top.push_back({.left = middle, .right = right});
     }
     nodes.reset(new Node[2 * n]); // NOLINT(cppcoreguidelines-owning-memory): not initialised
+    advise_sparse(nodes.get(), 2 * n * sizeof(Node)); // an eighth of it or so is used
     finish_tree(tree, top, subtrees, [&](Top& node) {
         Node* next = nodes.get() + 2 * node.left;
         node.node =

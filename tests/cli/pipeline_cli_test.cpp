@@ -3,8 +3,10 @@
 
 // The library's pipeline (polygonize/reconstruct.h) and the command line make the same thing:
 // `pointform reconstruct` and `pointform remesh` write, byte for byte, the mesh and hierarchy
-// that reconstruct() and remesh() return, and report the same figures.
+// that reconstruct() and remesh() return, and report the same figures; `pointform normals` the
+// surfels of compute_surfels().
 
+#include "pointform/geometry/shapes.h"
 #include "pointform/hermite/surfels.h"
 #include "pointform/io/hierarchy.h"
 #include "pointform/io/io.h"
@@ -84,6 +86,30 @@ TEST(PipelineCli, ReconstructWritesTheLibrarysMeshAndHierarchyByteForByte)
     EXPECT_EQ(json["intermediate_faces"].get<std::size_t>(), report.intermediate_faces);
     EXPECT_EQ(json["cell"].get<double>(), report.cell);
     EXPECT_EQ(json["stop"].get<std::string>(), to_string(report.semi_regular.refinement.stop));
+}
+
+// A noisy cloud, whose orientation grows guide normals in the handed cloud's position array,
+// through the executable's allocation (huge pages for its blocks of 4 MiB and more, as the
+// neighbour table of 80,000 samples is: large_pages.cpp) and through the test's.
+TEST(PipelineCli, NormalsWritesTheLibrarysSurfelsByteForByte)
+{
+    test::TempDir dir;
+    const auto input = dir / "noisy.ply";
+    PointCloud cloud = sample_shape(Shape::Torus, {.count = 80000, .seed = 9, .noise = 0.011});
+    cloud.normals.clear();
+    write_point_cloud(input, cloud);
+    const auto cli_surfels = dir / "cli.ply";
+    const auto r = run("normals " + quoted(input) + " -o " + quoted(cli_surfels) + " --json");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const auto json = nlohmann::json::parse(r.out);
+
+    const SurfelResult result = compute_surfels(read_point_cloud(input));
+    const auto lib_surfels = dir / "lib.ply";
+    write_point_cloud(lib_surfels, result.surfels);
+    EXPECT_EQ(bytes_of(cli_surfels), bytes_of(lib_surfels));
+    EXPECT_EQ(json["points"].get<std::size_t>(), result.surfels.size());
+    EXPECT_EQ(json["flipped"].get<std::size_t>(), result.orientation.flipped);
+    EXPECT_EQ(json["components"].get<std::size_t>(), result.orientation.components);
 }
 
 TEST(PipelineCli, RemeshWritesTheLibrarysMeshByteForByte)

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <vector>
 
 namespace pointform {
 namespace {
@@ -91,6 +92,20 @@ TEST(MemoryLimit, TheLiveSystemHasALimitAndCheckMemoryRefusesBeyondIt)
         EXPECT_NE(what.find(limit.source), std::string::npos) << what;
         EXPECT_NE(what.find("ask for less"), std::string::npos) << what;
     }
+}
+
+// A sparse array keeps what is written to it, and nothing (no array, no whole page) is no error.
+TEST(AdviseSparse, KeepsTheContentsAndTakesAnyRange)
+{
+    std::vector<std::uint32_t> pool(std::size_t{3} << 20U);
+    advise_sparse(pool.data(), pool.size() * sizeof(std::uint32_t));
+    for (std::size_t i = 0; i < pool.size(); i += 4099)
+        pool[i] = static_cast<std::uint32_t>(i);
+    for (std::size_t i = 0; i < pool.size(); ++i)
+        ASSERT_EQ(pool[i], i % 4099 == 0 ? i : 0U) << i;
+    advise_sparse(nullptr, 0);
+    advise_sparse(pool.data() + 1, 16);
+    EXPECT_EQ(pool[4099], 4099U);
 }
 
 } // namespace

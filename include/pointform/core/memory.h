@@ -3,6 +3,7 @@
 
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -49,5 +50,12 @@ struct MemoryLimitFiles
 /// \throw InvalidInput "<what> would need about N GiB, more than the M GiB this process may use
 ///        (<source>); <advice>"
 void check_memory(double need_bytes, const std::string& what, const std::string& advice);
+
+/// \brief Marks `bytes` from `begin` as an array whose pages are written sparsely (a pool sized for
+/// the worst case, most of it never used): the kernel keeps its small pages there, so that
+/// transparent huge pages (a system in `always` mode, or an executable asking for them for its
+/// large blocks) do not make the whole array resident. Call before anything is written. Does
+/// nothing where the system has no such advice.
+void advise_sparse(void* begin, std::size_t bytes) noexcept;
 
 } // namespace pointform
