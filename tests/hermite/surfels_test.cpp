@@ -151,6 +151,18 @@ TEST(ComputeSurfels, NoisyCloudHandedOverComesBackWhole)
     EXPECT_EQ(moved.surfels.normals, viewed.surfels.normals);
     EXPECT_EQ(moved.surfels.radii, viewed.surfels.radii);
 
+    // Repeated samples: the work holds fewer places than samples, the array still every sample.
+    PointCloud repeated = cloud;
+    repeated.normals.clear();
+    for (std::size_t i = 0; i < 500; ++i)
+        repeated.positions.push_back(cloud.positions[(i * 7919) % cloud.size()]);
+    const SurfelResult repeated_viewed = compute_surfels(repeated);
+    PointCloud repeated_handed = repeated;
+    const SurfelResult repeated_moved = compute_surfels(std::move(repeated_handed));
+    EXPECT_EQ(repeated_moved.copies.size(), 500U);
+    EXPECT_EQ(repeated_moved.surfels.positions, repeated.positions);
+    EXPECT_EQ(repeated_moved.surfels.normals, repeated_viewed.surfels.normals);
+
     PointCloud cancelled = cloud;
     const Vec3f* const cancelled_positions = cancelled.positions.data();
     bool asked = false;
