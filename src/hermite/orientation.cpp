@@ -1205,6 +1205,22 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
     std::vector<double> share(queries.size() * count, 0.0);
     const double area_scale =
         std::numbers::pi * static_cast<double>(stride) / static_cast<double>(neighbors.k);
+    //    Each source's point, normal, area factor and region gathered once, in order: every
+    //    query reads them all.
+    struct Source
+    {
+        Vec3f p;
+        Vec3f n;
+        double area;
+        std::int32_t tried;
+    };
+    std::vector<Source> gathered(sources.size());
+    for (std::size_t s = 0; s < sources.size(); ++s)
+    {
+        const std::uint32_t j = sources[s];
+        gathered[s] = {positions[j], normals[j],
+                       area_scale * static_cast<double>(neighbors.farthest2(j)), tried_index(j)};
+    }
     parallel_blocks(queries.size(), 64, [&](std::size_t begin, std::size_t end) {
         for (std::size_t qi = begin; qi < end; ++qi)
         {
@@ -1212,19 +1228,18 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
             const float excluded2 = winding_exclusion * winding_exclusion *
                                     neighbors.farthest2(queries[qi]) * static_cast<float>(stride);
             double sum = 0.0;
-            for (const std::uint32_t j : sources)
+            for (const Source& source : gathered)
             {
-                const Vec3f d = positions[j] - q;
+                const Vec3f d = source.p - q;
                 const float d2 = d.squaredNorm();
                 if (d2 <= excluded2)
                     continue;
                 const auto dd = static_cast<double>(d2);
-                const double term = area_scale * static_cast<double>(neighbors.farthest2(j)) *
-                                    static_cast<double>(normals[j].dot(d)) /
+                const double term = source.area * static_cast<double>(source.n.dot(d)) /
                                     (4.0 * std::numbers::pi * dd * std::sqrt(dd));
                 sum += term;
-                if (const std::int32_t t = tried_index(j); t >= 0)
-                    share[qi * count + static_cast<std::size_t>(t)] += term;
+                if (source.tried >= 0)
+                    share[qi * count + static_cast<std::size_t>(source.tried)] += term;
             }
             total[qi] = sum;
         }
