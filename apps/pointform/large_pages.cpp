@@ -2,7 +2,7 @@
 // Copyright (c) 2026 the pointform authors
 
 // The executable's operator new: malloc, as the default one, plus a request for transparent huge
-// pages (madvise(MADV_HUGEPAGE)) over every whole 2 MiB page of a large block. The large arrays
+// pages over every whole 2 MiB page of a large block (pointform::advise_dense()). The large arrays
 // of a run (neighbour tables, the guide's moments, grids, level buffers) are written once page by
 // page soon after they are made, so with 4 KiB pages a good share of a run is the kernel's page
 // faults. Commands ask for it (ask_for_huge_pages()) where that pays: `normals` (1M samples of a
@@ -17,6 +17,8 @@
 // against its deallocation.
 
 #include "large_pages.h"
+
+#include "pointform/core/memory.h"
 
 #include <atomic>
 
@@ -39,16 +41,12 @@ void pointform::cli::ask_for_huge_pages()
 
 #if !defined(PF_KEEP_OPERATOR_NEW) && defined(__linux__)
 
-#include <sys/mman.h>
-
 #include <cstddef>
-#include <cstdint>
 #include <cstdlib>
 #include <new>
 
 namespace {
 
-constexpr std::uintptr_t huge_page = std::uintptr_t{2} << 20U;
 constexpr std::size_t large_block = std::size_t{4} << 20U;
 
 void* allocate(std::size_t size)
@@ -58,13 +56,7 @@ void* allocate(std::size_t size)
         if (void* block = std::malloc(size == 0 ? 1 : size))
         {
             if (size >= large_block && huge_pages_asked.load(std::memory_order_relaxed))
-            {
-                const auto start = reinterpret_cast<std::uintptr_t>(block);
-                const std::uintptr_t first = (start + huge_page - 1) & ~(huge_page - 1);
-                const std::uintptr_t last = (start + size) & ~(huge_page - 1);
-                if (last > first)
-                    (void)madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
-            }
+                pointform::advise_dense(block, size);
             return block;
         }
         // As the default operator new: the new-handler may free memory, else bad_alloc.

@@ -167,18 +167,41 @@ void check_memory(double need_bytes, const std::string& what, const std::string&
     throw InvalidInput(what + text + " this process may use (" + limit.source + "); " + advice);
 }
 
+namespace {
+
+/// madvise(advice) over the whole pages of `alignment` bytes within [begin, begin + bytes).
+void advise_whole_pages([[maybe_unused]] void* begin, [[maybe_unused]] std::size_t bytes,
+                        [[maybe_unused]] std::uintptr_t alignment, [[maybe_unused]] int advice)
+{
+#if defined(__linux__)
+    if (begin == nullptr || alignment == 0)
+        return;
+    const auto start = reinterpret_cast<std::uintptr_t>(begin);
+    const std::uintptr_t first = (start + alignment - 1) & ~(alignment - 1);
+    const std::uintptr_t last = (start + bytes) & ~(alignment - 1);
+    if (last > first)
+        (void)madvise(reinterpret_cast<void*>(first), last - first, advice);
+#endif
+}
+
+} // namespace
+
 void advise_sparse(void* begin, std::size_t bytes) noexcept
 {
 #if defined(__linux__) && defined(MADV_NOHUGEPAGE)
     const long page_size = sysconf(_SC_PAGESIZE);
-    if (page_size <= 0 || begin == nullptr)
-        return;
-    const auto page = static_cast<std::uintptr_t>(page_size);
-    const auto start = reinterpret_cast<std::uintptr_t>(begin);
-    const std::uintptr_t first = (start + page - 1) & ~(page - 1);
-    const std::uintptr_t last = (start + bytes) & ~(page - 1);
-    if (last > first)
-        (void)madvise(reinterpret_cast<void*>(first), last - first, MADV_NOHUGEPAGE);
+    if (page_size > 0)
+        advise_whole_pages(begin, bytes, static_cast<std::uintptr_t>(page_size), MADV_NOHUGEPAGE);
+#else
+    (void)begin;
+    (void)bytes;
+#endif
+}
+
+void advise_dense(void* begin, std::size_t bytes) noexcept
+{
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    advise_whole_pages(begin, bytes, std::uintptr_t{2} << 20U, MADV_HUGEPAGE);
 #else
     (void)begin;
     (void)bytes;

@@ -94,18 +94,22 @@ TEST(MemoryLimit, TheLiveSystemHasALimitAndCheckMemoryRefusesBeyondIt)
     }
 }
 
-// A sparse array keeps what is written to it, and nothing (no array, no whole page) is no error.
+// An array advised sparse or dense keeps what is written to it, and nothing (no array, no whole
+// page) is no error.
 TEST(AdviseSparse, KeepsTheContentsAndTakesAnyRange)
 {
-    std::vector<std::uint32_t> pool(std::size_t{3} << 20U);
-    advise_sparse(pool.data(), pool.size() * sizeof(std::uint32_t));
-    for (std::size_t i = 0; i < pool.size(); i += 4099)
-        pool[i] = static_cast<std::uint32_t>(i);
-    for (std::size_t i = 0; i < pool.size(); ++i)
-        ASSERT_EQ(pool[i], i % 4099 == 0 ? i : 0U) << i;
-    advise_sparse(nullptr, 0);
-    advise_sparse(pool.data() + 1, 16);
-    EXPECT_EQ(pool[4099], 4099U);
+    for (const auto advise : {&advise_sparse, &advise_dense})
+    {
+        std::vector<std::uint32_t> pool(std::size_t{3} << 20U);
+        advise(pool.data(), pool.size() * sizeof(std::uint32_t));
+        for (std::size_t i = 0; i < pool.size(); i += 4099)
+            pool[i] = static_cast<std::uint32_t>(i);
+        for (std::size_t i = 0; i < pool.size(); ++i)
+            ASSERT_EQ(pool[i], i % 4099 == 0 ? i : 0U) << i;
+        advise(nullptr, 0);
+        advise(pool.data() + 1, 16);
+        EXPECT_EQ(pool[4099], 4099U);
+    }
 }
 
 } // namespace

@@ -58,4 +58,10 @@ void check_memory(double need_bytes, const std::string& what, const std::string&
 /// nothing where the system has no such advice.
 void advise_sparse(void* begin, std::size_t bytes) noexcept;
 
+/// \brief The opposite of advise_sparse(): asks for transparent huge pages (2 MiB) over the whole
+/// huge pages within `bytes` from `begin`, an array about to be written densely (fewer page
+/// faults). Allocates nothing, so an allocation function may call it. Does nothing where the
+/// system has no such advice or grants no huge pages.
+void advise_dense(void* begin, std::size_t bytes) noexcept;
+
 } // namespace pointform
