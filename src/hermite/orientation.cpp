@@ -11,6 +11,10 @@
 
 #include <Eigen/Core>
 
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -1089,6 +1093,87 @@ std::vector<std::uint8_t> crease_band(std::span<const Vec3f> positions, const Kn
     return band;
 }
 
+/// The winding check's sums run in this many float lanes (turn_regions_by_winding()): each
+/// lane adds every winding_lanes-th term of a group, then the lanes are added in a fixed order,
+/// so a sum is the same bits with or without vector instructions and on any thread count.
+constexpr std::size_t winding_lanes = 8;
+
+/// The winding check's sources, as float columns in groups padded to whole lanes: positions
+/// relative to `origin` times `scale`, unit normals, and each source's area over 4π in the
+/// scaled units.
+struct WindingSources
+{
+    Vec3f origin = Vec3f::Zero();
+    float scale = 1.0F;
+    std::vector<float> x, y, z, nx, ny, nz, area;
+    /// Where each group starts, and the end.
+    std::vector<std::size_t> begin;
+
+    [[nodiscard]] std::size_t size() const { return x.size(); }
+    [[nodiscard]] Vec3f local(const Vec3f& p) const { return (p - origin) * scale; }
+    void push(const Vec3f& p, const Vec3f& n, float a)
+    {
+        x.push_back(p.x());
+        y.push_back(p.y());
+        z.push_back(p.z());
+        nx.push_back(n.x());
+        ny.push_back(n.y());
+        nz.push_back(n.z());
+        area.push_back(a);
+    }
+};
+
+/// Σ area · n·d / |d|³ (d from q to the source) over the sources [from, to) farther than
+/// sqrt(excluded2) from q, in winding_lanes lanes.
+double winding_group_sum(const WindingSources& s, std::size_t from, std::size_t to, const Vec3f& q,
+                         float excluded2)
+{
+    std::array<float, winding_lanes> lane{};
+#if defined(__SSE2__)
+    static_assert(winding_lanes == 8);
+    const __m128 qx = _mm_set1_ps(q.x());
+    const __m128 qy = _mm_set1_ps(q.y());
+    const __m128 qz = _mm_set1_ps(q.z());
+    const __m128 limit = _mm_set1_ps(excluded2);
+    __m128 sum[2] = {_mm_setzero_ps(), _mm_setzero_ps()};
+    for (std::size_t b = from; b < to; b += winding_lanes)
+        for (std::size_t h = 0; h < 2; ++h)
+        {
+            const std::size_t i = b + 4 * h;
+            const __m128 dx = _mm_sub_ps(_mm_loadu_ps(&s.x[i]), qx);
+            const __m128 dy = _mm_sub_ps(_mm_loadu_ps(&s.y[i]), qy);
+            const __m128 dz = _mm_sub_ps(_mm_loadu_ps(&s.z[i]), qz);
+            const __m128 d2 =
+                _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+            const __m128 flux = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_loadu_ps(&s.nx[i]), dx),
+                                                      _mm_mul_ps(_mm_loadu_ps(&s.ny[i]), dy)),
+                                           _mm_mul_ps(_mm_loadu_ps(&s.nz[i]), dz));
+            const __m128 term = _mm_div_ps(_mm_mul_ps(_mm_loadu_ps(&s.area[i]), flux),
+                                           _mm_mul_ps(d2, _mm_sqrt_ps(d2)));
+            sum[h] = _mm_add_ps(sum[h], _mm_and_ps(_mm_cmpgt_ps(d2, limit), term));
+        }
+    _mm_storeu_ps(lane.data(), sum[0]);
+    _mm_storeu_ps(lane.data() + 4, sum[1]);
+#else
+    for (std::size_t b = from; b < to; b += winding_lanes)
+        for (std::size_t l = 0; l < winding_lanes; ++l)
+        {
+            const std::size_t i = b + l;
+            const float dx = s.x[i] - q.x();
+            const float dy = s.y[i] - q.y();
+            const float dz = s.z[i] - q.z();
+            const float d2 = (dx * dx + dy * dy) + dz * dz;
+            const float flux = (s.nx[i] * dx + s.ny[i] * dy) + s.nz[i] * dz;
+            const float term = s.area[i] * flux / (d2 * std::sqrt(d2));
+            lane[l] += d2 > excluded2 ? term : 0.0F;
+        }
+#endif
+    double total = 0.0;
+    for (const float v : lane)
+        total += static_cast<double>(v);
+    return total;
+}
+
 /// The generalized winding number check of a guided orientation: regions that a crease band
 /// parts are turned over where that makes the winding number of the oriented samples about ½ on
 /// the samples themselves.
@@ -1203,43 +1288,62 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
         queries.push_back(sources[s]);
     std::vector<double> total(queries.size(), 0.0);
     std::vector<double> share(queries.size() * count, 0.0);
-    const double area_scale =
-        std::numbers::pi * static_cast<double>(stride) / static_cast<double>(neighbors.k);
-    //    Each source's point, normal, area factor and region gathered once, in order: every
-    //    query reads them all.
-    struct Source
+    //    The sources gathered once, grouped by the region tried they lie in (each group in
+    //    sample order, the untried last), in float lanes: every query sums each group in
+    //    winding_lanes lanes (winding_group_sum()). Positions are taken about the first source
+    //    and scaled by the largest extent, so that the terms (each dimensionless) neither
+    //    underflow nor overflow in float, whatever the cloud's units.
+    WindingSources gathered;
     {
-        Vec3f p;
-        Vec3f n;
-        double area;
-        std::int32_t tried;
-    };
-    std::vector<Source> gathered(sources.size());
-    for (std::size_t s = 0; s < sources.size(); ++s)
-    {
-        const std::uint32_t j = sources[s];
-        gathered[s] = {positions[j], normals[j],
-                       area_scale * static_cast<double>(neighbors.farthest2(j)), tried_index(j)};
+        Vec3f low = Vec3f::Constant(std::numeric_limits<float>::max());
+        Vec3f high = Vec3f::Constant(std::numeric_limits<float>::lowest());
+        for (const std::uint32_t j : sources)
+        {
+            low = low.cwiseMin(positions[j]);
+            high = high.cwiseMax(positions[j]);
+        }
+        gathered.origin = positions[sources.front()];
+        // Halved first: a span of the whole float range stays finite.
+        const float half_extent = (0.5F * high - 0.5F * low).maxCoeff();
+        gathered.scale = half_extent > 0.0F ? 0.5F / half_extent : 1.0F;
+        // A source stands for stride samples, each of area π r² (r its k-th neighbour's
+        // distance) over the k samples inside it; over 4π: stride r² / (4 k).
+        const double area_scale =
+            static_cast<double>(stride) / (4.0 * static_cast<double>(neighbors.k)) *
+            static_cast<double>(gathered.scale) * static_cast<double>(gathered.scale);
+        std::vector<std::vector<std::uint32_t>> group(count + 1);
+        for (const std::uint32_t j : sources)
+        {
+            const std::int32_t t = tried_index(j);
+            group[t < 0 ? count : static_cast<std::size_t>(t)].push_back(j);
+        }
+        for (std::size_t g = 0; g <= count; ++g)
+        {
+            gathered.begin.push_back(gathered.size());
+            for (const std::uint32_t j : group[g])
+                gathered.push(
+                    gathered.local(positions[j]), normals[j],
+                    static_cast<float>(area_scale * static_cast<double>(neighbors.farthest2(j))));
+            while (gathered.size() % winding_lanes != 0)
+                gathered.push(Vec3f::Zero(), Vec3f::Zero(), 0.0F); // masked or zero: adds 0
+        }
+        gathered.begin.push_back(gathered.size());
     }
     parallel_blocks(queries.size(), 64, [&](std::size_t begin, std::size_t end) {
         for (std::size_t qi = begin; qi < end; ++qi)
         {
-            const Vec3f& q = positions[queries[qi]];
+            const Vec3f q = gathered.local(positions[queries[qi]]);
             const float excluded2 = winding_exclusion * winding_exclusion *
-                                    neighbors.farthest2(queries[qi]) * static_cast<float>(stride);
+                                    neighbors.farthest2(queries[qi]) * static_cast<float>(stride) *
+                                    gathered.scale * gathered.scale;
             double sum = 0.0;
-            for (const Source& source : gathered)
+            for (std::size_t g = 0; g <= count; ++g)
             {
-                const Vec3f d = source.p - q;
-                const float d2 = d.squaredNorm();
-                if (d2 <= excluded2)
-                    continue;
-                const auto dd = static_cast<double>(d2);
-                const double term = source.area * static_cast<double>(source.n.dot(d)) /
-                                    (4.0 * std::numbers::pi * dd * std::sqrt(dd));
+                const double term = winding_group_sum(gathered, gathered.begin[g],
+                                                      gathered.begin[g + 1], q, excluded2);
                 sum += term;
-                if (source.tried >= 0)
-                    share[qi * count + static_cast<std::size_t>(source.tried)] += term;
+                if (g < count)
+                    share[qi * count + g] = term;
             }
             total[qi] = sum;
         }
