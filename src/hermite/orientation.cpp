@@ -26,6 +26,7 @@
 #include <numeric>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 namespace pointform {
@@ -228,9 +229,10 @@ float middle_value(std::span<float> values)
     if (count <= short_row)
         for (std::size_t i = 0; i < count; ++i)
         {
+            // 32-bit counts: the compare masks add up in vector lanes without widening.
             const float v = values[i];
-            std::size_t less = 0;
-            std::size_t not_greater = 0;
+            std::uint32_t less = 0;
+            std::uint32_t not_greater = 0;
             for (std::size_t j = 0; j < count; ++j)
             {
                 less += values[j] < v ? 1U : 0U;
@@ -313,6 +315,77 @@ float median_flatness(const std::vector<Moments>& moments)
             values[t] = flatness(moments[t * stride].covariance);
     });
     return values.empty() ? 0.0F : middle_value(values);
+}
+
+/// The ring pass asks for the moments of the neighbours of the sample this many ahead: the
+/// loads of a row's moments were a third of the pass (1M noisy blobby's orientation 1.56 ->
+/// 1.49 s, median of five; 8 ahead was no faster).
+constexpr std::size_t ring_prefetch = 4;
+
+/// One ring's sums of sample i from its neighbours' moments (guide_normals()): `sum` gets Σ d and
+/// `outer` Σ d dᵀ + Σ C (upper triangle), d each neighbour's centroid less `centre` and C its
+/// covariance. Each entry is added up in the row's order, so the SSE2 form gives the scalar
+/// form's bits (the same normals bytes on 100 inputs; 1M noisy sphere's `normals` 6% faster: the
+/// scalar form spilled its fifteen sums to the stack).
+void ring_sums(const Moments* moments, std::span<const std::uint32_t> row,
+               const std::array<float, 3>& centre, std::array<float, 3>& sum,
+               std::array<float, 6>& outer)
+{
+    static_assert(sizeof(Moments) == 9 * sizeof(float) && std::is_standard_layout_v<Moments>);
+#if defined(__SSE2__)
+    // Lanes: d = (x, y, z, -), products (xx, xy, xz, yy) and (yz, zz, -, -), covariance entries
+    // 0-3 and 4-5: the last lanes of d and of the second products are never read.
+    const __m128 c = _mm_setr_ps(centre[0], centre[1], centre[2], 0.0F);
+    __m128 d_sum = _mm_setzero_ps();
+    __m128 products_low = _mm_setzero_ps();
+    __m128 products_high = _mm_setzero_ps();
+    __m128 within_low = _mm_setzero_ps();
+    __m128 within_high = _mm_setzero_ps();
+    for (const std::uint32_t j : row)
+    {
+        const auto* m = reinterpret_cast<const float*>(moments + j);
+        const __m128 d = _mm_sub_ps(_mm_loadu_ps(m), c);
+        d_sum = _mm_add_ps(d_sum, d);
+        products_low =
+            _mm_add_ps(products_low, _mm_mul_ps(_mm_shuffle_ps(d, d, _MM_SHUFFLE(1, 0, 0, 0)),
+                                                _mm_shuffle_ps(d, d, _MM_SHUFFLE(1, 2, 1, 0))));
+        products_high =
+            _mm_add_ps(products_high, _mm_mul_ps(_mm_shuffle_ps(d, d, _MM_SHUFFLE(2, 2, 2, 1)),
+                                                 _mm_shuffle_ps(d, d, _MM_SHUFFLE(2, 2, 2, 2))));
+        within_low = _mm_add_ps(within_low, _mm_loadu_ps(m + 3));
+        within_high = _mm_add_ps(
+            within_high, _mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(m + 7))));
+    }
+    std::array<float, 4> lanes{};
+    _mm_storeu_ps(lanes.data(), d_sum);
+    std::copy_n(lanes.begin(), 3, sum.begin());
+    _mm_storeu_ps(lanes.data(), _mm_add_ps(products_low, within_low));
+    std::copy_n(lanes.begin(), 4, outer.begin());
+    _mm_storeu_ps(lanes.data(), _mm_add_ps(products_high, within_high));
+    std::copy_n(lanes.begin(), 2, outer.begin() + 4);
+#else
+    std::array<float, 6> within{};
+    for (const std::uint32_t j : row)
+    {
+        const Moments& m = moments[j];
+        const float x = m.centroid[0] - centre[0];
+        const float y = m.centroid[1] - centre[1];
+        const float z = m.centroid[2] - centre[2];
+        sum[0] += x;
+        sum[1] += y;
+        sum[2] += z;
+        outer[0] += x * x;
+        outer[1] += x * y;
+        outer[2] += x * z;
+        outer[3] += y * y;
+        outer[4] += y * z;
+        outer[5] += z * z;
+        for (std::size_t e = 0; e < 6; ++e)
+            within[e] += m.covariance[e];
+    }
+    for (std::size_t e = 0; e < 6; ++e)
+        outer[e] += within[e];
+#endif
 }
 
 /// The normals that orientation follows: for each sample, the PCA normal of its neighbourhood
@@ -435,18 +508,13 @@ Guide guide_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
                 const auto& c = current[i].centroid;
                 std::array<float, 3> sum{};
                 std::array<float, 6> outer{};
-                std::array<float, 6> within{};
                 const auto row = neighbors.neighbors(i);
-                for (const std::uint32_t j : row)
-                {
-                    const Moments& m = current[j];
-                    add(sum, outer, m.centroid[0] - c[0], m.centroid[1] - c[1],
-                        m.centroid[2] - c[2]);
-                    for (std::size_t e = 0; e < 6; ++e)
-                        within[e] += m.covariance[e];
-                }
-                for (std::size_t e = 0; e < 6; ++e)
-                    outer[e] += within[e];
+#if defined(__GNUC__) || defined(__clang__)
+                if (i + ring_prefetch < end)
+                    for (const std::uint32_t j : neighbors.neighbors(i + ring_prefetch))
+                        __builtin_prefetch(&current[j]);
+#endif
+                ring_sums(current.data(), row, c, sum, outer);
                 next[i] = finish(c, sum, outer, static_cast<float>(row.size()));
                 take_if_flatter(i, next[i], &current[i]);
             }
