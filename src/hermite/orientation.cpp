@@ -5,6 +5,7 @@
 
 #include "pointform/core/disjoint_sets.h"
 #include "pointform/core/error.h"
+#include "pointform/core/memory.h"
 #include "pointform/core/parallel.h"
 
 #include "orientation_detail.h"
@@ -305,7 +306,7 @@ void mark_sheets(std::span<const Vec3f> positions, const KnnTable& neighbors, Gu
 
 /// The median of flatness() over every stride-th neighbourhood of `moments` (stride as the noise
 /// test's), the same for any thread count.
-float median_flatness(const std::vector<Moments>& moments)
+float median_flatness(std::span<const Moments> moments)
 {
     const std::size_t n = moments.size();
     const std::size_t stride = noise_test_stride_for(n);
@@ -464,7 +465,7 @@ Guide guide_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
     // flatter, from the moments still at hand (or after the last ring): a sign bit on the
     // flatness marks it owed. Most noisy samples get flatter ring after ring, and the axis was
     // most of a ring's arithmetic when it was taken at each.
-    std::vector<Moments> current(n);
+    FilledLaterVector<Moments> current(n); // filled below, each page by the thread that fills it
     Guide result;
     if (scratch.size() >= n)
         result.normals = scratch.first(n);
@@ -499,7 +500,7 @@ Guide guide_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
         }
     });
     most_rings = std::max(rings, most_rings);
-    std::vector<Moments> next(most_rings > 0 ? n : 0);
+    FilledLaterVector<Moments> next(most_rings > 0 ? n : 0);
     for (std::size_t ring = 0; ring < most_rings; ++ring)
     {
         parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
@@ -528,8 +529,8 @@ Guide guide_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
             if (std::signbit(best_flatness[i]))
                 settle(i, current[i]);
     });
-    std::vector<Moments>().swap(current);
-    std::vector<Moments>().swap(next);
+    FilledLaterVector<Moments>().swap(current);
+    FilledLaterVector<Moments>().swap(next);
     result.flatness.swap(best_flatness);
     return result;
 }

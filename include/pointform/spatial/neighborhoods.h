@@ -3,6 +3,8 @@
 
 #pragma once
 
+#include "pointform/core/memory.h"
+
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -19,9 +21,10 @@ struct KnnTable
     KnnTable() = default; // not an aggregate: `{.k = 16}` means options, never a table
 
     std::size_t k = 0;
-    std::vector<std::uint32_t> indices; ///< N*k, row-major
+    /// N*k, row-major. Its pages are first written by the search that fills it (knn_batch()).
+    FilledLaterVector<std::uint32_t> indices;
     /// N*k, row-major, non-decreasing within a row; or N, each row's farthest.
-    std::vector<float> squared_distances;
+    FilledLaterVector<float> squared_distances;
 
     [[nodiscard]] std::size_t rows() const { return k == 0 ? 0 : indices.size() / k; }
     [[nodiscard]] std::span<const std::uint32_t> neighbors(std::size_t i) const
