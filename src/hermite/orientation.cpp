@@ -1298,17 +1298,38 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
         const auto in_region = [&](std::size_t i) {
             return band[i] == 0 && usable(normals[i]);
         };
+        //    Which steps join are tested in parallel (a bit a column), then joined on one
+        //    thread in the same order: the tests were most of the serial time (1.2 s at 10M).
+        const std::size_t row_bytes = (columns + 7) / 8;
+        auto joins = std::make_unique_for_overwrite<std::uint8_t[]>(n * row_bytes);
+        parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                std::uint8_t* bits = joins.get() + i * row_bytes;
+                std::fill(bits, bits + row_bytes, std::uint8_t{0});
+                if (!in_region(i))
+                    continue;
+                const auto row = neighbors.neighbors(i).first(columns);
+                for (std::size_t c = 0; c < columns; ++c)
+                {
+                    const std::uint32_t j = row[c];
+                    if (j != i && in_region(j) &&
+                        std::abs(guide.normals[i].dot(guide.normals[j])) >= reliable &&
+                        !guide.jumps(positions, neighbors, static_cast<std::uint32_t>(i), j))
+                        bits[c / 8] |= static_cast<std::uint8_t>(1U << (c % 8));
+                }
+            }
+        });
         DisjointSets sets(n);
         for (std::size_t i = 0; i < n; ++i)
         {
-            if (!in_region(i))
-                continue;
-            for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
-                if (j != i && in_region(j) &&
-                    std::abs(guide.normals[i].dot(guide.normals[j])) >= reliable &&
-                    !guide.jumps(positions, neighbors, static_cast<std::uint32_t>(i), j))
-                    sets.unite(i, j);
+            const std::uint8_t* bits = joins.get() + i * row_bytes;
+            const auto row = neighbors.neighbors(i);
+            for (std::size_t c = 0; c < columns; ++c)
+                if ((bits[c / 8] & (1U << (c % 8))) != 0)
+                    sets.unite(i, row[c]);
         }
+        joins.reset();
         std::vector<std::uint32_t> id(n, none);
         for (std::size_t i = 0; i < n; ++i)
         {
