@@ -318,6 +318,20 @@ float median_flatness(std::span<const Moments> moments)
     return values.empty() ? 0.0F : middle_value(values);
 }
 
+/// Adds d = (x, y, z) to the sums of d and of d dᵀ (upper triangle: xx xy xz yy yz zz).
+void add_moment(std::array<float, 3>& sum, std::array<float, 6>& outer, float x, float y, float z)
+{
+    sum[0] += x;
+    sum[1] += y;
+    sum[2] += z;
+    outer[0] += x * x;
+    outer[1] += x * y;
+    outer[2] += x * z;
+    outer[3] += y * y;
+    outer[4] += y * z;
+    outer[5] += z * z;
+}
+
 /// The ring pass asks for the moments of the neighbours of the sample this many ahead: the
 /// loads of a row's moments were a third of the pass (1M noisy blobby's orientation 1.56 ->
 /// 1.49 s, median of five; 8 ahead was no faster).
@@ -369,18 +383,8 @@ void ring_sums(const Moments* moments, std::span<const std::uint32_t> row,
     for (const std::uint32_t j : row)
     {
         const Moments& m = moments[j];
-        const float x = m.centroid[0] - centre[0];
-        const float y = m.centroid[1] - centre[1];
-        const float z = m.centroid[2] - centre[2];
-        sum[0] += x;
-        sum[1] += y;
-        sum[2] += z;
-        outer[0] += x * x;
-        outer[1] += x * y;
-        outer[2] += x * z;
-        outer[3] += y * y;
-        outer[4] += y * z;
-        outer[5] += z * z;
+        add_moment(sum, outer, m.centroid[0] - centre[0], m.centroid[1] - centre[1],
+                   m.centroid[2] - centre[2]);
         for (std::size_t e = 0; e < 6; ++e)
             within[e] += m.covariance[e];
     }
@@ -417,18 +421,6 @@ Guide guide_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
             {outer[0] - sum[0] * sum[0], outer[1] - sum[0] * sum[1], outer[2] - sum[0] * sum[2],
              outer[3] - sum[1] * sum[1], outer[4] - sum[1] * sum[2], outer[5] - sum[2] * sum[2]}};
     };
-    const auto add = [](std::array<float, 3>& sum, std::array<float, 6>& outer, float x, float y,
-                        float z) {
-        sum[0] += x;
-        sum[1] += y;
-        sum[2] += z;
-        outer[0] += x * x;
-        outer[1] += x * y;
-        outer[2] += x * z;
-        outer[3] += y * y;
-        outer[4] += y * z;
-        outer[5] += z * z;
-    };
     // The moments of sample i's own neighbourhood.
     const auto own_moments = [&](std::size_t i) {
         const Vec3f& p = positions[i];
@@ -438,7 +430,7 @@ Guide guide_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
         for (const std::uint32_t j : row)
         {
             const Vec3f d = positions[j] - p;
-            add(sum, outer, d.x(), d.y(), d.z());
+            add_moment(sum, outer, d.x(), d.y(), d.z());
         }
         return finish({p.x(), p.y(), p.z()}, sum, outer, static_cast<float>(row.size()));
     };
