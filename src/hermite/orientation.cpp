@@ -368,8 +368,8 @@ void ring_sums(const Moments* moments, std::span<const std::uint32_t> row,
             _mm_add_ps(products_high, _mm_mul_ps(_mm_shuffle_ps(d, d, _MM_SHUFFLE(2, 2, 2, 1)),
                                                  _mm_shuffle_ps(d, d, _MM_SHUFFLE(2, 2, 2, 2))));
         within_low = _mm_add_ps(within_low, _mm_loadu_ps(m + 3));
-        within_high = _mm_add_ps(
-            within_high, _mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(m + 7))));
+        // m + 7 is only 4-byte aligned: _mm_loadu_si64 reads the pair through an unaligned type.
+        within_high = _mm_add_ps(within_high, _mm_castsi128_ps(_mm_loadu_si64(m + 7)));
     }
     std::array<float, 4> lanes{};
     _mm_storeu_ps(lanes.data(), d_sum);
