@@ -1631,21 +1631,39 @@ OrientedNormals orient_graph(std::span<const Vec3f> positions, std::span<const V
         std::uint32_t b;
         float weight;
     };
-    std::vector<Vote> votes;
-    for (std::size_t i = 0; i < n; ++i)
-    {
-        const auto pi = patch[i];
-        if (pi == RiemannianForest::none)
-            continue;
-        for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+    //    Collected a block at a time in parallel, then joined in block order: the list (and so
+    //    the sums below) is the one a single pass in sample order makes.
+    constexpr std::size_t vote_block = 4096;
+    std::vector<std::vector<Vote>> block_votes((n + vote_block - 1) / vote_block);
+    parallel_blocks(n, vote_block, [&](std::size_t begin, std::size_t end) {
+        std::vector<Vote>& out = block_votes[begin / vote_block];
+        for (std::size_t i = begin; i < end; ++i)
         {
-            const auto pj = patch[j];
-            if (pj == RiemannianForest::none || pj == pi ||
-                guide.jumps(positions, neighbors, static_cast<std::uint32_t>(i), j))
+            const auto pi = patch[i];
+            if (pi == RiemannianForest::none)
                 continue;
-            const float w = agreement(positions, result.normals, options.rule,
-                                      static_cast<std::uint32_t>(i), j);
-            votes.push_back({std::min(pi, pj), std::max(pi, pj), w});
+            for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+            {
+                const auto pj = patch[j];
+                if (pj == RiemannianForest::none || pj == pi ||
+                    guide.jumps(positions, neighbors, static_cast<std::uint32_t>(i), j))
+                    continue;
+                const float w = agreement(positions, result.normals, options.rule,
+                                          static_cast<std::uint32_t>(i), j);
+                out.push_back({std::min(pi, pj), std::max(pi, pj), w});
+            }
+        }
+    });
+    std::vector<Vote> votes;
+    {
+        std::size_t total = 0;
+        for (const std::vector<Vote>& part : block_votes)
+            total += part.size();
+        votes.reserve(total);
+        for (std::vector<Vote>& part : block_votes)
+        {
+            votes.insert(votes.end(), part.begin(), part.end());
+            std::vector<Vote>().swap(part);
         }
     }
     std::sort(votes.begin(), votes.end(),
