@@ -9,12 +9,9 @@
 #include "pointform/core/parallel.h"
 
 #include "orientation_detail.h"
+#include "orientation_lanes.h"
 
 #include <Eigen/Core>
-
-#if defined(__SSE2__)
-#include <immintrin.h>
-#endif
 
 #include <algorithm>
 #include <array>
@@ -33,7 +30,13 @@
 namespace pointform {
 namespace {
 
+using detail::add_moment;
 using detail::Guide;
+using detail::Moments;
+using detail::ring_sums;
+using detail::winding_group_sum;
+using detail::winding_lanes;
+using detail::WindingSources;
 
 /// The flux test overrides the seed's +z only when |flux| exceeds this fraction of
 /// Σ a_i |p_i − c|. A closed convex surface scores 1, closed non-convex shapes (bunny, torus)
@@ -142,14 +145,6 @@ constexpr float off_sheet_deviations = 3.0F;
 /// farthest neighbour: on a clean, flat part of a noisy cloud the deviations are about zero, and
 /// rounding would decide.
 constexpr float min_height_limit = 0.05F;
-
-/// A neighbourhood's centroid and covariance (upper triangle: xx xy xz yy yz zz), in float: the
-/// guide needs a direction, not digits.
-struct Moments
-{
-    std::array<float, 3> centroid;
-    std::array<float, 6> covariance;
-};
 
 /// A covariance as a matrix, divided by its trace (so that its adjugate and determinant stay in
 /// float range whatever the units); zero when the trace is not positive.
@@ -318,80 +313,10 @@ float median_flatness(std::span<const Moments> moments)
     return values.empty() ? 0.0F : middle_value(values);
 }
 
-/// Adds d = (x, y, z) to the sums of d and of d dᵀ (upper triangle: xx xy xz yy yz zz).
-void add_moment(std::array<float, 3>& sum, std::array<float, 6>& outer, float x, float y, float z)
-{
-    sum[0] += x;
-    sum[1] += y;
-    sum[2] += z;
-    outer[0] += x * x;
-    outer[1] += x * y;
-    outer[2] += x * z;
-    outer[3] += y * y;
-    outer[4] += y * z;
-    outer[5] += z * z;
-}
-
 /// The ring pass asks for the moments of the neighbours of the sample this many ahead: the
 /// loads of a row's moments were a third of the pass (1M noisy blobby's orientation 1.56 ->
 /// 1.49 s, median of five; 8 ahead was no faster).
 constexpr std::size_t ring_prefetch = 4;
-
-/// One ring's sums of sample i from its neighbours' moments (guide_normals()): `sum` gets Σ d and
-/// `outer` Σ d dᵀ + Σ C (upper triangle), d each neighbour's centroid less `centre` and C its
-/// covariance. Each entry is added up in the row's order, so the SSE2 form gives the scalar
-/// form's bits (the same normals bytes on 100 inputs; 1M noisy sphere's `normals` 6% faster: the
-/// scalar form spilled its fifteen sums to the stack).
-void ring_sums(const Moments* moments, std::span<const std::uint32_t> row,
-               const std::array<float, 3>& centre, std::array<float, 3>& sum,
-               std::array<float, 6>& outer)
-{
-    static_assert(sizeof(Moments) == 9 * sizeof(float) && std::is_standard_layout_v<Moments>);
-#if defined(__SSE2__)
-    // Lanes: d = (x, y, z, -), products (xx, xy, xz, yy) and (yz, zz, -, -), covariance entries
-    // 0-3 and 4-5: the last lanes of d and of the second products are never read.
-    const __m128 c = _mm_setr_ps(centre[0], centre[1], centre[2], 0.0F);
-    __m128 d_sum = _mm_setzero_ps();
-    __m128 products_low = _mm_setzero_ps();
-    __m128 products_high = _mm_setzero_ps();
-    __m128 within_low = _mm_setzero_ps();
-    __m128 within_high = _mm_setzero_ps();
-    for (const std::uint32_t j : row)
-    {
-        const auto* m = reinterpret_cast<const float*>(moments + j);
-        const __m128 d = _mm_sub_ps(_mm_loadu_ps(m), c);
-        d_sum = _mm_add_ps(d_sum, d);
-        products_low =
-            _mm_add_ps(products_low, _mm_mul_ps(_mm_shuffle_ps(d, d, _MM_SHUFFLE(1, 0, 0, 0)),
-                                                _mm_shuffle_ps(d, d, _MM_SHUFFLE(1, 2, 1, 0))));
-        products_high =
-            _mm_add_ps(products_high, _mm_mul_ps(_mm_shuffle_ps(d, d, _MM_SHUFFLE(2, 2, 2, 1)),
-                                                 _mm_shuffle_ps(d, d, _MM_SHUFFLE(2, 2, 2, 2))));
-        within_low = _mm_add_ps(within_low, _mm_loadu_ps(m + 3));
-        // m + 7 is only 4-byte aligned: _mm_loadu_si64 reads the pair through an unaligned type.
-        within_high = _mm_add_ps(within_high, _mm_castsi128_ps(_mm_loadu_si64(m + 7)));
-    }
-    std::array<float, 4> lanes{};
-    _mm_storeu_ps(lanes.data(), d_sum);
-    std::copy_n(lanes.begin(), 3, sum.begin());
-    _mm_storeu_ps(lanes.data(), _mm_add_ps(products_low, within_low));
-    std::copy_n(lanes.begin(), 4, outer.begin());
-    _mm_storeu_ps(lanes.data(), _mm_add_ps(products_high, within_high));
-    std::copy_n(lanes.begin(), 2, outer.begin() + 4);
-#else
-    std::array<float, 6> within{};
-    for (const std::uint32_t j : row)
-    {
-        const Moments& m = moments[j];
-        add_moment(sum, outer, m.centroid[0] - centre[0], m.centroid[1] - centre[1],
-                   m.centroid[2] - centre[2]);
-        for (std::size_t e = 0; e < 6; ++e)
-            within[e] += m.covariance[e];
-    }
-    for (std::size_t e = 0; e < 6; ++e)
-        outer[e] += within[e];
-#endif
-}
 
 /// The normals that orientation follows: for each sample, the PCA normal of its neighbourhood
 /// grown ring by ring through the neighbour table (at least `rings` rings, and more, up to
@@ -1152,87 +1077,6 @@ std::vector<std::uint8_t> crease_band(std::span<const Vec3f> positions, const Kn
         }
     });
     return band;
-}
-
-/// The winding check's sums run in this many float lanes (turn_regions_by_winding()): each
-/// lane adds every winding_lanes-th term of a group, then the lanes are added in a fixed order,
-/// so a sum is the same bits with or without vector instructions and on any thread count.
-constexpr std::size_t winding_lanes = 8;
-
-/// The winding check's sources, as float columns in groups padded to whole lanes: positions
-/// relative to `origin` times `scale`, unit normals, and each source's area over 4π in the
-/// scaled units.
-struct WindingSources
-{
-    Vec3f origin = Vec3f::Zero();
-    float scale = 1.0F;
-    std::vector<float> x, y, z, nx, ny, nz, area;
-    /// Where each group starts, and the end.
-    std::vector<std::size_t> begin;
-
-    [[nodiscard]] std::size_t size() const { return x.size(); }
-    [[nodiscard]] Vec3f local(const Vec3f& p) const { return (p - origin) * scale; }
-    void push(const Vec3f& p, const Vec3f& n, float a)
-    {
-        x.push_back(p.x());
-        y.push_back(p.y());
-        z.push_back(p.z());
-        nx.push_back(n.x());
-        ny.push_back(n.y());
-        nz.push_back(n.z());
-        area.push_back(a);
-    }
-};
-
-/// Σ area · n·d / |d|³ (d from q to the source) over the sources [from, to) farther than
-/// sqrt(excluded2) from q, in winding_lanes lanes.
-double winding_group_sum(const WindingSources& s, std::size_t from, std::size_t to, const Vec3f& q,
-                         float excluded2)
-{
-    std::array<float, winding_lanes> lane{};
-#if defined(__SSE2__)
-    static_assert(winding_lanes == 8);
-    const __m128 qx = _mm_set1_ps(q.x());
-    const __m128 qy = _mm_set1_ps(q.y());
-    const __m128 qz = _mm_set1_ps(q.z());
-    const __m128 limit = _mm_set1_ps(excluded2);
-    __m128 sum[2] = {_mm_setzero_ps(), _mm_setzero_ps()};
-    for (std::size_t b = from; b < to; b += winding_lanes)
-        for (std::size_t h = 0; h < 2; ++h)
-        {
-            const std::size_t i = b + 4 * h;
-            const __m128 dx = _mm_sub_ps(_mm_loadu_ps(&s.x[i]), qx);
-            const __m128 dy = _mm_sub_ps(_mm_loadu_ps(&s.y[i]), qy);
-            const __m128 dz = _mm_sub_ps(_mm_loadu_ps(&s.z[i]), qz);
-            const __m128 d2 =
-                _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
-            const __m128 flux = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_loadu_ps(&s.nx[i]), dx),
-                                                      _mm_mul_ps(_mm_loadu_ps(&s.ny[i]), dy)),
-                                           _mm_mul_ps(_mm_loadu_ps(&s.nz[i]), dz));
-            const __m128 term = _mm_div_ps(_mm_mul_ps(_mm_loadu_ps(&s.area[i]), flux),
-                                           _mm_mul_ps(d2, _mm_sqrt_ps(d2)));
-            sum[h] = _mm_add_ps(sum[h], _mm_and_ps(_mm_cmpgt_ps(d2, limit), term));
-        }
-    _mm_storeu_ps(lane.data(), sum[0]);
-    _mm_storeu_ps(lane.data() + 4, sum[1]);
-#else
-    for (std::size_t b = from; b < to; b += winding_lanes)
-        for (std::size_t l = 0; l < winding_lanes; ++l)
-        {
-            const std::size_t i = b + l;
-            const float dx = s.x[i] - q.x();
-            const float dy = s.y[i] - q.y();
-            const float dz = s.z[i] - q.z();
-            const float d2 = (dx * dx + dy * dy) + dz * dz;
-            const float flux = (s.nx[i] * dx + s.ny[i] * dy) + s.nz[i] * dz;
-            const float term = s.area[i] * flux / (d2 * std::sqrt(d2));
-            lane[l] += d2 > excluded2 ? term : 0.0F;
-        }
-#endif
-    double total = 0.0;
-    for (const float v : lane)
-        total += static_cast<double>(v);
-    return total;
 }
 
 /// The generalized winding number check of a guided orientation: regions that a crease band
