@@ -10,7 +10,7 @@
 // there. (A compiler that fuses multiplies and adds, say with -march=native or on ARM, rounds
 // the scalar form differently: the promise is per build, like the thread count's.)
 
-#include "pointform/geometry/point_cloud.h"
+#include "pointform/core/types.h"
 
 #if defined(__SSE2__)
 #include <immintrin.h>
