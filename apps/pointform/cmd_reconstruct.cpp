@@ -18,6 +18,19 @@
 namespace pointform::cli {
 namespace {
 
+std::string describe_handle_cuts(const HandleCutReport& cuts, double radii)
+{
+    if (cuts.genus_before == 0)
+        return "none (genus 0)";
+    std::string text = "genus " + std::to_string(cuts.genus_before) + " -> " +
+                       std::to_string(cuts.genus_after) + ": cut " + std::to_string(cuts.cuts) +
+                       " loop" + (cuts.cuts == 1 ? "" : "s");
+    if (cuts.cuts > 0)
+        text += " (the longest " + format_number(cuts.longest_cut) + ")";
+    return text + " of at most " + format_number(cuts.max_length) + " (" + format_number(radii) +
+           " median influence radii, --max-handle), capped both sides";
+}
+
 struct ReconstructCommandOptions
 {
     std::string input;
@@ -88,6 +101,7 @@ void run_reconstruct(const ReconstructCommandOptions& options, const GlobalOptio
                       std::to_string(report.debris.components) + " components (" +
                       std::to_string(report.debris.removed_faces) + " faces) that fewer than " +
                       std::to_string(report.debris.min_samples) + " samples are nearest to");
+        print_row("handles", describe_handle_cuts(report.handles, options.reconstruct.max_handle));
         print_base_mesh(*base_stats);
     }
     else
@@ -132,6 +146,12 @@ void register_reconstruct(CLI::App& app, const GlobalOptions& global)
                     "Close the automatic base mesh's holes whose rim encloses at most this "
                     "fraction of their component's area (0 keeps every hole)")
         ->check(CLI::Range(0.0, 0.999999))
+        ->capture_default_str();
+    cmd->add_option("--max-handle", options->reconstruct.max_handle,
+                    "Cut the intermediate mesh's handles whose loop is at most this many median "
+                    "influence radii long, and cap both sides (topological noise: tunnels where "
+                    "the field's sheets meet past their samples); 0 keeps every handle")
+        ->check(CLI::Range(0.0, max_handle_radii))
         ->capture_default_str();
     add_rim_reach_option(*cmd, options->reconstruct.rim_reach);
     add_refine_options(*cmd, options->refine);

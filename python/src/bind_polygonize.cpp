@@ -283,9 +283,10 @@ void bind_polygonize(py::module_& m)
            const std::optional<std::filesystem::path>& base_mesh, const py::object& base_triangles,
            long long k, double radius_scale, const std::string& predictor, int relax_iterations,
            const std::string& relaxation, double fill_holes, double rim_reach,
-           long long denoise_rounds, bool hole_fairing) {
+           long long denoise_rounds, bool hole_fairing, double max_handle) {
             ReconstructOptions options;
             options.fill_holes = fill_holes; // checked by the base mesh
+            options.max_handle = max_handle; // checked by reconstruct()
             options.rim_reach = rim_reach;   // checked by the point field
             options.semi_regular =
                 semi_regular_options(levels, base_faces, stop_rule, predictor, relax_iterations,
@@ -348,18 +349,21 @@ void bind_polygonize(py::module_& m)
         py::arg("rim_reach") = ReconstructOptions{}.rim_reach,
         py::arg("denoise_rounds") = static_cast<long long>(RefineOptions{}.denoise_rounds),
         py::arg("hole_fairing") = RefineOptions{}.fair_unsupported,
+        py::arg("max_handle") = default_max_handle,
         "reconstruct(cloud, *, levels=None, base_faces=None, stop_rule='auto', fit='quadric', "
         "resolution=0, cell=0.0, min_component_samples=None, base_mesh=None, base_triangles=None, "
         "k=16, "
         "radius_scale=1.5, predictor=..., relax_iterations=..., relaxation=..., fill_holes=0.05, "
-        "rim_reach=0.25, denoise_rounds=10, hole_fairing=True) "
+        "rim_reach=0.25, denoise_rounds=10, hole_fairing=True, max_handle=4.0) "
         "-> Hierarchy\n\n"
         "Points to a semi-regular multiresolution mesh (paper §5), as `pointform reconstruct` "
         "does, with the same defaults and the same result: surfels (pointform.surfels() with "
         "k and radius_scale; raw points get normals, points with normals keep them), their "
         "field (fit; rim_reach: how far past a rim of the samples it reaches, in (0, 1] of a "
         "radius), marching cubes (resolution cells along the longest side, or cell size, "
-        "or automatic), debris removal, the automatic base mesh (base_faces faces) or a picked "
+        "or automatic), debris removal, the handles whose loop is at most max_handle median "
+        "influence radii long cut and capped (0 keeps them), the automatic base mesh "
+        "(base_faces faces) or a picked "
         "one (base_mesh: a file as `reconstruct --base-mesh` reads; base_triangles: an M by 3 "
         "integer array of the cloud's sample indices, as picked in `pointform view`), its holes "
         "enclosing at most fill_holes of their component's area closed (0 keeps them), then "

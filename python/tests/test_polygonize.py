@@ -203,6 +203,40 @@ def test_reconstruct_fills_holes_as_the_cli_does(tmp_path):
         assert mine.read_bytes() == out.read_bytes()
 
 
+def test_reconstruct_cuts_short_handles_as_the_cli_does(tmp_path):
+    # A noisy 45-degree cone, raw points (normals estimated): its sharp rim makes the field's
+    # sheets meet as small tunnels. By
+    # default they are cut before the base mesh; max_handle=0 keeps them. The same bytes as
+    # `pointform reconstruct` either way.
+    points = tmp_path / "cone.ply"
+    run_cli("sample", "cone", "-n", 20000, "--noise", 0.002, "--seed", 2, "-o", points)
+    positions = pointform.read_points(points).world().astype("<f4")
+    raw = tmp_path / "raw.ply"
+    raw.write_bytes(b"ply\nformat binary_little_endian 1.0\n"
+                    + f"element vertex {len(positions)}\n".encode()
+                    + b"property float x\nproperty float y\nproperty float z\nend_header\n"
+                    + positions.tobytes())
+    cloud = pointform.read_points(raw)
+    reports = {}
+    for max_handle in (None, 0.0):
+        kwargs = {} if max_handle is None else {"max_handle": max_handle}
+        hierarchy = pointform.reconstruct(cloud, **kwargs)
+        reports[max_handle] = hierarchy.report["handles"]
+        out = tmp_path / f"cli{max_handle}.pfh"
+        run_cli("reconstruct", raw, "-o", tmp_path / "cli.ply", "--save-hierarchy", out, "-q",
+                *([] if max_handle is None else ["--max-handle", max_handle]))
+        mine = tmp_path / f"py{max_handle}.pfh"
+        hierarchy.save(mine)
+        assert mine.read_bytes() == out.read_bytes()
+    default, kept = reports[None], reports[0.0]
+    assert kept["cuts"] == 0 and kept["genus_after"] == kept["genus_before"] > 3
+    assert default["genus_before"] == kept["genus_before"]
+    assert default["cuts"] > default["genus_before"] // 2
+    assert default["genus_after"] == default["genus_before"] - default["cuts"]
+    with pytest.raises(ValueError, match="handle"):
+        pointform.reconstruct(cloud, max_handle=-1.0)
+
+
 def test_fill_holes_is_the_mc_clis(tmp_path):
     # `pointform mc` closes a scan's holes by default: the same as its open zero set passed
     # to pointform.fill_holes().

@@ -5,6 +5,7 @@
 
 #include "pointform/core/error.h"
 #include "pointform/core/memory.h"
+#include "pointform/polygonize/handles.h"
 #include "pointform/polygonize/marching_cubes.h"
 
 #include <algorithm>
@@ -115,6 +116,17 @@ std::size_t automatic_base_faces(const SemiRegularOptions& options, std::size_t 
     if (samples == 0 || options.levels || options.stop_rule != StopRule::Automatic)
         return target;
     return std::min(faces, fit_base_faces_to_budget(target, samples));
+}
+
+/// The median of the samples' influence radii (0 without radii).
+double median_radius(const PointCloud& samples)
+{
+    std::vector<float> radii(samples.radii.begin(), samples.radii.end());
+    if (radii.empty())
+        return 0.0;
+    const auto middle = radii.begin() + static_cast<std::ptrdiff_t>(radii.size() / 2);
+    std::nth_element(radii.begin(), middle, radii.end());
+    return static_cast<double>(*middle);
 }
 
 } // namespace
@@ -292,6 +304,10 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
         throw InvalidInput("give a base-mesh file or picked vertices, not both");
     if (!(options.fill_holes >= 0.0 && options.fill_holes < 1.0))
         throw InvalidInput("the largest hole to fill must be in [0, 1) of its component's area");
+    if (!(options.max_handle >= 0.0 && options.max_handle <= max_handle_radii))
+        throw InvalidInput("the longest handle loop to cut must be in [0, " +
+                           std::to_string(static_cast<int>(max_handle_radii)) +
+                           "] median influence radii");
     ReconstructReport report;
     StageClock clock(report.stage_seconds);
     const Aabb bounds = surfels.bounds();
@@ -358,6 +374,8 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
             options.min_component_samples ? *options.min_component_samples
                                           : default_min_component_samples(samples.size()));
         clock.lap("debris");
+        report.handles = cut_short_handles(mc.mesh, options.max_handle * median_radius(samples));
+        clock.lap("handles");
         SemiRegularOptions semi_regular = options.semi_regular;
         semi_regular.fill_holes = options.fill_holes;
         semi_regular.sample_tree = &field.tree();

@@ -252,6 +252,11 @@ nlohmann::json report_json(const ReconstructReport& report, const ReconstructOpt
                          {"removed_components", report.debris.removed_components},
                          {"removed_faces", report.debris.removed_faces},
                          {"min_samples", report.debris.min_samples}};
+        out["handles"] = {{"genus_before", report.handles.genus_before},
+                          {"genus_after", report.handles.genus_after},
+                          {"cuts", report.handles.cuts},
+                          {"longest_cut", report.handles.longest_cut},
+                          {"max_length", report.handles.max_length}};
     }
     else if (report.picked)
     {

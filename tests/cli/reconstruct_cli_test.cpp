@@ -135,11 +135,12 @@ TEST(ReconstructCli, AHighGenusScanStillFillsItsVertexBudget)
     // has about 170 handles, and the base mesh, which keeps them, stopped at 3,952 faces for a
     // target of 1,791 fitted to two levels. Level 2 of it was then over the budget and the
     // output was level 1, 7,991 vertices: a third of the budget. Now the base mesh is built
-    // again for the one level it affords.
+    // again for the one level it affords. The handles are kept here (--max-handle 0); by
+    // default most are cut as topological noise (below).
     test::TempDir dir;
     const auto output = dir / "lidar.ply";
     const auto r = run("reconstruct " + quoted(test::data_path("lidar/4_6_crop.las")) + " -o " +
-                       quoted(output) + " --json");
+                       quoted(output) + " --json --max-handle 0");
     ASSERT_EQ(r.exit_code, 0) << r.out;
     const auto report = nlohmann::json::parse(r.out);
     const auto budget = report["vertex_budget"].get<std::size_t>();
@@ -149,6 +150,26 @@ TEST(ReconstructCli, AHighGenusScanStillFillsItsVertexBudget)
     EXPECT_LE(vertices, budget);
     EXPECT_GE(vertices, budget * 2 / 5);
     EXPECT_TRUE(report["base_mesh"]["topology_kept"].get<bool>());
+    EXPECT_EQ(report["handles"]["cuts"].get<std::size_t>(), 0U);
+
+    // By default the short handles (loops of at most 4 median influence radii, among the
+    // trees) are cut before the base mesh, and the budget is still filled.
+    const auto d = run("reconstruct " + quoted(test::data_path("lidar/4_6_crop.las")) + " -o " +
+                       quoted(output) + " --json");
+    ASSERT_EQ(d.exit_code, 0) << d.out;
+    const auto cut = nlohmann::json::parse(d.out);
+    const auto& handles = cut["handles"];
+    EXPECT_EQ(handles["genus_before"].get<std::size_t>(),
+              report["handles"]["genus_before"].get<std::size_t>());
+    EXPECT_GT(handles["cuts"].get<std::size_t>(), handles["genus_before"].get<std::size_t>() / 2);
+    EXPECT_EQ(handles["genus_after"].get<std::size_t>() + handles["cuts"].get<std::size_t>(),
+              handles["genus_before"].get<std::size_t>());
+    EXPECT_LE(handles["longest_cut"].get<double>(), handles["max_length"].get<double>());
+    EXPECT_GT(cut["euler_characteristic"].get<long long>(),
+              report["euler_characteristic"].get<long long>());
+    EXPECT_LE(cut["vertices"].get<std::size_t>(), budget);
+    EXPECT_GE(cut["vertices"].get<std::size_t>(), budget * 2 / 5);
+    EXPECT_TRUE(cut["base_mesh"]["topology_kept"].get<bool>());
 }
 
 TEST(ReconstructCli, LevelsRefinesExactlyAndTheHierarchyGivesTheSameMesh)

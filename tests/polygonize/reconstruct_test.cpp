@@ -58,8 +58,10 @@ TEST(Reconstruct, SampledSphereStopsByTheRuleWithinTheBudgetOnTheSphere)
     EXPECT_EQ(topo.euler_characteristic, 2);
     EXPECT_LT(sphere_error(finest), semi.refinement.sampling_density);
     // Every stage reported, in order.
-    ASSERT_EQ(report.stage_seconds.size(), 5U);
+    ASSERT_EQ(report.stage_seconds.size(), 6U);
     EXPECT_EQ(report.stage_seconds.front().first, "field");
+    EXPECT_EQ(report.stage_seconds[3].first, "handles");
+    EXPECT_EQ(report.handles.genus_before, 0U);
     EXPECT_EQ(report.stage_seconds.back().first, "refinement");
     EXPECT_GT(report.intermediate_faces, semi.base->faces);
 }

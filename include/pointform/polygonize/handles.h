@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#pragma once
+
+#include "pointform/geometry/tri_mesh.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace pointform {
+
+/// \brief A closed loop of mesh edges: its vertices in order (the last joins the first).
+struct MeshLoop
+{
+    std::vector<std::uint32_t> vertices;
+    double length = 0.0; ///< the sum of its edges' lengths
+};
+
+/// \brief The shortest non-separating loop of `mesh` no longer than `max_length`: a loop of edges
+/// that cutting the surface along does not split it, so one that goes round a handle (the
+/// meridian of a torus's tube), or nothing when the mesh has no handle or every loop round one is
+/// longer. The rims of holes count as capped: a loop round a hole is not a handle.
+///
+/// Each vertex away from the boundary is the start of a Dijkstra search to max_length / 2; the
+/// shortest loop through it is two of its shortest paths joined by an edge (Erickson and
+/// Har-Peled 2004), and whether a loop separates is its class in the surface's Z/2 homology,
+/// read off a tree-cotree basis (Eppstein 2003). O(V (max_length / h)² log) for edge length h.
+/// \pre `mesh` is an oriented 2-manifold (analyze_topology().is_oriented_manifold())
+/// \return an empty loop (no vertices) when there is none
+[[nodiscard]] MeshLoop shortest_handle_loop(const TriMesh& mesh, double max_length);
+
+/// \brief What cut_short_handles() did.
+struct HandleCutReport
+{
+    std::size_t genus_before = 0; ///< handles of the mesh before (summed over its components)
+    std::size_t genus_after = 0;  ///< and after
+    std::size_t cuts = 0;         ///< loops cut (each removes one handle)
+    double longest_cut = 0.0;     ///< the length of the longest loop cut
+    std::vector<double> lengths;  ///< every cut loop's length, in the order cut
+    double max_length = 0.0;      ///< the longest loop that could be cut
+};
+
+/// \brief Topological noise removal (Guskov and Wood 2001): cuts `mesh` along its short
+/// non-separating loops, shortest first, and caps both sides with a fan (a vertex at the loop's
+/// centroid, moved a tenth of the loop's mean radius to its own side), until no handle has a
+/// loop round it of at most `max_length`. Handles are tunnels and bridges far smaller than the
+/// shape: where fits of two sheets meet past their samples (a sharp rim under noise, a step of
+/// a scan) the field's zero set joins them with a tube that a surface of the scanned object does
+/// not have. Loops through boundary vertices are not cut. Deterministic (no threads).
+/// \pre `mesh` is an oriented 2-manifold
+HandleCutReport cut_short_handles(TriMesh& mesh, double max_length);
+
+} // namespace pointform
