@@ -11,6 +11,7 @@
 #include "pointform/polygonize/components.h"
 #include "pointform/polygonize/marching_cubes.h"
 #include "pointform/polygonize/reconstruct.h"
+#include "pointform/report/report_json.h"
 
 #include "common.h"
 #include "options.h"
@@ -36,6 +37,7 @@ struct McCommandOptions
     double rim_reach = PointFieldOptions{}.rim_reach;
     double fill_holes = ReconstructOptions{}.fill_holes;
     std::optional<std::size_t> min_component_samples;
+    double max_handle = ReconstructOptions{}.max_handle;
     SurfelsFromSamplesOptions surfels;
     bool ascii = false;
     bool json = false;
@@ -69,6 +71,9 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
         options.min_component_samples ? *options.min_component_samples
                                       : default_min_component_samples(input.surfels.size()));
     timings.lap("debris");
+    const HandleCutReport handles =
+        cut_short_handles(result.mesh, options.max_handle * field.median_radius());
+    timings.lap("handles");
     const HoleFillStats holes = fill_mesh_holes(result.mesh, options.fill_holes);
     timings.lap("fill holes");
     write_output(options.output, [&](const std::filesystem::path& path) {
@@ -95,6 +100,8 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
         out["min_component_samples"] = debris.min_samples;
         out["components_removed"] = debris.removed_components;
         out["faces_removed"] = debris.removed_faces;
+        out["max_handle"] = options.max_handle;
+        out["handles"] = report_json(handles);
         out["fill_holes"] = options.fill_holes;
         out["holes_filled"] = holes.holes_filled;
         out["hole_vertices"] = holes.hole_vertices;
@@ -135,6 +142,7 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
                                 std::to_string(debris.removed_components) +
                                 " removed: fewer than " + std::to_string(debris.min_samples) +
                                 " samples nearest)");
+    print_row("handles", describe_handle_cuts(handles, options.max_handle));
     print_row("holes filled", holes.skipped_not_manifold
                                   ? std::string("none (the mesh is not an oriented 2-manifold)")
                                   : std::to_string(holes.holes_filled) + " (" +
@@ -161,8 +169,9 @@ void register_mc(CLI::App& app, const GlobalOptions& global)
     CLI::App* cmd = app.add_subcommand(
         "mc",
         "Level 2 -> mesh: marching cubes on the point field over the cells near the samples "
-        "(paper §4, Fig. 4), its debris removed and the scan's holes closed as reconstruct "
-        "does them (--min-component-samples, --fill-holes); "
+        "(paper §4, Fig. 4), its debris removed, its short handles cut and the scan's holes "
+        "closed as reconstruct does them (--min-component-samples, --max-handle, "
+        "--fill-holes); "
         "prints counts, boundary loops and the Hausdorff distance from the samples to the "
         "mesh");
     cmd->add_option("input", options->input,
@@ -187,6 +196,7 @@ void register_mc(CLI::App& app, const GlobalOptions& global)
                     "stray samples or flipped normals), as reconstruct does; default: 0.1% of "
                     "the samples, at least 32; 0 keeps every component")
         ->check(CLI::NonNegativeNumber);
+    add_max_handle_option(*cmd, options->max_handle);
     cmd->add_option("--fill-holes", options->fill_holes,
                     "Close the mesh's holes whose rim encloses at most this fraction of their "
                     "component's area with faired patches, as reconstruct does (0 keeps the "

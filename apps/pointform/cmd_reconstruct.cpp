@@ -18,19 +18,6 @@
 namespace pointform::cli {
 namespace {
 
-std::string describe_handle_cuts(const HandleCutReport& cuts, double radii)
-{
-    if (cuts.genus_before == 0)
-        return "none (genus 0)";
-    std::string text = "genus " + std::to_string(cuts.genus_before) + " -> " +
-                       std::to_string(cuts.genus_after) + ": cut " + std::to_string(cuts.cuts) +
-                       " loop" + (cuts.cuts == 1 ? "" : "s");
-    if (cuts.cuts > 0)
-        text += " (the longest " + format_number(cuts.longest_cut) + ")";
-    return text + " of at most " + format_number(cuts.max_length) + " (" + format_number(radii) +
-           " median influence radii, --max-handle), capped both sides";
-}
-
 struct ReconstructCommandOptions
 {
     std::string input;
@@ -147,12 +134,7 @@ void register_reconstruct(CLI::App& app, const GlobalOptions& global)
                     "fraction of their component's area (0 keeps every hole)")
         ->check(CLI::Range(0.0, 0.999999))
         ->capture_default_str();
-    cmd->add_option("--max-handle", options->reconstruct.max_handle,
-                    "Cut the intermediate mesh's handles whose loop is at most this many median "
-                    "influence radii long, and cap both sides (topological noise: tunnels where "
-                    "the field's sheets meet past their samples); 0 keeps every handle")
-        ->check(CLI::Range(0.0, max_handle_radii))
-        ->capture_default_str();
+    add_max_handle_option(*cmd, options->reconstruct.max_handle);
     add_rim_reach_option(*cmd, options->reconstruct.rim_reach);
     add_refine_options(*cmd, options->refine);
     auto* resolution = cmd->add_option("--resolution", options->reconstruct.resolution,

@@ -5,6 +5,7 @@
 
 #include "pointform/hermite/radius.h"
 #include "pointform/polygonize/refine.h"
+#include "pointform/report/report_json.h" // format_number
 
 #include <stdexcept>
 #include <string>
@@ -145,6 +146,34 @@ CLI::Option* add_rim_reach_option(CLI::App& cmd, double& rim_reach)
                     "(the paper's field, which extrapolates the rim's surfaces into the hole)")
         ->check(CLI::Range(1e-6, 1.0))
         ->capture_default_str();
+}
+
+CLI::Option* add_max_handle_option(CLI::App& cmd, double& max_handle)
+{
+    return cmd
+        .add_option("--max-handle", max_handle,
+                    "Cut the marching-cubes mesh's handles whose loop is at most this many "
+                    "median influence radii long, and cap both sides (topological noise: tunnels "
+                    "where the field's sheets meet past their samples); 0 keeps every handle")
+        ->check(CLI::Range(0.0, max_handle_radii))
+        ->capture_default_str();
+}
+
+std::string describe_handle_cuts(const HandleCutReport& cuts, double radii)
+{
+    if (cuts.skipped_not_manifold)
+        return "none cut (the mesh is not an oriented 2-manifold)";
+    if (cuts.genus_before == 0)
+        return "none (genus 0)";
+    const std::string bound = format_number(cuts.max_length) + " (" + format_number(radii) +
+                              " median influence radii, --max-handle)";
+    if (cuts.cuts == 0)
+        return "genus " + std::to_string(cuts.genus_before) +
+               ", no loop round a handle of at most " + bound;
+    return "genus " + std::to_string(cuts.genus_before) + " -> " +
+           std::to_string(cuts.genus_after) + ": cut " + std::to_string(cuts.cuts) + " loop" +
+           (cuts.cuts == 1 ? "" : "s") + " of at most " + bound + " (the longest " +
+           format_number(cuts.longest_cut) + "), capped both sides";
 }
 
 CLI::Option* add_rule_option(CLI::App& cmd, OrientationRule& rule, const std::string& help)

@@ -36,6 +36,13 @@ CLI::Option* add_fit_option(CLI::App& cmd, PlaneFit& fit, const std::string& hel
 /// `--rim-reach F` (PointFieldOptions::rim_reach), in (0, 1].
 CLI::Option* add_rim_reach_option(CLI::App& cmd, double& rim_reach);
 
+/// \brief --max-handle: the longest handle loop cut as topological noise, in median influence
+/// radii (ReconstructOptions::max_handle; `reconstruct` and `mc`).
+CLI::Option* add_max_handle_option(CLI::App& cmd, double& max_handle);
+
+/// \brief A line of what cut_short_handles() did, for the commands' summaries.
+[[nodiscard]] std::string describe_handle_cuts(const HandleCutReport& cuts, double radii);
+
 /// --rule hoppe|reflection.
 CLI::Option* add_rule_option(CLI::App& cmd, OrientationRule& rule, const std::string& help);
 

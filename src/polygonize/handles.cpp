@@ -6,6 +6,7 @@
 #include "pointform/core/disjoint_sets.h"
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
+#include "pointform/geometry/mesh_topology.h"
 
 #include <algorithm>
 #include <cmath>
@@ -21,6 +22,11 @@ namespace pointform {
 namespace {
 
 constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
+
+/// Rounds of cut_short_handles() at most: a round cuts up to 64 loops (the hashes' width), so
+/// 1,024 handles in all, which bounds the time a pathological mesh takes (each round rebuilds
+/// the edges and the homology basis).
+constexpr std::size_t max_cut_rounds = 16;
 
 /// The undirected edges of a manifold mesh, each with its (one or two) triangles, and the
 /// edges round each vertex in CSR form.
@@ -338,6 +344,14 @@ public:
         return best;
     }
 
+    /// The vertices the last run settled within `reach` of its seed (the seed first).
+    void settled_within(double reach, std::vector<std::uint32_t>& out) const
+    {
+        for (const std::uint32_t v : settled_list_)
+            if (distance_[v] <= reach)
+                out.push_back(v);
+    }
+
     /// The loop of a candidate this search just ran for: from the lowest common ancestor of the
     /// edge's ends down one path, across the edge and back up the other.
     MeshLoop loop(const Candidate& c, const EdgeGraph& g) const
@@ -416,11 +430,76 @@ std::vector<Candidate> candidates(const TriMesh& mesh, const EdgeGraph& g, const
     return found;
 }
 
-std::vector<std::uint32_t> every_vertex(std::size_t count)
+/// A geodesic cover: vertices in index order, each not yet within `spacing` (along the edges,
+/// away from the boundary) of one taken before it is taken. Every interior vertex is then within
+/// `spacing` of one of them. Serial; each vertex is reached from a few of them.
+std::vector<std::uint32_t> cover(const EdgeGraph& g, std::size_t vertex_count, double spacing)
 {
-    std::vector<std::uint32_t> all(count);
-    std::iota(all.begin(), all.end(), 0U);
-    return all;
+    std::vector<char> covered(vertex_count, 0);
+    std::vector<double> distance(vertex_count, std::numeric_limits<double>::infinity());
+    std::vector<std::uint32_t> touched;
+    std::vector<std::uint32_t> centres;
+    using Entry = std::pair<double, std::uint32_t>;
+    std::priority_queue<Entry, std::vector<Entry>, std::greater<>> heap;
+    for (std::uint32_t v = 0; v < vertex_count; ++v)
+    {
+        if (covered[v] != 0 || g.on_boundary[v] != 0 || g.offsets[v] == g.offsets[v + 1])
+            continue;
+        centres.push_back(v);
+        for (const std::uint32_t t : touched)
+            distance[t] = std::numeric_limits<double>::infinity();
+        touched.assign(1, v);
+        distance[v] = 0.0;
+        heap.emplace(0.0, v);
+        while (!heap.empty())
+        {
+            const auto [d, u] = heap.top();
+            heap.pop();
+            if (d > distance[u])
+                continue;
+            covered[u] = 1;
+            for (const std::uint32_t e : g.edges_of(u))
+            {
+                const std::uint32_t w = g.other(e, u);
+                const double dw = d + g.length[e];
+                if (g.on_boundary[w] != 0 || dw > spacing || !(dw < distance[w]))
+                    continue;
+                if (distance[w] == std::numeric_limits<double>::infinity())
+                    touched.push_back(w);
+                distance[w] = dw;
+                heap.emplace(dw, w);
+            }
+        }
+    }
+    return centres;
+}
+
+/// The seeds whose searches can find a loop of at most `max_length`. Take such a loop γ, a
+/// vertex v on it and a centre c of a cover() within `spacing` of v. The loops through c made of
+/// its shortest paths to the ends of an edge of γ sum to γ's class, so one of them is not zero,
+/// and each is at most max_length + 2 spacing and an edge long: c's search to max_length +
+/// 3 spacing finds a loop. So only the vertices within `spacing` of a centre whose search found
+/// a loop are seeds; where there is no short handle, searches from the centres alone (a few
+/// percent of the vertices) show it.
+std::vector<std::uint32_t> hot_seeds(const TriMesh& mesh, const EdgeGraph& g, const Homology& h,
+                                     double max_length)
+{
+    const std::size_t nv = mesh.vertex_count();
+    const double spacing = 0.25 * max_length;
+    const std::vector<std::uint32_t> centres = cover(g, nv, spacing);
+    const std::size_t blocks = 4 * static_cast<std::size_t>(std::max(1, thread_count()));
+    const std::size_t block = std::max<std::size_t>(64, (centres.size() + blocks - 1) / blocks);
+    std::vector<std::uint32_t> seeds = parallel_collect<std::uint32_t>(
+        centres.size(), block,
+        [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& out) {
+            Search search(nv);
+            for (std::size_t k = begin; k < end; ++k)
+                if (search.run(centres[k], g, h, max_length + 3.0 * spacing).edge != none)
+                    search.settled_within(spacing, out);
+        });
+    std::sort(seeds.begin(), seeds.end());
+    seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+    return seeds;
 }
 
 /// Z/2 row reduction over 64-bit hashes: whether `hash` is independent of those added so far
@@ -550,7 +629,7 @@ MeshLoop shortest_handle_loop(const TriMesh& mesh, double max_length)
     if (h.genus == 0)
         return {};
     const std::vector<Candidate> found =
-        candidates(mesh, g, h, every_vertex(mesh.vertex_count()), max_length);
+        candidates(mesh, g, h, hot_seeds(mesh, g, h, max_length), max_length);
     if (found.empty())
         return {};
     Search search(mesh.vertex_count());
@@ -564,12 +643,19 @@ HandleCutReport cut_short_handles(TriMesh& mesh, double max_length)
     report.max_length = max_length;
     if (mesh.face_count() == 0)
         return report;
-    // The first round searches from every vertex; a later one only from the seeds that found
+    if (!analyze_topology(mesh).is_oriented_manifold())
+    {
+        report.skipped_not_manifold = true;
+        return report;
+    }
+    // The first round searches from the hot_seeds(); a later one only from the seeds that found
     // a loop in the round before and the vertices the cuts made (a cut removes loops, and a loop
     // it makes short runs through a cap).
-    std::vector<std::uint32_t> seeds = every_vertex(mesh.vertex_count());
+    std::vector<std::uint32_t> seeds;
     for (bool first = true;; first = false)
     {
+        if (report.rounds == max_cut_rounds)
+            return report; // genus_after counts what is left
         const EdgeGraph g = edge_graph(mesh);
         const Homology h = edge_homology(mesh, g);
         if (first)
@@ -577,6 +663,8 @@ HandleCutReport cut_short_handles(TriMesh& mesh, double max_length)
         report.genus_after = h.genus;
         if (h.genus == 0 || !(max_length > 0.0))
             return report;
+        if (first)
+            seeds = hot_seeds(mesh, g, h, max_length);
         const std::vector<Candidate> found = candidates(mesh, g, h, seeds, max_length);
         if (found.empty())
             return report;
@@ -627,6 +715,7 @@ HandleCutReport cut_short_handles(TriMesh& mesh, double max_length)
             }
         }
         report.cuts += cut;
+        ++report.rounds;
         if (cut == 0)
             return report;
         seeds.clear();

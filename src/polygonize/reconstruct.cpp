@@ -118,17 +118,6 @@ std::size_t automatic_base_faces(const SemiRegularOptions& options, std::size_t 
     return std::min(faces, fit_base_faces_to_budget(target, samples));
 }
 
-/// The median of the samples' influence radii (0 without radii).
-double median_radius(const PointCloud& samples)
-{
-    std::vector<float> radii(samples.radii.begin(), samples.radii.end());
-    if (radii.empty())
-        return 0.0;
-    const auto middle = radii.begin() + static_cast<std::ptrdiff_t>(radii.size() / 2);
-    std::nth_element(radii.begin(), middle, radii.end());
-    return static_cast<double>(*middle);
-}
-
 } // namespace
 
 std::size_t base_face_target(const SemiRegularOptions& options, const TriMesh& intermediate,
@@ -374,7 +363,7 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
             options.min_component_samples ? *options.min_component_samples
                                           : default_min_component_samples(samples.size()));
         clock.lap("debris");
-        report.handles = cut_short_handles(mc.mesh, options.max_handle * median_radius(samples));
+        report.handles = cut_short_handles(mc.mesh, options.max_handle * field.median_radius());
         clock.lap("handles");
         SemiRegularOptions semi_regular = options.semi_regular;
         semi_regular.fill_holes = options.fill_holes;

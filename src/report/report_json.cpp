@@ -129,6 +129,17 @@ nlohmann::json report_json(const RefineLevelStats& s, double diagonal)
     return out;
 }
 
+nlohmann::json report_json(const HandleCutReport& handles)
+{
+    return {{"genus_before", handles.genus_before},
+            {"genus_after", handles.genus_after},
+            {"cuts", handles.cuts},
+            {"rounds", handles.rounds},
+            {"longest_cut", handles.longest_cut},
+            {"max_length", handles.max_length},
+            {"skipped_not_manifold", handles.skipped_not_manifold}};
+}
+
 nlohmann::json report_json(const BaseMeshStats& stats)
 {
     nlohmann::json out;
@@ -252,11 +263,7 @@ nlohmann::json report_json(const ReconstructReport& report, const ReconstructOpt
                          {"removed_components", report.debris.removed_components},
                          {"removed_faces", report.debris.removed_faces},
                          {"min_samples", report.debris.min_samples}};
-        out["handles"] = {{"genus_before", report.handles.genus_before},
-                          {"genus_after", report.handles.genus_after},
-                          {"cuts", report.handles.cuts},
-                          {"longest_cut", report.handles.longest_cut},
-                          {"max_length", report.handles.max_length}};
+        out["handles"] = report_json(report.handles);
     }
     else if (report.picked)
     {

@@ -118,6 +118,44 @@ TEST(McCli, HolesInTheSamplesAreClosedUnlessAsked)
         ASSERT_NEAR(mesh.vertices.world(v).norm(), 1.0, 0.02) << v;
 }
 
+TEST(McCli, ShortHandlesAreCutUnlessAsked)
+{
+    // A noisy 45° cone: the fits of its base and side reach past the rim and meet as tunnels,
+    // which mc cuts by default as reconstruct does, and keeps with --max-handle 0.
+    test::TempDir dir;
+    ASSERT_EQ(
+        run("sample cone -n 20000 --noise 0.002 --seed 2 -o " + quoted(dir / "cone.ply")).exit_code,
+        0);
+    const auto kept = run("mc " + quoted(dir / "cone.ply") + " -o " + quoted(dir / "kept.ply") +
+                          " --reestimate --max-handle 0 --json");
+    ASSERT_EQ(kept.exit_code, 0) << kept.out;
+    const auto kept_report = nlohmann::json::parse(kept.out);
+    const auto cut = run("mc " + quoted(dir / "cone.ply") + " -o " + quoted(dir / "cut.ply") +
+                         " --reestimate --json");
+    ASSERT_EQ(cut.exit_code, 0) << cut.out;
+    const auto cut_report = nlohmann::json::parse(cut.out);
+    const auto genus = [](const nlohmann::json& r) {
+        return (2 * r["components"].get<long long>() - r["euler_characteristic"].get<long long>() -
+                r["boundary_loops"].get<long long>()) /
+               2;
+    };
+    EXPECT_EQ(kept_report["handles"]["cuts"].get<int>(), 0);
+    EXPECT_EQ(kept_report["max_handle"].get<double>(), 0.0);
+    EXPECT_EQ(cut_report["max_handle"].get<double>(), 4.0);
+    const auto handles = cut_report["handles"];
+    EXPECT_EQ(handles["genus_before"], kept_report["handles"]["genus_before"]);
+    ASSERT_GT(handles["genus_before"].get<long long>(), 3) << "no tunnels: the test tests nothing";
+    EXPECT_GT(handles["cuts"].get<long long>(), handles["genus_before"].get<long long>() / 2);
+    EXPECT_FALSE(handles["skipped_not_manifold"].get<bool>());
+    EXPECT_LT(genus(cut_report), genus(kept_report));
+    EXPECT_TRUE(cut_report["manifold"].get<bool>());
+    // The human summary says so.
+    const auto text =
+        run("mc " + quoted(dir / "cone.ply") + " -o " + quoted(dir / "cut.ply") + " --reestimate");
+    ASSERT_EQ(text.exit_code, 0) << text.out;
+    EXPECT_NE(text.out.find("capped both sides"), std::string::npos) << text.out;
+}
+
 TEST(McCli, DebrisOfStraySamplesIsRemoved)
 {
     // A sphere of 6,000 points and, far off, a flat cluster of 24 strays: the field makes a
@@ -183,6 +221,8 @@ TEST(McCli, BadOptionsAndInputsFailCleanly)
         {"mc " + bunny + " -o " + quoted(output) + " --rim-reach 1.5", "--rim-reach"},
         {"mc " + bunny + " -o " + quoted(output) + " --fill-holes 1", "--fill-holes"},
         {"mc " + bunny + " -o " + quoted(output) + " --fill-holes -0.1", "--fill-holes"},
+        {"mc " + bunny + " -o " + quoted(output) + " --max-handle -1", "--max-handle"},
+        {"mc " + bunny + " -o " + quoted(output) + " --max-handle 65", "--max-handle"},
         {"mc " + bunny + " -o " + quoted(output) + " --min-component-samples -1",
          "--min-component-samples"},
         {"mc " + bunny + " -o " + quoted(output) + " --cell 1e-9", "cells along an axis"},

@@ -167,6 +167,7 @@ TEST(Handles, CutsTheThinHandleAndKeepsTheThickOne)
     EXPECT_EQ(report.genus_before, 3U);
     EXPECT_EQ(report.genus_after, 1U);
     ASSERT_EQ(report.cuts, 2U);
+    EXPECT_EQ(report.rounds, 1U); // independent loops, clear of each other: one round
     ASSERT_EQ(report.lengths.size(), 2U);
     // Shortest first.
     EXPECT_NEAR(report.lengths[0], polygon(0.05, 16), 1e-5);
@@ -206,6 +207,22 @@ TEST(Handles, NothingIsCutWithoutALengthOrAHandle)
     TriMesh empty;
     EXPECT_EQ(cut_short_handles(empty, 1.0).cuts, 0U);
     EXPECT_TRUE(shortest_handle_loop(empty, 1.0).vertices.empty());
+}
+
+TEST(Handles, ANonManifoldMeshIsLeftAsItIs)
+{
+    // A torus with a fin: a triangle on one of its edges makes that edge's third.
+    TriMesh mesh;
+    add_torus(mesh, Vec3d::Zero(), 1.0, 0.05, 120, 16);
+    const Triangle& t = mesh.triangles.front();
+    mesh.vertices.positions.emplace_back(2.0f, 2.0f, 2.0f);
+    mesh.triangles.push_back({t[0], t[1], static_cast<std::uint32_t>(mesh.vertex_count() - 1)});
+    const TriMesh before = mesh;
+    const HandleCutReport report = cut_short_handles(mesh, 1.0);
+    EXPECT_TRUE(report.skipped_not_manifold);
+    EXPECT_EQ(report.cuts, 0U);
+    EXPECT_EQ(mesh.triangles, before.triangles);
+    EXPECT_EQ(mesh.vertices.positions, before.vertices.positions);
 }
 
 TEST(Handles, TheSameCutsWhateverTheThreadCount)

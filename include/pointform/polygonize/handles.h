@@ -39,6 +39,11 @@ struct HandleCutReport
     std::size_t cuts = 0;         ///< loops cut (each removes one handle)
     double longest_cut = 0.0;     ///< the length of the longest loop cut
     std::vector<double> lengths;  ///< every cut loop's length, in the order cut
+    /// Rounds that cut (each cuts up to 64 independent loops, then the basis is made again); at
+    /// most 16, so at most 1,024 cuts, after which genus_after counts the handles left.
+    std::size_t rounds = 0;
+    /// The mesh was not an oriented 2-manifold, and nothing was cut.
+    bool skipped_not_manifold = false;
     double max_length = 0.0;      ///< the longest loop that could be cut
 };
 
@@ -48,8 +53,11 @@ struct HandleCutReport
 /// loop round it of at most `max_length`. Handles are tunnels and bridges far smaller than the
 /// shape: where fits of two sheets meet past their samples (a sharp rim under noise, a step of
 /// a scan) the field's zero set joins them with a tube that a surface of the scanned object does
-/// not have. Loops through boundary vertices are not cut. Deterministic (no threads).
-/// \pre `mesh` is an oriented 2-manifold
+/// not have. Loops through boundary vertices are not cut. The searches run in parallel; the
+/// result is the same whatever the thread count.
+/// A mesh that is not an oriented 2-manifold is left as it is (HandleCutReport::
+/// skipped_not_manifold).
 HandleCutReport cut_short_handles(TriMesh& mesh, double max_length);
+
 
 } // namespace pointform

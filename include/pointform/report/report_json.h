@@ -49,6 +49,10 @@ inline constexpr const char* hausdorff_definition =
 /// \brief The automatic base mesh's figures (BaseMeshStats), its "source" "automatic".
 [[nodiscard]] nlohmann::json report_json(const BaseMeshStats& stats);
 
+/// \brief The short handles cut (cut_short_handles()): genus before and after, cuts, rounds,
+/// the longest loop cut and the bound.
+[[nodiscard]] nlohmann::json report_json(const HandleCutReport& handles);
+
 /// \brief A semi-regular mesh's report: the samples, the sampling density and the definitions,
 /// the levels from the base (level 0) up, a dropped level, the stop and its reason, the
 /// predictor and relaxation of `options`, and the automatic base mesh when there is one.
