@@ -44,7 +44,7 @@ struct HandleCutReport
     std::size_t rounds = 0;
     /// The mesh was not an oriented 2-manifold, and nothing was cut.
     bool skipped_not_manifold = false;
-    double max_length = 0.0;      ///< the longest loop that could be cut
+    double max_length = 0.0; ///< the longest loop that could be cut
 };
 
 /// \brief Topological noise removal (Guskov and Wood 2001): cuts `mesh` along its short
@@ -58,6 +58,5 @@ struct HandleCutReport
 /// A mesh that is not an oriented 2-manifold is left as it is (HandleCutReport::
 /// skipped_not_manifold).
 HandleCutReport cut_short_handles(TriMesh& mesh, double max_length);
-
 
 } // namespace pointform
