@@ -278,9 +278,11 @@ public:
           settled_(vertex_count, 0)
     {}
 
-    /// The shortest non-separating loop through `seed` within `max_length` (an edge between two
-    /// vertices within max_length / 2, neither's tree edge, whose loop's hash is not zero).
-    Candidate run(std::uint32_t seed, const EdgeGraph& g, const Homology& h, double max_length)
+    /// Settles the vertices within `reach` of `seed` (along the edges, boundary vertices left
+    /// out), each with its distance, its tree edge and, given `edge_hash`, the XOR of the hashes
+    /// of its path from the seed.
+    void grow(std::uint32_t seed, const EdgeGraph& g, double reach,
+              std::span<const std::uint64_t> edge_hash)
     {
         for (const std::uint32_t v : touched_)
         {
@@ -290,14 +292,12 @@ public:
             settled_[v] = 0;
         }
         touched_.clear();
-        const double reach = 0.5 * max_length;
+        settled_list_.clear();
         using Entry = std::pair<double, std::uint32_t>;
         std::priority_queue<Entry, std::vector<Entry>, std::greater<>> heap;
         distance_[seed] = 0.0;
         touched_.push_back(seed);
         heap.emplace(0.0, seed);
-        std::vector<std::uint32_t>& settled_list = settled_list_;
-        settled_list.clear();
         while (!heap.empty())
         {
             const auto [d, u] = heap.top();
@@ -305,7 +305,7 @@ public:
             if (settled_[u] != 0 || d > distance_[u])
                 continue;
             settled_[u] = 1;
-            settled_list.push_back(u);
+            settled_list_.push_back(u);
             for (const std::uint32_t e : g.edges_of(u))
             {
                 const std::uint32_t w = g.other(e, u);
@@ -318,10 +318,19 @@ public:
                     touched_.push_back(w);
                 distance_[w] = dw;
                 parent_edge_[w] = e;
-                hash_[w] = hash_[u] ^ h.hash[e];
+                if (!edge_hash.empty())
+                    hash_[w] = hash_[u] ^ edge_hash[e];
                 heap.emplace(dw, w);
             }
         }
+    }
+
+    /// The shortest non-separating loop through `seed` within `max_length` (an edge between two
+    /// vertices within max_length / 2, neither's tree edge, whose loop's hash is not zero).
+    Candidate run(std::uint32_t seed, const EdgeGraph& g, const Homology& h, double max_length)
+    {
+        grow(seed, g, 0.5 * max_length, h.hash);
+        const std::vector<std::uint32_t>& settled_list = settled_list_;
         Candidate best;
         best.seed = seed;
         for (const std::uint32_t u : settled_list)
@@ -436,40 +445,19 @@ std::vector<Candidate> candidates(const TriMesh& mesh, const EdgeGraph& g, const
 std::vector<std::uint32_t> cover(const EdgeGraph& g, std::size_t vertex_count, double spacing)
 {
     std::vector<char> covered(vertex_count, 0);
-    std::vector<double> distance(vertex_count, std::numeric_limits<double>::infinity());
-    std::vector<std::uint32_t> touched;
     std::vector<std::uint32_t> centres;
-    using Entry = std::pair<double, std::uint32_t>;
-    std::priority_queue<Entry, std::vector<Entry>, std::greater<>> heap;
+    std::vector<std::uint32_t> reached;
+    Search search(vertex_count);
     for (std::uint32_t v = 0; v < vertex_count; ++v)
     {
         if (covered[v] != 0 || g.on_boundary[v] != 0 || g.offsets[v] == g.offsets[v + 1])
             continue;
         centres.push_back(v);
-        for (const std::uint32_t t : touched)
-            distance[t] = std::numeric_limits<double>::infinity();
-        touched.assign(1, v);
-        distance[v] = 0.0;
-        heap.emplace(0.0, v);
-        while (!heap.empty())
-        {
-            const auto [d, u] = heap.top();
-            heap.pop();
-            if (d > distance[u])
-                continue;
+        search.grow(v, g, spacing, {});
+        reached.clear();
+        search.settled_within(spacing, reached);
+        for (const std::uint32_t u : reached)
             covered[u] = 1;
-            for (const std::uint32_t e : g.edges_of(u))
-            {
-                const std::uint32_t w = g.other(e, u);
-                const double dw = d + g.length[e];
-                if (g.on_boundary[w] != 0 || dw > spacing || !(dw < distance[w]))
-                    continue;
-                if (distance[w] == std::numeric_limits<double>::infinity())
-                    touched.push_back(w);
-                distance[w] = dw;
-                heap.emplace(dw, w);
-            }
-        }
     }
     return centres;
 }
@@ -532,8 +520,7 @@ private:
 
 /// Cuts the mesh along a simple loop of interior vertices and caps both sides. \return false
 /// (mesh untouched) if a vertex's fan does not run from one loop edge to the other.
-bool cut_and_cap(TriMesh& mesh, const MeshLoop& loop,
-                 const std::vector<std::vector<std::uint32_t>>& faces_of)
+bool cut_and_cap(TriMesh& mesh, const MeshLoop& loop, const VertexFans& fans)
 {
     const std::size_t k = loop.vertices.size();
     if (k < 3)
@@ -549,7 +536,7 @@ bool cut_and_cap(TriMesh& mesh, const MeshLoop& loop,
         const std::uint32_t prev = loop.vertices[(i + k - 1) % k];
         auto face_from = [&](std::uint32_t a) -> std::pair<std::uint32_t, std::uint32_t> {
             // The face holding the halfedge v → a, and its third vertex.
-            for (const std::uint32_t f : faces_of[v])
+            for (const std::uint32_t f : fans.faces_of(v))
             {
                 const Triangle& t = mesh.triangles[f];
                 for (int c = 0; c < 3; ++c)
@@ -562,14 +549,14 @@ bool cut_and_cap(TriMesh& mesh, const MeshLoop& loop,
         for (std::size_t step = 0;; ++step)
         {
             const auto [f, b] = face_from(a);
-            if (f == none || step > faces_of[v].size())
+            if (f == none || step > fans.faces_of(v).size())
                 return false;
             left[i].push_back(f);
             if (b == prev)
                 break;
             a = b;
         }
-        if (left[i].size() >= faces_of[v].size())
+        if (left[i].size() >= fans.faces_of(v).size())
             return false; // the sweep took every face: not a loop through v's interior
     }
     PointCloud& points = mesh.vertices;
@@ -677,10 +664,6 @@ HandleCutReport cut_short_handles(TriMesh& mesh, double max_length)
             return report;
         // Shortest first, each independent of those taken (so the cuts together split
         // nothing) and clear of them by a ring (so no vertex is on two loops).
-        std::vector<std::vector<std::uint32_t>> faces_of(mesh.vertex_count());
-        for (std::size_t f = 0; f < mesh.face_count(); ++f)
-            for (const std::uint32_t v : mesh.triangles[f])
-                faces_of[v].push_back(static_cast<std::uint32_t>(f));
         std::vector<char> blocked(mesh.vertex_count(), 0);
         Basis basis;
         Search search(mesh.vertex_count());
@@ -709,12 +692,13 @@ HandleCutReport cut_short_handles(TriMesh& mesh, double max_length)
             taken.push_back(std::move(loop));
         }
         const std::size_t old_count = mesh.vertex_count();
+        const VertexFans fans = vertex_fans(mesh.triangles, old_count);
         std::size_t cut = 0;
         for (const MeshLoop& loop : taken)
         {
-            // Faces keep their index through a cut (the caps are appended), so the lists stay
+            // Faces keep their index through a cut (the caps are appended), so the fans stay
             // right for the other loops, whose vertices no cut touched.
-            if (cut_and_cap(mesh, loop, faces_of))
+            if (cut_and_cap(mesh, loop, fans))
             {
                 ++cut;
                 report.longest_cut = std::max(report.longest_cut, loop.length);
