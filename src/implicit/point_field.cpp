@@ -549,22 +549,6 @@ double cut_of_disc_centroid(double c)
 /// cos 30°: a neighbour whose normal turns further sets off crease_normal()'s refit.
 constexpr float crease_turn_cosine = 0.8660254F;
 
-/// A neighbour whose normal turns from a sample's by more than this faces away: the other side
-/// of a thin wall, which bounds nothing, not the other face of a crease (crease_normal(),
-/// crease_limit()). Under noise 120° (cos −0.5): a thin part's two sides, a tube narrower
-/// than the neighbourhood, turn their noisy normals by that much, and taking them for faces
-/// moved the simulated teapot scan 3's Chamfer 0.130 -> 0.137% of the diagonal, spot scan 1's
-/// 0.121 -> 0.125% and the noisy 100k plate's Hausdorff 0.83 -> 1.04% (at 143°).
-constexpr float noisy_away_cosine = -0.5F;
-/// ... and in a clean cloud 143° (cos −0.8), so that a wedge of 37° or more is a crease: the
-/// 45° rim of a cone, whose faces' normals turn by 135°. Taken for two sides of a wall, neither
-/// face's samples bounded the other's: beyond the rim the base's planes ran on over the side
-/// and the side's under the base, and their blend left sheets of inside past the edge, 0.02
-/// deep (an influence radius 0.029); on the clean 100k cone (`pointform sample cone`) marching
-/// cubes of the field had 38 components and 169 boundary loops, with the planes bounded 4 and 109
-/// (the rest at the edge itself, see the README).
-constexpr float clean_away_cosine = -0.8F;
-
 /// How far past its crease line a sample leaves the blend's samples that hold (and joins
 /// those past their lines), as a fraction of the blend's bandwidth (PointField::Impl::
 /// evaluate_with()). Leaving at once made the field jump where a query crossed a line. Measured
@@ -746,14 +730,15 @@ struct CreaseFit
 Eigen::Vector4f crease_limit(const CreaseNeighbourhood& hood,
                              std::span<const std::uint32_t> neighbors,
                              std::span<const Vec3f> normals, const Vec3f& normal, double cut,
-                             float away, Eigen::Vector4f* other_plane)
+                             Eigen::Vector4f* other_plane)
 {
     const Vec3d n = normal.cast<double>();
     const Vec3d t1 = tangent_of(normal).cast<double>();
     const Vec3d t2 = n.cross(t1);
     // Off the plane by more than `beyond` and not facing away: the other face's.
     const auto other_face = [&](std::size_t j, double beyond) {
-        return std::abs(hood.x[j].dot(n)) > beyond && normals[neighbors[j]].dot(normal) > away;
+        return std::abs(hood.x[j].dot(n)) > beyond &&
+               normals[neighbors[j]].cast<double>().dot(n) > -0.5;
     };
     Eigen::Vector2d sum = Eigen::Vector2d::Zero();
     std::size_t inliers = 0;
@@ -968,12 +953,11 @@ CreaseFit crease_normal(std::span<const Vec3f> positions, std::span<const Vec3f>
     // them less (7° on the tube of the 100k torus of bench/peers), though it may leave
     // residuals off the plane that look like outliers (the tube's curvature along one
     // direction only).
-    const float away = clean ? clean_away_cosine : noisy_away_cosine;
     bool turned = false;
     for (std::size_t j = 1; j < hood.count && !turned; ++j)
     {
         const float cosine = normals[neighbors[j]].dot(normal);
-        turned = cosine < crease_turn_cosine && cosine > away;
+        turned = cosine < crease_turn_cosine && cosine > -0.5F;
     }
     const Vec3d original = normal.cast<double>();
     if (!turned)
@@ -999,7 +983,7 @@ CreaseFit crease_normal(std::span<const Vec3f> positions, std::span<const Vec3f>
         for (std::size_t j = 1; j < hood.count; ++j)
         {
             const float cosine = normals[neighbors[j]].dot(from);
-            if (cosine > away && cosine < furthest_cosine)
+            if (cosine > -0.5F && cosine < furthest_cosine)
             {
                 furthest_cosine = cosine;
                 furthest = j;
@@ -1051,20 +1035,9 @@ CreaseFit crease_normal(std::span<const Vec3f> positions, std::span<const Vec3f>
     }
     if (!best || (!outliers && !hood.has_outliers(*fits[*best])))
         return {normal};
-    Vec3d fitted = fits[*best]->normalized();
-    if (clean)
-    {
-        // The plane faces the way the neighbours it holds do: a sample on a wedge's edge whose
-        // plane is the other face's, signed like its own normal, faced into the wedge.
-        Vec3d facing = Vec3d::Zero();
-        for (std::size_t j = 0; j < hood.count; ++j)
-            if (std::abs(hood.x[j].dot(fitted)) <= cuts[*best])
-                facing += normals[neighbors[j]].cast<double>();
-        if (facing.dot(fitted) < 0.0)
-            fitted = -fitted;
-    }
+    const Vec3d fitted = fits[*best]->normalized();
     CreaseFit out{fitted.cast<float>()};
-    out.crease = crease_limit(hood, neighbors, normals, out.normal, cuts[*best], away,
+    out.crease = crease_limit(hood, neighbors, normals, out.normal, cuts[*best],
                               clean ? &out.other : nullptr);
     return out;
 }
