@@ -148,6 +148,17 @@ def _signed_distance(shape: str, p: np.ndarray) -> np.ndarray:
     if shape == "part":
         value = np.min([_primitive_sdf(q, p) for q in PART_ADDED], axis=0)
         return np.maximum(value, -np.min([_primitive_sdf(q, p) for q in PART_REMOVED], axis=0))
+    if shape == "cone":
+        # Shape::Cone, in the half-plane (rho, z) round its axis: the triangle (0, 0), (1, 0),
+        # (0, 1), whose edge on the axis is no surface: the base z = 0 for rho <= 1 and the side
+        # rho + z = 1.
+        rho = np.hypot(p[:, 0], p[:, 1])
+        z = p[:, 2]
+        base = np.where(rho <= 1.0, np.abs(z), np.hypot(rho - 1.0, z))
+        t = np.clip((1.0 - rho + z) / 2.0, 0.0, 1.0)
+        side = np.hypot(rho - (1.0 - t), z - t)
+        inside = (z > 0.0) & (rho + z < 1.0)
+        return np.where(inside, -1.0, 1.0) * np.minimum(base, side)
     raise ValueError(shape)
 
 

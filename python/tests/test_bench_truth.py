@@ -14,7 +14,7 @@ from conftest import ROOT, run_cli
 sys.path.insert(0, os.path.join(ROOT, "bench", "peers"))
 
 
-@pytest.mark.parametrize("shape", ["sphere", "torus", "blobby", "part", "plate"])
+@pytest.mark.parametrize("shape", ["sphere", "torus", "blobby", "part", "plate", "cone"])
 def test_analytic_truth_normals_are_the_samples_exact_normals(shape, tmp_path):
     pytest.importorskip("open3d")
     from plyio import read_ply
@@ -31,6 +31,14 @@ def test_analytic_truth_normals_are_the_samples_exact_normals(shape, tmp_path):
     # both faces: a few samples in 20,000 at most.
     assert np.mean(dots > 0.999) > 0.995
     assert np.all(dots > 0.0)
+    # The samples lie on the surface the signed distance measures (float positions), and a
+    # step of 10⁻³ along their normals leaves them that far outside (within the rounding and
+    # where a crease or rim is nearer than the step).
+    from run_surface_bench import _signed_distance
+    assert np.max(np.abs(_signed_distance(shape, points))) < 1e-5 * diag
+    step = 1e-3 * diag
+    outside = _signed_distance(shape, points + step * exact)
+    assert np.mean(np.abs(outside - step) < 1e-2 * step) > 0.99
 
 
 def test_mesh_truth_normals_and_an_inside_out_copy():
