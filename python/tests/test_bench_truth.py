@@ -18,7 +18,7 @@ sys.path.insert(0, os.path.join(ROOT, "bench", "peers"))
 def test_analytic_truth_normals_are_the_samples_exact_normals(shape, tmp_path):
     pytest.importorskip("open3d")
     from plyio import read_ply
-    from run_surface_bench import true_normals
+    from run_surface_bench import _signed_distance, true_normals
 
     path = tmp_path / "samples.ply"
     run_cli("sample", shape, "-n", 20000, "--seed", 3, "-o", path)
@@ -34,7 +34,6 @@ def test_analytic_truth_normals_are_the_samples_exact_normals(shape, tmp_path):
     # The samples lie on the surface the signed distance measures (float positions), and a
     # step of 10⁻³ along their normals leaves them that far outside (within the rounding and
     # where a crease or rim is nearer than the step).
-    from run_surface_bench import _signed_distance
     assert np.max(np.abs(_signed_distance(shape, points))) < 1e-5 * diag
     step = 1e-3 * diag
     outside = _signed_distance(shape, points + step * exact)

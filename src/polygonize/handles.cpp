@@ -330,10 +330,9 @@ public:
     Candidate run(std::uint32_t seed, const EdgeGraph& g, const Homology& h, double max_length)
     {
         grow(seed, g, 0.5 * max_length, h.hash);
-        const std::vector<std::uint32_t>& settled_list = settled_list_;
         Candidate best;
         best.seed = seed;
-        for (const std::uint32_t u : settled_list)
+        for (const std::uint32_t u : settled_list_)
             for (const std::uint32_t e : g.edges_of(u))
             {
                 const std::uint32_t w = g.other(e, u);
@@ -352,6 +351,9 @@ public:
             }
         return best;
     }
+
+    /// The vertices the last grow() settled (all within its reach; the seed first).
+    [[nodiscard]] std::span<const std::uint32_t> settled() const { return settled_list_; }
 
     /// The vertices the last run settled within `reach` of its seed (the seed first).
     void settled_within(double reach, std::vector<std::uint32_t>& out) const
@@ -446,7 +448,6 @@ std::vector<std::uint32_t> cover(const EdgeGraph& g, std::size_t vertex_count, d
 {
     std::vector<char> covered(vertex_count, 0);
     std::vector<std::uint32_t> centres;
-    std::vector<std::uint32_t> reached;
     Search search(vertex_count);
     for (std::uint32_t v = 0; v < vertex_count; ++v)
     {
@@ -454,9 +455,7 @@ std::vector<std::uint32_t> cover(const EdgeGraph& g, std::size_t vertex_count, d
             continue;
         centres.push_back(v);
         search.grow(v, g, spacing, {});
-        reached.clear();
-        search.settled_within(spacing, reached);
-        for (const std::uint32_t u : reached)
+        for (const std::uint32_t u : search.settled())
             covered[u] = 1;
     }
     return centres;
