@@ -943,6 +943,8 @@ bool convex_edge(const CreaseNeighbourhood& hood, std::span<const std::uint32_t>
     for (std::size_t c = 0; c < hood.count; ++c)
     {
         const Vec3d n = c == 0 ? normal.cast<double>() : normals[neighbors[c]].cast<double>();
+        if (!(n.squaredNorm() > 0.5)) // a sample without a normal bounds nothing
+            continue;
         bool under = true;
         for (std::size_t j = 0; j < hood.count && under; ++j)
             under = hood.x[j].dot(n) <= tolerance;
