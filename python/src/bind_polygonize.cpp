@@ -354,7 +354,7 @@ void bind_polygonize(py::module_& m)
         "resolution=0, cell=0.0, min_component_samples=None, base_mesh=None, base_triangles=None, "
         "k=16, "
         "radius_scale=1.5, predictor=..., relax_iterations=..., relaxation=..., fill_holes=0.05, "
-        "rim_reach=0.25, denoise_rounds=10, hole_fairing=True, max_handle=4.0) "
+        "rim_reach=0.25, denoise_rounds=10, hole_fairing=True, max_handle=6.0) "
         "-> Hierarchy\n\n"
         "Points to a semi-regular multiresolution mesh (paper §5), as `pointform reconstruct` "
         "does, with the same defaults and the same result: surfels (pointform.surfels() with "

@@ -4,6 +4,7 @@
 // `pointform mc` end to end: raw points and surfels in, a mesh and its report out.
 
 #include "pointform/geometry/mesh_topology.h"
+#include "pointform/polygonize/reconstruct.h"
 #include "pointform/io/io.h"
 
 #include "cli_run.h"
@@ -141,7 +142,7 @@ TEST(McCli, ShortHandlesAreCutUnlessAsked)
     };
     EXPECT_EQ(kept_report["handles"]["cuts"].get<int>(), 0);
     EXPECT_EQ(kept_report["max_handle"].get<double>(), 0.0);
-    EXPECT_EQ(cut_report["max_handle"].get<double>(), 4.0);
+    EXPECT_EQ(cut_report["max_handle"].get<double>(), pointform::default_max_handle);
     const auto handles = cut_report["handles"];
     EXPECT_EQ(handles["genus_before"], kept_report["handles"]["genus_before"]);
     ASSERT_GT(handles["genus_before"].get<long long>(), 3) << "no tunnels: the test tests nothing";

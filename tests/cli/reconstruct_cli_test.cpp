@@ -152,7 +152,7 @@ TEST(ReconstructCli, AHighGenusScanStillFillsItsVertexBudget)
     EXPECT_TRUE(report["base_mesh"]["topology_kept"].get<bool>());
     EXPECT_EQ(report["handles"]["cuts"].get<std::size_t>(), 0U);
 
-    // By default the short handles (loops of at most 4 median influence radii, among the
+    // By default the short handles (loops of at most 6 median influence radii, among the
     // trees) are cut before the base mesh, and the budget is still filled.
     const auto d = run("reconstruct " + quoted(test::data_path("lidar/4_6_crop.las")) + " -o " +
                        quoted(output) + " --json");
