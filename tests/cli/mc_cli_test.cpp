@@ -4,8 +4,8 @@
 // `pointform mc` end to end: raw points and surfels in, a mesh and its report out.
 
 #include "pointform/geometry/mesh_topology.h"
-#include "pointform/polygonize/reconstruct.h"
 #include "pointform/io/io.h"
+#include "pointform/polygonize/reconstruct.h"
 
 #include "cli_run.h"
 #include "support/test_support.h"
