@@ -847,7 +847,7 @@ Eigen::Vector4f crease_limit(const CreaseNeighbourhood& hood,
         if (solver->eigenvalues()[1] > 4.0 * solver->eigenvalues()[0] && turn < 0.866 &&
             reach > 0.0 && along.dot(d) > 0.0)
         {
-            if (along.dot(d) < crease_turn_cosine)
+            if (along.dot(d) < static_cast<double>(crease_turn_cosine))
             {
                 limit = t;
                 direction = Eigen::Vector2d(along.dot(t1), along.dot(t2));
