@@ -470,6 +470,21 @@ TEST(PointField, CreaseFitsMeetTheFacesAtCreasesAndLeaveSmoothSurfacesAlone)
     EXPECT_EQ(runs[0], runs[2]);
 }
 
+/// Turns each of `normals` to the side of `truth`'s (one per normal); returns how many it turned.
+std::size_t turn_to_the_truth(std::vector<Vec3f>& normals, const std::vector<Vec3f>& truth)
+{
+    std::size_t flipped = 0;
+    for (std::size_t i = 0; i < normals.size(); ++i)
+    {
+        if (normals[i].dot(truth[i]) < 0.0F)
+        {
+            normals[i] = -normals[i];
+            ++flipped;
+        }
+    }
+    return flipped;
+}
+
 /// The surfels of raw points (normals estimated), each normal turned to the side of `truth`'s
 /// (the solid's outward normals, one per raw point): the orientation must have agreed with it
 /// everywhere or nowhere. Unturned if the surfels are not one per point (the caller asserts it).
@@ -479,15 +494,7 @@ PointCloud oriented_as_the_solid(const PointCloud& raw, const std::vector<Vec3f>
     PointCloud surfels = compute_surfels(raw, options).surfels;
     if (surfels.size() != truth.size())
         return surfels;
-    std::size_t flipped = 0;
-    for (std::size_t i = 0; i < surfels.size(); ++i)
-    {
-        if (surfels.normals[i].dot(truth[i]) < 0.0F)
-        {
-            surfels.normals[i] = -surfels.normals[i];
-            ++flipped;
-        }
-    }
+    const std::size_t flipped = turn_to_the_truth(surfels.normals, truth);
     EXPECT_TRUE(flipped == 0 || flipped == surfels.size()) << flipped << " flipped";
     return surfels;
 }
@@ -693,9 +700,7 @@ TEST(PointField, WedgeEdgeIsACreaseNotTheTwoSidesOfAWall)
     // sharp is not this test's: some 300 of its 7,200 samples come out the other way).
     PointCloud surfels = compute_surfels(raw, {.radius_scale = default_field_radius_scale}).surfels;
     ASSERT_EQ(surfels.size(), raw.size());
-    for (std::size_t i = 0; i < surfels.size(); ++i)
-        if (surfels.normals[i].dot(truth[i]) < 0.0F)
-            surfels.normals[i] = -surfels.normals[i];
+    turn_to_the_truth(surfels.normals, truth);
     const PointField field(surfels);
     // The larger of the two faces' signed distances: the truth's sign, and outside no more
     // than its distance.
