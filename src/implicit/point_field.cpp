@@ -5,6 +5,7 @@
 
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
+#include "pointform/hermite/crease_fit.h"
 #include "pointform/spatial/feature_grid.h"
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/point_grid.h"
@@ -139,6 +140,12 @@ std::string_view to_string(PlaneFit fit)
 namespace {
 
 using detail::BlendSums;
+using detail::clean_cloud;
+using detail::crease_plane;
+using detail::crease_turn_cosine;
+using detail::CreaseNeighbourhood;
+using detail::CreasePlane;
+using detail::flatness;
 using detail::PackedSurfel;
 
 } // namespace
@@ -546,25 +553,6 @@ double cut_of_disc_centroid(double c)
     return lo;
 }
 
-/// cos 30°: a neighbour whose normal turns further sets off crease_normal()'s refit.
-constexpr float crease_turn_cosine = 0.8660254F;
-
-/// A neighbour whose normal turns from a sample's by more than 120° (cos −0.5) faces away: the
-/// other side of a thin wall, which bounds nothing, not the other face of a crease
-/// (crease_normal(), crease_limit()). Under noise a thin part's two sides, a tube narrower than
-/// the neighbourhood, turn their normals by that much: taking neighbours turned up to 143° for
-/// faces in every cloud moved the simulated teapot scan 3's Chamfer 0.130 -> 0.137% of the
-/// diagonal, spot scan 1's 0.121 -> 0.125% and the noisy 100k plate's Hausdorff 0.83 -> 1.04%.
-constexpr float wall_cosine = -0.5F;
-
-/// ... except at the edge of a clean cloud's convex wedge (convex_edge()), where faces turned up
-/// to 143° (cos −0.8) are a crease: a wedge of 37° or more, as the 45° rim of a cone, whose
-/// faces' normals turn by 135°. Taken for two sides of a wall, neither face's samples bounded the
-/// other's: past the rim the base's planes ran on over the side and the side's under the base,
-/// sheets of inside 0.02 deep (an influence radius 0.029) beside the edge, and on the clean 100k
-/// cone (`pointform sample cone`, raw points) marching cubes of the field had 151 boundary loops.
-constexpr float wedge_cosine = -0.8F;
-
 /// How far past its crease line a sample leaves the blend's samples that hold (and joins
 /// those past their lines), as a fraction of the blend's bandwidth (PointField::Impl::
 /// evaluate_with()). Leaving at once made the field jump where a query crossed a line. Measured
@@ -575,153 +563,6 @@ constexpr float wedge_cosine = -0.8F;
 /// 1.35 / 0.0836, bunny 3.64 / 0.0713 -> 3.66 / 0.0715 (0.05: 3.75 / 0.0755); the 1M clean
 /// blobby 0.088 / 0.00058 -> 0.072 / 0.00058.
 constexpr double crease_blend_width = 0.1;
-
-/// Iterations of crease_normal()'s reweighting from each start.
-constexpr int crease_iterations = 16;
-
-/// The reweighting has converged when the normal turns by less than about 1e-4 radians in an
-/// iteration (cos 1e-4 ≈ 1 − 5e-9). Four iterations at most (from a principal normal 40° off
-/// a face at the edges of the 1M clean plate of bench/peers) left planes tilted 10°, which ran
-/// 0.004 past the edge.
-constexpr double crease_converged = 1.0 - 5e-9;
-
-/// A sample's neighbours (relative to the sample) as crease_normal() weighs them: the nearest
-/// `capacity` of them where PointFieldOptions::quadric_k asks for more.
-struct CreaseNeighbourhood
-{
-    static constexpr std::size_t capacity = 256;
-    std::array<Vec3d, capacity> x;
-    std::array<double, capacity> spatial; ///< a Gaussian of half the farthest distance
-    std::size_t count = 0;
-    double floor = 0.0; ///< the least residual scale, 1e-3 of the farthest distance
-    mutable std::array<double, capacity> scratch; ///< cut()'s residuals
-    /// Whether cut() takes the residuals' scale from their lower quartile, not their median.
-    bool lower_quartile = false;
-
-    /// The cut of Tukey's biweight for the residuals of the plane through the sample with
-    /// normal n: 3 robust standard deviations (1.4826 × their median), at least 3 floor. With
-    /// lower_quartile, 3.139 × their lower quartile (where a quarter of normal residuals' sizes
-    /// lie under 0.3186 σ): a face that holds a quarter of the neighbourhood sets the scale,
-    /// where the median needs half. At a wedge's edge a sample's own face holds less than half:
-    /// from the median the refits ran to planes between the faces (on the clean 100k cone, a
-    /// base sample 0.015 from the rim took a plane turned 5° from the base's with a cut of 0.012,
-    /// another a plane turned 80°, whose field put a fin of inside under the base).
-    [[nodiscard]] double cut(const Vec3d& n) const
-    {
-        std::array<double, capacity>& residual = scratch;
-        for (std::size_t j = 0; j < count; ++j)
-            residual[j] = std::abs(x[j].dot(n));
-        const auto middle =
-            residual.begin() + static_cast<std::ptrdiff_t>(lower_quartile ? count / 4 : count / 2);
-        std::nth_element(residual.begin(), middle,
-                         residual.begin() + static_cast<std::ptrdiff_t>(count));
-        return 3.0 * std::max((lower_quartile ? 3.139 : 1.4826) * *middle, floor);
-    }
-
-    /// Whether some residual exceeds cut(n), without sorting: the largest residual r exceeds
-    /// 3 × max(1.4826 × median, floor) where it exceeds 3 floor and more than half of the
-    /// residuals lie under r / (3 × 1.4826) (then the median does).
-    [[nodiscard]] bool has_outliers(const Vec3d& n) const
-    {
-        double largest = 0.0;
-        for (std::size_t j = 0; j < count; ++j)
-        {
-            scratch[j] = std::abs(x[j].dot(n));
-            largest = std::max(largest, scratch[j]);
-        }
-        if (!(largest > 3.0 * floor))
-            return false;
-        const double median_below = largest / (3.0 * 1.4826);
-        std::size_t below = 0;
-        for (std::size_t j = 0; j < count; ++j)
-            below += scratch[j] < median_below ? 1U : 0U;
-        return below > count / 2;
-    }
-
-    [[nodiscard]] double weight(std::size_t j, const Vec3d& n, double cut) const
-    {
-        const double t = x[j].dot(n) / cut;
-        return t * t < 1.0 ? spatial[j] * (1.0 - t * t) * (1.0 - t * t) : 0.0;
-    }
-
-    /// How much of the neighbourhood the plane with normal n holds at the given cut.
-    [[nodiscard]] double support(const Vec3d& n, double cut) const
-    {
-        double sum = 0.0;
-        for (std::size_t j = 0; j < count; ++j)
-            sum += weight(j, n, cut);
-        return sum;
-    }
-
-    /// The support of a plane that held every neighbour: the spatial weights' sum.
-    [[nodiscard]] double total() const
-    {
-        double sum = 0.0;
-        for (std::size_t j = 0; j < count; ++j)
-            sum += spatial[j];
-        return sum;
-    }
-
-    /// The principal axes (eigenvalues ascending) of the neighbours weighted by w(j) (those of
-    /// weight 0 left out), about their weighted centroid, written to `centroid` if given;
-    /// nullopt where no weight is positive.
-    template <typename Weight>
-    [[nodiscard]] std::optional<Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>> principal_axes(
-        Weight w, Vec3d* centroid = nullptr) const
-    {
-        double weight_sum = 0.0;
-        Vec3d mean = Vec3d::Zero();
-        for (std::size_t j = 0; j < count; ++j)
-        {
-            const double wj = w(j);
-            if (wj == 0.0)
-                continue;
-            weight_sum += wj;
-            mean += wj * x[j];
-        }
-        if (!(weight_sum > 0.0))
-            return std::nullopt;
-        mean /= weight_sum;
-        Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-        for (std::size_t j = 0; j < count; ++j)
-        {
-            const double wj = w(j);
-            if (wj == 0.0)
-                continue;
-            const Vec3d y = x[j] - mean;
-            covariance.noalias() += wj * y * y.transpose();
-        }
-        if (centroid != nullptr)
-            *centroid = mean;
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-        solver.computeDirect(covariance);
-        return solver;
-    }
-
-    /// Iteratively reweighted least squares from `start` (signed like `sign`); nullopt where
-    /// the weighted neighbours span no plane.
-    [[nodiscard]] std::optional<Vec3d> refit(Vec3d n, const Vec3d& sign) const
-    {
-        for (int iteration = 0; iteration < crease_iterations; ++iteration)
-        {
-            const double c = cut(n);
-            std::array<double, capacity> w;
-            for (std::size_t j = 0; j < count; ++j)
-                w[j] = weight(j, n, c);
-            const auto axes = principal_axes([&](std::size_t j) { return w[j]; });
-            // A line or a point (too few weighted neighbours off a line): no plane.
-            if (!axes || !(axes->eigenvalues()[1] > 1e-6 * axes->eigenvalues()[2]) ||
-                !axes->eigenvectors().allFinite())
-                return std::nullopt;
-            const Vec3d next = axes->eigenvectors().col(0);
-            const Vec3d previous = n;
-            n = next.dot(sign) < 0.0 ? Vec3d(-next) : next;
-            if (std::abs(n.dot(previous)) > crease_converged)
-                break;
-        }
-        return n;
-    }
-};
 
 /// A sample's normal fitted to its own face, and how far its surface reaches across a crease
 /// in the blend (as rim_limit(): the direction toward the crease in the frame (t1, t2) of the
@@ -878,248 +719,20 @@ Eigen::Vector4f crease_limit(const CreaseNeighbourhood& hood,
             static_cast<float>(limit), outlier_height < 0.0 ? 1.0F : -1.0F};
 }
 
-/// How far points are from a plane, from their covariance C (eigenvalues λ0 ≤ λ1 ≤ λ2):
-/// 3 det C / (I2 tr C), I2 the sum of C's principal 2 × 2 minors: 0 on a plane, 1 for an
-/// isotropic blob, about 3 λ0 / (λ1 + λ2) when thin (as the orientation's noise test measures).
-double flatness(std::span<const Vec3f> positions, std::span<const std::uint32_t> points)
-{
-    if (points.size() < 3)
-        return 0.0;
-    Vec3d mean = Vec3d::Zero();
-    for (const std::uint32_t j : points)
-        mean += positions[j].cast<double>();
-    mean /= static_cast<double>(points.size());
-    Eigen::Matrix3d c = Eigen::Matrix3d::Zero();
-    for (const std::uint32_t j : points)
-    {
-        const Vec3d y = positions[j].cast<double>() - mean;
-        c.noalias() += y * y.transpose();
-    }
-    const double minors = c(0, 0) * c(1, 1) - c(0, 1) * c(0, 1) + c(0, 0) * c(2, 2) -
-                          c(0, 2) * c(0, 2) + c(1, 1) * c(2, 2) - c(1, 2) * c(1, 2);
-    const double denominator = minors * c.trace();
-    return denominator > 0.0 ? 3.0 * c.determinant() / denominator : 0.0;
-}
-
-/// Median flatness() of the samples' fit neighbourhoods under which a cloud counts as clean for
-/// crease_normal(): the orientation's noise threshold (orient_normals_mst()), where a disc of
-/// radius ρ with position noise σ scores about 6 σ² / ρ², so noise under about ρ / 17.
-/// Curvature scores 4e-4 to 3e-3 on the clean shapes of bench/peers, the bunny scans about
-/// 0.01; its noisy clouds 0.1 to 0.9.
-constexpr double clean_flatness = 0.02;
-
-/// Whether the median of `flatness` (one a sample of a subsample; reordered) is under
-/// clean_flatness.
-bool clean_cloud(std::vector<double>& flatness)
-{
-    if (flatness.empty())
-        return true;
-    const auto middle = flatness.begin() + static_cast<std::ptrdiff_t>(flatness.size() / 2);
-    std::nth_element(flatness.begin(), middle, flatness.end());
-    return *middle < clean_flatness;
-}
-
-/// Whether sample i (neighbourhood `hood`, normal `normal`, farthest neighbour at `reach`) is
-/// at the edge of a convex wedge: some neighbour's normal turns from its own by 120-143°
-/// (between wall_cosine and wedge_cosine), and some plane through the sample, with its own normal
-/// or a neighbour's, has every neighbour on its inner side (within 2% of the reach). Two faces
-/// that meet at a convex edge lie under a plane through it; a thin wall's two sides do too, but
-/// their normals turn by about 180°. Where two sheets cross or one sheet is doubled over another
-/// (the clean samples of data/meshes/teapot.obj, at its spout and handle) the neighbours lie on
-/// both sides of every such plane. The estimated normals by the edge are blended between the
-/// faces', so the sample's own normal alone failed the test at 4,390 of the clean cone's samples.
-bool convex_edge(const CreaseNeighbourhood& hood, std::span<const std::uint32_t> neighbors,
-                 std::span<const Vec3f> normals, const Vec3f& normal, double reach)
-{
-    bool band = false;
-    for (std::size_t j = 1; j < hood.count && !band; ++j)
-    {
-        const float cosine = normals[neighbors[j]].dot(normal);
-        band = cosine <= wall_cosine && cosine > wedge_cosine;
-    }
-    if (!band)
-        return false;
-    const double tolerance = 0.02 * reach;
-    for (std::size_t c = 0; c < hood.count; ++c)
-    {
-        const Vec3d n = c == 0 ? normal.cast<double>() : normals[neighbors[c]].cast<double>();
-        if (!(n.squaredNorm() > 0.5)) // a sample without a normal bounds nothing
-            continue;
-        bool under = true;
-        for (std::size_t j = 0; j < hood.count && under; ++j)
-            under = hood.x[j].dot(n) <= tolerance;
-        if (under)
-            return true;
-    }
-    return false;
-}
-
-/// The normal of sample i refitted to the neighbours on its own side of a crease. A principal
-/// component normal averages over every face in the neighbourhood: at a crease it tilts toward
-/// the other face (up to 54° at the corners of the 100k plate of bench/peers, and in a concave
-/// crease it can lie nearly in the surface), and the quadric fitted in its frame bends round
-/// the crease and reaches past it (a lip of half the plate's thickness beyond a corner).
-/// Where some neighbours' normals turn by more than 30° (elsewhere the normal is kept), a
-/// plane through the sample is fitted by iteratively reweighted least squares (weights falling
-/// with a neighbour's distance and with its residual, Tukey's biweight) from six starts: the
-/// normal, the middle principal direction and the two diagonals between it and the smallest
-/// (the faces of a crease whose principal normal lies between them), and the normals of two
-/// neighbours, the one turned furthest from the sample's and the one turned furthest from
-/// that (the faces' own normals, away from the crease); the plane that holds most of the
-/// neighbourhood at the tightest of their scales wins, signed like the sample's normal. A
-/// sample about a spacing from a crease, whose neighbourhood lies mostly on the other face,
-/// needs the neighbours' starts: from the others every refit ran to the plane between the
-/// faces (its cut, from the median residual, then holds both), whose quadric filled a
-/// concave groove by up to 1.4 spacings on the 1M clean blobby of bench/peers.
-/// It replaces the normal where the normal's plane leaves some neighbours off by more than 3
-/// robust standard deviations of the residuals (CreaseNeighbourhood::cut()), or, in a `clean`
-/// cloud (clean_cloud()), where the fitted plane does. A first plane that holds 90% of the
-/// neighbourhood's weight (in a clean cloud: at a cut under half the neighbourhood's reach) is
-/// taken at once: on the 100k clean part of bench/peers the other starts then doubled the
-/// field's build time for 0.5% in Chamfer. At a box's corner three faces share the
-/// neighbourhood, the principal plane fits none of them, and its residuals spread too evenly
-/// to count as outliers; its cut then spans the neighbourhood and so holds all of it: with
-/// the outlier test on the normal's plane only and the early plane taken at any cut, the
-/// corners of the 100k clean plate kept their principal normals, whose surfaces put a lip
-/// 0.025 past the corner (Hausdorff 0.86% of the diagonal against 0.38%). Under noise as
-/// large as the sampling step (the 1M noisy part of bench/peers) the same rules fitted planes
-/// to the noise (a sample 3.6 deviations off a corner tilted 65° into the next face, a dent
-/// 0.03 deep; Chamfer 0.0584% -> 0.0591% of the diagonal).
-/// Measured with a numpy prototype of this fit on the 100k clean plate and blobby of
-/// bench/peers (estimated normals, samples within 0.15 of a corner and of a concave crease):
-/// error to the nearer true face normal over 30° on 61 and 22 samples with the principal
-/// normal, 43 and 13 with one start (the normal), 21 and 4 with the four.
+/// crease_plane(), and where it refitted the normal, how far the sample's surface reaches
+/// across the crease (crease_limit()).
 CreaseFit crease_normal(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
                         std::span<const std::uint32_t> neighbors, std::size_t i,
                         const Vec3f& normal, bool clean)
 {
-    if (neighbors.size() < 10)
-        return {normal};
     CreaseNeighbourhood hood;
-    hood.count = std::min(neighbors.size(), CreaseNeighbourhood::capacity);
-    const Vec3d s = positions[i].cast<double>();
-    double far2 = 0.0;
-    for (std::size_t j = 0; j < hood.count; ++j)
-    {
-        hood.x[j] = positions[neighbors[j]].cast<double>() - s;
-        far2 = std::max(far2, hood.x[j].squaredNorm());
-    }
-    // A surface's k nearest spread as a disc (the farthest of 48 about 2.2 times as far as the
-    // tenth); a stray point's reach a surface far off past its few fellows (a cluster of 10 to
-    // 30 strays 1 to 1.5 from a sphere: 10 to 25 times), and have no face to fit.
-    const double tenth2 = hood.x[std::min<std::size_t>(10, hood.count - 1)].squaredNorm();
-    if (!(far2 > 0.0) || !(far2 <= 16.0 * tenth2))
+    const CreasePlane plane = crease_plane(hood, positions, normals, neighbors, i, normal, clean);
+    if (!plane.refitted)
         return {normal};
-    hood.floor = 1e-3 * std::sqrt(far2);
-    // A crease turns some neighbours' normals by more than 30° (and not by more than 120°,
-    // 143° at a wedge's edge: those face away, the other side of a thin wall); curvature over the
-    // neighbourhood turns them less (7° on the tube of the 100k torus of bench/peers), though it
-    // may leave residuals off the plane that look like outliers (the tube's curvature along one
-    // direction only).
-    const bool wedge = clean && convex_edge(hood, neighbors, normals, normal, std::sqrt(far2));
-    const float away = wedge ? wedge_cosine : wall_cosine;
-    hood.lower_quartile = wedge;
-    bool turned = false;
-    for (std::size_t j = 1; j < hood.count && !turned; ++j)
-    {
-        const float cosine = normals[neighbors[j]].dot(normal);
-        turned = cosine < crease_turn_cosine && cosine > away;
-    }
-    const Vec3d original = normal.cast<double>();
-    if (!turned)
-        return {normal};
-    for (std::size_t j = 0; j < hood.count; ++j)
-        hood.spatial[j] = std::exp(-hood.x[j].squaredNorm() / (0.25 * far2));
-    // Under noise a sample's plane leaves no outliers where the noise hides the crease, and
-    // the plane fitted instead is the noise's: only clean clouds go on without outliers.
-    const bool outliers = hood.has_outliers(original);
-    if (!outliers && !clean)
-        return {normal};
-
-    const auto principal = hood.principal_axes([](std::size_t) { return 1.0; });
-    const Vec3d e0 = principal->eigenvectors().col(0);
-    const Vec3d e1 = principal->eigenvectors().col(1);
-    // In clean clouds, two more starts from the neighbours' own normals, which away from the
-    // crease are their faces': the one turned furthest from the sample's (the other face, or
-    // this one where the principal normal leans to the other), and the one turned furthest from
-    // that.
-    const auto furthest_turned = [&](const Vec3f& from) {
-        std::size_t furthest = 0;
-        float furthest_cosine = 2.0F;
-        for (std::size_t j = 1; j < hood.count; ++j)
-        {
-            const float cosine = normals[neighbors[j]].dot(from);
-            if (cosine > away && cosine < furthest_cosine)
-            {
-                furthest_cosine = cosine;
-                furthest = j;
-            }
-        }
-        return normals[neighbors[furthest]];
-    };
-    Vec3d first_face = Vec3d::Constant(std::numeric_limits<double>::quiet_NaN());
-    Vec3d second_face = first_face;
-    if (clean)
-    {
-        const Vec3f first = furthest_turned(normal);
-        first_face = first.cast<double>();
-        second_face = furthest_turned(first).cast<double>();
-    }
-    std::array<Vec3d, 6> starts = {
-        original, e1, (e0 + e1).normalized(), (e0 - e1).normalized(), first_face, second_face};
-    std::array<std::optional<Vec3d>, 6> fits;
-    std::array<double, 6> cuts{};
-    double tightest = std::numeric_limits<double>::infinity();
-    for (std::size_t c = 0; c < starts.size(); ++c)
-    {
-        if (!starts[c].allFinite())
-            continue;
-        const Vec3d start = starts[c].dot(original) < 0.0 ? Vec3d(-starts[c]) : starts[c];
-        fits[c] = hood.refit(start, original);
-        if (!fits[c])
-            continue;
-        cuts[c] = hood.cut(*fits[c]);
-        tightest = std::min(tightest, cuts[c]);
-        // A plane from the normal that holds nearly the whole neighbourhood (curvature, not a
-        // crease, set off the test): the other starts would not do better.
-        if (c == 0 && (!clean || cuts[c] < 0.5 * std::sqrt(far2)) &&
-            hood.support(*fits[c], cuts[c]) >= 0.9 * hood.total())
-            break;
-    }
-    std::optional<std::size_t> best;
-    double best_support = 0.0;
-    for (std::size_t c = 0; c < fits.size(); ++c)
-    {
-        if (!fits[c])
-            continue;
-        const double support = hood.support(*fits[c], tightest);
-        if (support > best_support)
-        {
-            best = c;
-            best_support = support;
-        }
-    }
-    if (!best || (!outliers && !hood.has_outliers(*fits[*best])))
-        return {normal};
-    Vec3d fitted = fits[*best]->normalized();
-    if (clean)
-    {
-        // The plane faces the way the neighbours it holds do, not as the sample's normal: by a
-        // sharp edge that normal is a blend of the faces' and may be turned over (on the clean
-        // 100k cone 0.8% of the estimated normals, all within 0.02 of the rim), and a sample on
-        // the edge that takes the other face's plane, signed like its own normal, faced into
-        // the wedge.
-        Vec3d facing = Vec3d::Zero();
-        for (std::size_t j = 0; j < hood.count; ++j)
-            if (std::abs(hood.x[j].dot(fitted)) <= cuts[*best])
-                facing += normals[neighbors[j]].cast<double>();
-        if (facing.dot(fitted) < 0.0)
-            fitted = -fitted;
-    }
-    CreaseFit out{fitted.cast<float>()};
-    out.crease = crease_limit(hood, neighbors, normals, out.normal, cuts[*best], away,
+    CreaseFit out{plane.normal};
+    out.crease = crease_limit(hood, neighbors, normals, out.normal, plane.cut, plane.away,
                               clean ? &out.other : nullptr);
-    out.wedge = wedge && out.crease.w() > 0.0F;
+    out.wedge = plane.wedge && out.crease.w() > 0.0F;
     return out;
 }
 
