@@ -99,6 +99,7 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
         out["k"] = options.surfels.k;
         out["components"] = orientation.components;
         out["flipped"] = orientation.flipped;
+        out["crease_refits"] = result.crease_refits;
         out["degenerate"] = result.degenerate;
         out["inherited"] = orientation.inherited;
         out["unoriented"] = orientation.unoriented.size();
@@ -119,6 +120,11 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
     print_row("points", std::to_string(result.surfels.size()));
     print_row("components", std::to_string(orientation.components));
     print_row("normals flipped", std::to_string(orientation.flipped));
+    if (options.surfels.sharp_creases)
+        print_row("crease refits",
+                  std::to_string(result.crease_refits) +
+                      (result.crease_refits == 0 ? " (none at a crease, or a noisy cloud)"
+                                                 : " (normals refitted to their own face)"));
     print_row("degenerate (inherited)", std::to_string(result.degenerate));
     print_row("unoriented", std::to_string(orientation.unoriented.size()));
     print_row("isolated", std::to_string(result.isolated.size()) +
@@ -168,6 +174,7 @@ void register_normals(CLI::App& app, const GlobalOptions& global)
                     "mst (consistent, outward on closed surfaces), none, flip (mst, then "
                     "inward), towards:X,Y,Z (a viewpoint) or along:X,Y,Z (a direction)")
         ->capture_default_str();
+    add_sharp_creases_flag(*cmd, options->surfels.sharp_creases);
     add_rule_option(*cmd, options->surfels.rule,
                     "MST propagation rule: hoppe (robust to noise) or reflection (thin walls "
                     "and creases in clean data)");

@@ -195,6 +195,16 @@ void add_surfel_input_options(CLI::App& cmd, SurfelsFromSamplesOptions& options)
         "JSON file of balls and boxes that set the radius (see `pointform normals`)");
     cmd.add_flag("--reestimate", options.reestimate,
                  "Estimate and orient normals even if the input has them");
+    add_sharp_creases_flag(cmd, options.sharp_creases);
+}
+
+CLI::Option* add_sharp_creases_flag(CLI::App& cmd, bool& sharp)
+{
+    return cmd.add_flag(
+        "--sharp-creases", sharp,
+        "In a clean cloud, refit each estimated normal at a crease to its own face (by "
+        "reweighted least squares, as the field's quadrics do) instead of keeping the PCA "
+        "normal, a blend of the faces' there");
 }
 
 std::vector<CLI::Option*> add_level_options(CLI::App& cmd, SemiRegularCommandOptions& options,

@@ -25,6 +25,8 @@ CLI::Option* add_k_option(CLI::App& cmd, std::size_t& k, const std::string& help
 
 /// --radius-scale: the factor on the automatic influence radius (> 0).
 CLI::Option* add_radius_scale_option(CLI::App& cmd, double& scale, const std::string& help);
+/// --sharp-creases (SurfelOptions::sharp_creases).
+CLI::Option* add_sharp_creases_flag(CLI::App& cmd, bool& sharp);
 
 /// --radius-regions FILE: read into `regions` (read_radius_regions()) as the command line is
 /// parsed.

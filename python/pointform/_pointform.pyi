@@ -84,7 +84,12 @@ def read_points(path: _Path) -> PointCloud: ...
 def write(path: _Path, shape: PointCloud | Mesh | Hierarchy, *, ascii: bool = False) -> None: ...
 
 def surfels(
-    cloud: PointCloud, *, k: int = 16, radius_scale: float = 1.5, reestimate: bool = False
+    cloud: PointCloud,
+    *,
+    k: int = 16,
+    radius_scale: float = 1.5,
+    reestimate: bool = False,
+    sharp_creases: bool = False,
 ) -> Tuple[PointCloud, dict[str, Any]]: ...
 def surfels_from_mesh(
     mesh: Mesh, *, samples: int = 0, seed: int = 1, k: int = 16, radius_scale: float = 1.5

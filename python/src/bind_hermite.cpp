@@ -17,12 +17,13 @@ void bind_hermite(py::module_& m)
 
     m.def(
         "surfels",
-        [](const std::shared_ptr<Cloud>& cloud, std::size_t k, double radius_scale,
-           bool reestimate) {
+        [](const std::shared_ptr<Cloud>& cloud, std::size_t k, double radius_scale, bool reestimate,
+           bool sharp_creases) {
             SurfelsFromSamples result = run_interruptible([&](const ProgressCallback& progress) {
                 return surfels_from_samples(cloud->view, {.k = k,
                                                           .radius_scale = radius_scale,
                                                           .reestimate = reestimate,
+                                                          .sharp_creases = sharp_creases,
                                                           .progress = progress});
             });
             return py::make_tuple(owned_cloud(std::move(result.surfels)),
@@ -30,16 +31,20 @@ void bind_hermite(py::module_& m)
         },
         py::arg("cloud"), py::kw_only(), py::arg("k") = default_neighbors,
         py::arg("radius_scale") = default_field_radius_scale, py::arg("reestimate") = false,
-        "surfels(cloud, *, k=16, radius_scale=1.5, reestimate=False) -> (PointCloud, dict)\n\n"
+        py::arg("sharp_creases") = false,
+        "surfels(cloud, *, k=16, radius_scale=1.5, reestimate=False, sharp_creases=False) -> "
+        "(PointCloud, dict)\n\n"
         "Samples to the oriented surfels of a field (Level 1 or 2 -> 2, paper §4): raw points "
         "get PCA normals of their k nearest neighbours, oriented consistently in every "
         "connected component (minimum spanning tree), and influence radii (radius_scale times "
         "the distance to the k-th neighbour); points with normals keep them (unless "
         "reestimate) and get radii if they have none. Samples without a usable normal are left "
         "out and counted, and so are samples alone far from the rest (stray returns) and "
-        "samples at the very place of an earlier one where radii are computed. Returns the "
+        "samples at the very place of an earlier one where radii are computed. With "
+        "sharp_creases, the estimated normals of a clean cloud at its creases are refitted to "
+        "each sample's own face (`pointform normals --sharp-creases`). Returns the "
         "surfels (same origin) and a report: estimated_normals, estimated_radii, components, "
-        "flipped, degenerate, unoriented, isolated, copies. What `pointform "
+        "flipped, crease_refits, degenerate, unoriented, isolated, copies. What `pointform "
         "reconstruct` does to its input. Raises InvalidInput for fewer than k + 1 usable "
         "points, all coincident or collinear points, or k < 3 or a radius_scale not positive.");
 

@@ -3,6 +3,9 @@
 
 #include "pointform/hermite/crease_fit.h"
 
+#include "pointform/core/error.h"
+#include "pointform/core/parallel.h"
+
 #include <limits>
 
 namespace pointform::detail {
@@ -207,6 +210,54 @@ CreasePlane crease_plane(CreaseNeighbourhood& hood, std::span<const Vec3f> posit
             .cut = cuts[*best],
             .away = away,
             .wedge = wedge};
+}
+
+std::size_t refit_crease_normals(std::span<const Vec3f> positions, const KnnTable& table,
+                                 std::span<Vec3f> normals)
+{
+    const std::size_t n = positions.size();
+    PF_ASSERT(table.rows() == n && normals.size() == n);
+    // Clean: the median flatness of a fixed subsample of the rows (as the point field tests its
+    // own neighbourhoods).
+    const std::size_t stride = std::max<std::size_t>(1, n / clean_test_rows);
+    std::vector<double> flat((n + stride - 1) / stride);
+    for (std::size_t r = 0; r < flat.size(); ++r)
+        flat[r] = flatness(positions, table.neighbors(r * stride));
+    if (!clean_cloud(flat))
+        return 0;
+    const std::size_t blocks = (n + crease_refit_block - 1) / crease_refit_block;
+    // Each block's refitted normals, applied once every block has read the old ones.
+    std::vector<std::vector<std::pair<std::uint32_t, Vec3f>>> changed(blocks);
+    parallel_blocks(n, crease_refit_block, [&](std::size_t begin, std::size_t end) {
+        std::vector<std::pair<std::uint32_t, Vec3f>>& out = changed[begin / crease_refit_block];
+        std::vector<std::uint32_t> row(table.k);
+        CreaseNeighbourhood hood;
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            const Vec3f& normal = normals[i];
+            if (!(normal.squaredNorm() > 0.5F))
+                continue;
+            // The sample first, as crease_plane() reads its neighbours.
+            const std::span<const std::uint32_t> neighbors = table.neighbors(i);
+            row[0] = static_cast<std::uint32_t>(i);
+            std::size_t count = 1;
+            for (const std::uint32_t j : neighbors)
+                if (j != i && count < row.size())
+                    row[count++] = j;
+            const CreasePlane plane = crease_plane(hood, positions, normals,
+                                                   std::span(row).first(count), i, normal, true);
+            if (plane.refitted && plane.normal.allFinite())
+                out.emplace_back(static_cast<std::uint32_t>(i), plane.normal);
+        }
+    });
+    std::size_t count = 0;
+    for (const auto& block : changed)
+        for (const auto& [i, normal] : block)
+        {
+            normals[i] = normal;
+            ++count;
+        }
+    return count;
 }
 
 } // namespace pointform::detail

@@ -5,6 +5,7 @@
 
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
+#include "pointform/hermite/crease_fit.h"
 #include "pointform/hermite/normals.h"
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/spatial_sort.h"
@@ -358,6 +359,11 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
             break;
     }
     timer.lap("orientation", guide_seconds);
+    if (options.sharp_creases)
+    {
+        result.crease_refits = detail::refit_crease_normals(positions, table, oriented.normals);
+        timer.lap("creases");
+    }
 
     std::vector<float> radii = influence_radii(table, options.radius_scale);
     radii = apply_radius_regions(positions, cloud.origin, std::move(radii), options.radius_regions);

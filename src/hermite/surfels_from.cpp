@@ -73,11 +73,13 @@ SurfelsFromSamples surfels_from_samples(const PointCloudView& samples,
         SurfelResult result = compute_surfels(raw, {.k = options.k,
                                                     .radius_scale = options.radius_scale,
                                                     .radius_regions = options.radius_regions,
+                                                    .sharp_creases = options.sharp_creases,
                                                     .progress = options.progress});
         out.surfels = std::move(result.surfels);
         out.estimated_normals = true;
         out.estimated_radii = true;
         out.components = result.orientation.components;
+        out.crease_refits = result.crease_refits;
         out.flipped = result.orientation.flipped;
         out.degenerate = result.degenerate;
         out.unoriented = result.orientation.unoriented.size();

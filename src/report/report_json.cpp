@@ -96,6 +96,7 @@ nlohmann::json report_json(const SurfelsFromSamples& surfels)
             {"estimated_radii", surfels.estimated_radii},
             {"components", surfels.components},
             {"flipped", surfels.flipped},
+            {"crease_refits", surfels.crease_refits},
             {"degenerate", surfels.degenerate},
             {"unoriented", surfels.unoriented},
             {"isolated", surfels.isolated},

@@ -9,6 +9,7 @@
 /// (crease_plane()), and the tests it rests on. Internal to the library.
 
 #include "pointform/core/types.h"
+#include "pointform/spatial/neighborhoods.h"
 
 #include <Eigen/Eigenvalues>
 
@@ -265,5 +266,22 @@ struct CreasePlane
 CreasePlane crease_plane(CreaseNeighbourhood& hood, std::span<const Vec3f> positions,
                          std::span<const Vec3f> normals, std::span<const std::uint32_t> neighbors,
                          std::size_t i, const Vec3f& normal, bool clean);
+
+/// Samples a block of refit_crease_normals() takes (its parallel blocks).
+inline constexpr std::size_t crease_refit_block = 4096;
+
+/// Rows of a table whose flatness refit_crease_normals() takes the median of (every
+/// n / clean_test_rows-th).
+inline constexpr std::size_t clean_test_rows = 20000;
+
+/// \brief Refits the estimated, oriented normals of a clean cloud (clean_cloud() over the
+/// flatness of its table's rows) at its creases to each sample's own face (crease_plane() over
+/// the sample's row of `table`, the sample itself in it): a principal component normal there
+/// is a blend of the faces'. Every refit reads the normals as they were, so the result does not
+/// depend on the order or the threads. A noisy cloud keeps its normals: its planes would be
+/// fitted to the noise (crease_plane()).
+/// \return how many normals changed
+std::size_t refit_crease_normals(std::span<const Vec3f> positions, const KnnTable& table,
+                                 std::span<Vec3f> normals);
 
 } // namespace pointform::detail

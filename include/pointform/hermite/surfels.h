@@ -47,6 +47,10 @@ struct SurfelOptions
     double radius_scale = default_radius_scale;
     /// User regions that set the radius (§4.1, interactive), applied after the automatic one.
     std::vector<RadiusRegion> radius_regions;
+    /// In a clean cloud, refit each oriented normal at a crease to the sample's own face
+    /// (detail::refit_crease_normals()) instead of keeping the principal component normal, a
+    /// blend of the faces' there. Off by default (README, `normals --sharp-creases`).
+    bool sharp_creases = false;
     /// Optional progress report.
     ProgressCallback progress;
 };
@@ -59,6 +63,9 @@ struct SurfelResult
     /// Orientation outcome (components, flipped, unoriented samples); its `normals` are left
     /// empty (they are the surfels').
     OrientedNormals orientation;
+    /// Normals refitted to their own face at a crease of a clean cloud (SurfelOptions::
+    /// sharp_creases).
+    std::size_t crease_refits = 0;
     /// Samples whose neighbourhood was coincident or collinear (normal taken from a neighbour).
     std::size_t degenerate = 0;
     /// The smallest, median and largest of the surfels' radii.
@@ -71,7 +78,8 @@ struct SurfelResult
     /// and radius; surfels_from_samples() leaves the copies out.
     std::vector<std::uint32_t> copies;
     /// Wall-clock seconds by stage, in order: "check", "spatial sort" (with the copies), "kd-tree",
-    /// "knn", "normals", "orientation", "radius", "output order" (back to the input's order).
+    /// "knn", "normals", "orientation", "creases" (with SurfelOptions::sharp_creases), "radius",
+    /// "output order" (back to the input's order).
     std::vector<std::pair<std::string, double>> stage_seconds;
 };
 
@@ -103,6 +111,9 @@ struct SurfelsFromSamplesOptions
     std::vector<RadiusRegion> radius_regions;
     /// Estimate and orient normals even if the samples have them.
     bool reestimate = false;
+    /// Estimated normals at a clean cloud's creases refitted to their own face
+    /// (SurfelOptions::sharp_creases).
+    bool sharp_creases = false;
     ProgressCallback progress;
 };
 
@@ -118,6 +129,8 @@ struct SurfelsFromSamples
     /// When normals were estimated: the orientation's components and flipped normals
     /// (OrientedNormals), and the samples whose neighbourhood was degenerate.
     std::size_t components = 0;
+    /// Normals refitted at creases (SurfelsFromSamplesOptions::sharp_creases).
+    std::size_t crease_refits = 0;
     std::size_t flipped = 0;
     std::size_t degenerate = 0;
     /// Samples left out for want of a usable normal: ones that could not be oriented, or given
