@@ -129,10 +129,10 @@ struct SurfelsFromSamples
     /// When normals were estimated: the orientation's components and flipped normals
     /// (OrientedNormals), and the samples whose neighbourhood was degenerate.
     std::size_t components = 0;
-    /// Normals refitted at creases (SurfelsFromSamplesOptions::sharp_creases).
-    std::size_t crease_refits = 0;
     std::size_t flipped = 0;
     std::size_t degenerate = 0;
+    /// Normals refitted at creases (SurfelsFromSamplesOptions::sharp_creases).
+    std::size_t crease_refits = 0;
     /// Samples left out for want of a usable normal: ones that could not be oriented, or given
     /// normals that are zero or not finite.
     std::size_t unoriented = 0;
