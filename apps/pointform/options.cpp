@@ -195,11 +195,11 @@ void add_surfel_input_options(CLI::App& cmd, SurfelsFromSamplesOptions& options)
         "JSON file of balls and boxes that set the radius (see `pointform normals`)");
     cmd.add_flag("--reestimate", options.reestimate,
                  "Estimate and orient normals even if the input has them");
-    cmd.add_flag("--sharp-creases,!--no-sharp-creases", options.sharp_creases,
-                 "Where normals are estimated here (raw points, or --reestimate): in a clean "
-                 "cloud, refit each normal at a crease to its own face instead of keeping the "
-                 "PCA normal, a blend of the faces' there (see `pointform normals`). On by "
-                 "default; --no-sharp-creases keeps the PCA normals");
+    add_sharp_creases_flag(cmd, options.sharp_creases)
+        ->description(
+            "Where normals are estimated here (raw points, or --reestimate): in a clean "
+            "cloud, refit each normal at a crease to its own face instead of keeping "
+            "the PCA normal, a blend of the faces' there (see `pointform normals`)");
 }
 
 CLI::Option* add_sharp_creases_flag(CLI::App& cmd, bool& sharp)

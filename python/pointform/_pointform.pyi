@@ -89,7 +89,7 @@ def surfels(
     k: int = 16,
     radius_scale: float = 1.5,
     reestimate: bool = False,
-    sharp_creases: bool = True,
+    sharp_creases: bool = False,
 ) -> Tuple[PointCloud, dict[str, Any]]: ...
 def surfels_from_mesh(
     mesh: Mesh, *, samples: int = 0, seed: int = 1, k: int = 16, radius_scale: float = 1.5

@@ -31,8 +31,8 @@ void bind_hermite(py::module_& m)
         },
         py::arg("cloud"), py::kw_only(), py::arg("k") = default_neighbors,
         py::arg("radius_scale") = default_field_radius_scale, py::arg("reestimate") = false,
-        py::arg("sharp_creases") = true,
-        "surfels(cloud, *, k=16, radius_scale=1.5, reestimate=False, sharp_creases=True) -> "
+        py::arg("sharp_creases") = false,
+        "surfels(cloud, *, k=16, radius_scale=1.5, reestimate=False, sharp_creases=False) -> "
         "(PointCloud, dict)\n\n"
         "Samples to the oriented surfels of a field (Level 1 or 2 -> 2, paper §4): raw points "
         "get PCA normals of their k nearest neighbours, oriented consistently in every "
@@ -41,8 +41,8 @@ void bind_hermite(py::module_& m)
         "reestimate) and get radii if they have none. Samples without a usable normal are left "
         "out and counted, and so are samples alone far from the rest (stray returns) and "
         "samples at the very place of an earlier one where radii are computed. With "
-        "sharp_creases (the default), the estimated normals of a clean cloud at its creases are "
-        "refitted to each sample's own face (`pointform normals --sharp-creases`). Returns the "
+        "sharp_creases, the estimated normals of a clean cloud at its creases are refitted to "
+        "each sample's own face (`pointform normals --sharp-creases`). Returns the "
         "surfels (same origin) and a report: estimated_normals, estimated_radii, components, "
         "flipped, crease_refits, degenerate, unoriented, isolated, copies. What `pointform "
         "reconstruct` does to its input. Raises InvalidInput for fewer than k + 1 usable "

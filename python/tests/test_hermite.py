@@ -55,10 +55,8 @@ def test_surfels_are_bit_for_bit_the_clis(tmp_path, bunny_points):
     out = tmp_path / "surfels.ply"
     run_cli("normals", BUNNY_SCAN, "-o", out, "--radius-scale", 1.0, "-q")
     cli = pointform.read(out)
-    # `normals` keeps the PCA normals unless --sharp-creases; surfels(), the input of a field as
-    # `reconstruct` makes it, refits them by default.
-    surfels, report = pointform.surfels(bunny_points, radius_scale=1.0, sharp_creases=False)
-    assert report["unoriented"] == 0 and report["crease_refits"] == 0
+    surfels, report = pointform.surfels(bunny_points, radius_scale=1.0)
+    assert report["unoriented"] == 0
     assert np.array_equal(surfels.origin, cli.origin)
     assert np.array_equal(surfels.positions, cli.positions)
     assert np.array_equal(surfels.radii, cli.radii)
@@ -89,8 +87,8 @@ def box_points(n, seed=3):
 def test_sharp_creases_give_edge_samples_their_faces_normals(tmp_path):
     p, truth = box_points(12000)
     cloud = pointform.PointCloud(p)
-    blended, report = pointform.surfels(cloud, sharp_creases=False)
-    sharp, sharp_report = pointform.surfels(cloud)  # refitted by default
+    blended, report = pointform.surfels(cloud)
+    sharp, sharp_report = pointform.surfels(cloud, sharp_creases=True)
     assert report["crease_refits"] == 0 and sharp_report["crease_refits"] > 300
 
     def off(surfels, degrees):

@@ -596,12 +596,11 @@ struct CreaseFit
 /// bench/peers, with a margin of 0.25 / 0.1 / 0 of the farthest neighbour's distance beyond
 /// it, Hausdorff 1.17 / 0.91 / 0.80 % of the diagonal (0.93 with no limit), Chamfer 0.0102 /
 /// 0.0102 / 0.0101 %; the plate 1.15 / 0.88 / 0.89 (0.98). `other_plane`, unless null, gets
-/// the other face's plane at a concave crease (CreaseFit::other). `clean`: the cloud is clean
-/// (clean_cloud()).
+/// the other face's plane at a concave crease (CreaseFit::other).
 Eigen::Vector4f crease_limit(const CreaseNeighbourhood& hood,
                              std::span<const std::uint32_t> neighbors,
                              std::span<const Vec3f> normals, const Vec3f& normal, double cut,
-                             float away, bool clean, Eigen::Vector4f* other_plane)
+                             float away, Eigen::Vector4f* other_plane)
 {
     const Vec3d n = normal.cast<double>();
     const Vec3d t1 = tangent_of(normal).cast<double>();
@@ -713,34 +712,6 @@ Eigen::Vector4f crease_limit(const CreaseNeighbourhood& hood,
                                 static_cast<float>(outward.dot(mean))};
             }
         }
-        else if (clean && solver->eigenvalues()[1] > 4.0 * solver->eigenvalues()[0] &&
-                 turn < 0.866 && reach > 0.0)
-        {
-            // The planes' line on the far side of the sample from where its inliers' centroid
-            // points (which the line bounds nothing along): a sample on the crease line itself
-            // (random sampling puts some within a hair of it), whose refit may take either
-            // face's plane. Where the line runs between the sample and its inliers' centroid,
-            // and the sample lies on the line or past it seen from the other face's samples
-            // too, it lies on the other face's side and its surface holds nowhere beyond it.
-            // Its centroid's limit (the inliers' cut, half a spacing out along a direction 35°
-            // off the line's normal, at a sample 0.18 spacing from a random 90° edge) carried
-            // its face's plane over the other face, where it outweighed the samples at the rim
-            // of a gap in the sampling: a bump half a spacing over the top face beside the
-            // edge. Wrong-side probes of PointField.ConvexEdgeKeepsBothFacesUpToTheEdge 6 -> 3
-            // of 59,714, of PointField.WedgeEdgeIsACreaseNotTheTwoSidesOfAWall 100 -> 90 of
-            // 21,687. By the other face's samples alone: the same at the edge but 327 at the
-            // wedge (whose other face's samples lie on the sample's own side); by the inliers
-            // alone, 83 at the wedge but more of the meshes moved. Clean clouds only: noise
-            // puts samples past any line.
-            const Vec3d inliers_centroid = -offset * inlier_far * d;
-            const Vec3d normal_of_line = inplane / reach;
-            const double ahead = normal_of_line.dot(mean) >= 0.0 ? 1.0 : -1.0;
-            if (along.dot(inliers_centroid) > t && ahead * m.dot(mean) / reach <= 0.0)
-            {
-                limit = 0.0;
-                direction = Eigen::Vector2d(-along.dot(t1), -along.dot(t2));
-            }
-        }
     }
     // The other face falls away under the sample's plane at a convex crease (outside past the
     // line) and rises over it at a concave one (inside past the line).
@@ -759,7 +730,7 @@ CreaseFit crease_normal(std::span<const Vec3f> positions, std::span<const Vec3f>
     if (!plane.refitted)
         return {normal};
     CreaseFit out{plane.normal};
-    out.crease = crease_limit(hood, neighbors, normals, out.normal, plane.cut, plane.away, clean,
+    out.crease = crease_limit(hood, neighbors, normals, out.normal, plane.cut, plane.away,
                               clean ? &out.other : nullptr);
     out.wedge = plane.wedge && out.crease.w() > 0.0F;
     return out;

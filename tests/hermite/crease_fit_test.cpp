@@ -111,25 +111,6 @@ TEST(SharpCreases, SmoothOrNoisyCloudsKeepTheirNormals)
     EXPECT_NE(std::find(stages.begin(), stages.end(), "creases"), stages.end());
 }
 
-// A field's surfels (surfels_from_samples(), what `reconstruct`, `mc` and `model` make of raw
-// points) are refitted at a clean cloud's creases by default; compute_surfels() (`normals`)
-// keeps the principal normals unless asked.
-TEST(SharpCreases, AFieldsSurfelsAreRefittedByDefault)
-{
-    const PointCloud truth = sample_shape(Shape::Part, {.count = 40000, .seed = 5});
-    const PointCloud raw = without_normals(truth);
-    const SurfelsFromSamples field = surfels_from_samples(raw);
-    const SurfelsFromSamples kept = surfels_from_samples(raw, {.sharp_creases = false});
-    EXPECT_GT(field.crease_refits, truth.size() / 50);
-    EXPECT_EQ(kept.crease_refits, 0U);
-    EXPECT_EQ(compute_surfels(raw).crease_refits, 0U);
-    const SurfelResult sharp =
-        compute_surfels(raw, {.radius_scale = default_field_radius_scale, .sharp_creases = true});
-    EXPECT_EQ(field.surfels.normals, sharp.surfels.normals);
-    EXPECT_LT(off_by_more_than(field.surfels.normals, truth.normals, 10.0),
-              off_by_more_than(kept.surfels.normals, truth.normals, 10.0) / 3);
-}
-
 // The refits read the normals as the orientation left them, block by block: the same normals at
 // any thread count (150,000 samples: 37 blocks of crease_refit_block).
 TEST(SharpCreases, SameNormalsWhateverTheThreadCount)

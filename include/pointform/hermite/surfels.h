@@ -112,11 +112,8 @@ struct SurfelsFromSamplesOptions
     /// Estimate and orient normals even if the samples have them.
     bool reestimate = false;
     /// Estimated normals at a clean cloud's creases refitted to their own face
-    /// (SurfelOptions::sharp_creases). On by default here, where the surfels are a field's: with
-    /// the field's crease lines (PointField) the 100k clean inputs of bench/peers and the
-    /// fandisk, teapot and bunny come out closer to the truth (README, step 3); noisy clouds
-    /// are not refitted.
-    bool sharp_creases = true;
+    /// (SurfelOptions::sharp_creases).
+    bool sharp_creases = false;
     ProgressCallback progress;
 };
 
