@@ -74,18 +74,15 @@ void run_reconstruct(const ReconstructCommandOptions& options, const GlobalOptio
                              (input.estimated_normals ? " (normals estimated)" : " (surfels)"));
     if (base_stats)
     {
-        print_row(
-            "intermediate mesh",
-            std::to_string(report.intermediate_faces) + " faces (marching cubes, cell " +
-                format_number(report.cell) +
-                (report.coarsening > 1.0 ? " = " + format_number(report.coarsening) +
-                                               " x the field's, for the base mesh"
-                                         : std::string()) +
-                (report.wall_limited
-                     ? ", two cells across walls " + format_number(report.wall_thickness) + " thick"
-                     : std::string()) +
-                ", " + fit + " field; degenerate " +
-                describe_degenerate(report.degenerate_triangles, report.degenerate_kept) + ")");
+        print_row("intermediate mesh",
+                  std::to_string(report.intermediate_faces) + " faces (marching cubes, cell " +
+                      format_number(report.cell) +
+                      (report.coarsening > 1.0 ? " = " + format_number(report.coarsening) +
+                                                     " x the field's, for the base mesh"
+                                               : std::string()) +
+                      ", " + fit + " field; degenerate " +
+                      describe_degenerate(report.degenerate_triangles, report.degenerate_kept) +
+                      ")");
         print_row("debris",
                   "removed " + std::to_string(report.debris.removed_components) + " of " +
                       std::to_string(report.debris.components) + " components (" +

@@ -525,57 +525,6 @@ double estimate_marching_cubes_faces(double surface_area, double cell)
     return 3.0 * surface_area / (cell * cell);
 }
 
-WallSurvey survey_walls(const PointField& field, double reach)
-{
-    WallSurvey out;
-    const PointCloud& surfels = field.surfels();
-    const std::size_t n = surfels.size();
-    if (n == 0 || surfels.normals.size() != n || !(reach > 0.0) || !std::isfinite(reach))
-        return out;
-    const std::size_t stride = std::max<std::size_t>(1, n / wall_survey_samples);
-    const std::size_t queries = (n + stride - 1) / stride;
-    constexpr std::size_t block = 1024;
-    std::vector<float> thickness(queries, std::numeric_limits<float>::infinity());
-    const auto radius = static_cast<float>(reach);
-    parallel_blocks(queries, block, [&](std::size_t begin, std::size_t end) {
-        std::vector<std::uint32_t> near;
-        std::vector<float> d2;
-        for (std::size_t q = begin; q < end; ++q)
-        {
-            const std::size_t i = q * stride;
-            const Vec3f& p = surfels.positions[i];
-            const Vec3f& normal = surfels.normals[i];
-            near.clear();
-            d2.clear();
-            field.tree().radius_search(p, radius, near, d2);
-            for (const std::uint32_t j : near)
-            {
-                // Facing away (turned by more than 120°), behind the sample and within 45° of
-                // its normal's line: the other side of a wall, not a neighbour on a curve.
-                if (normal.dot(surfels.normals[j]) > -0.5F)
-                    continue;
-                const Vec3f d = surfels.positions[j] - p;
-                const float behind = -d.dot(normal);
-                if (behind > 0.0F && d.squaredNorm() <= 2.0F * behind * behind)
-                    thickness[q] = std::min(thickness[q], behind);
-            }
-        }
-    });
-    std::vector<float> walls;
-    for (const float t : thickness)
-        if (std::isfinite(t))
-            walls.push_back(t);
-    out.surveyed = queries;
-    out.walled = walls.size();
-    if (!walls.empty())
-    {
-        const auto middle = walls.begin() + static_cast<std::ptrdiff_t>(walls.size() / 2);
-        std::nth_element(walls.begin(), middle, walls.end());
-        out.median_thickness = static_cast<double>(*middle);
-    }
-    return out;
-}
-
 IntermediateGrid intermediate_grid(const PointField& field, double cell, double max_faces)
 {
     if (!(cell > 0.0) || !std::isfinite(cell) || !(max_faces > 0.0) || !std::isfinite(max_faces))
@@ -590,18 +539,6 @@ IntermediateGrid intermediate_grid(const PointField& field, double cell, double 
         out.coarsening = std::sqrt(out.estimated_faces / max_faces);
         out.cell = cell * out.coarsening;
         out.min_defined_corners = 1;
-        // Thin walls keep two cells across them at least, where they are not a stray few.
-        const WallSurvey walls = survey_walls(field, 2.0 * out.cell);
-        out.wall_thickness = walls.median_thickness;
-        if (static_cast<double>(walls.walled) >=
-                min_wall_share * static_cast<double>(walls.surveyed) &&
-            0.5 * walls.median_thickness < out.cell)
-        {
-            out.cell = std::max(cell, 0.5 * walls.median_thickness);
-            out.coarsening = out.cell / cell;
-            out.min_defined_corners = out.coarsening > 1.0 ? 1 : 8;
-            out.wall_limited = true;
-        }
     }
     return out;
 }

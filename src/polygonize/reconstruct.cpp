@@ -338,8 +338,6 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
         const double cell = intermediate.cell;
         report.cell = cell;
         report.coarsening = intermediate.coarsening;
-        report.wall_thickness = intermediate.wall_thickness;
-        report.wall_limited = intermediate.wall_limited;
         const CellGrid grid = grid_over(field.bounds(), cell);
         check_marching_cubes_memory(field, cell);
         // The intermediate mesh's vertex normals are not used (the base mesh is made from its

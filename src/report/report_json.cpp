@@ -254,8 +254,6 @@ nlohmann::json report_json(const ReconstructReport& report, const ReconstructOpt
     {
         out["cell"] = report.cell;
         out["intermediate_coarsening"] = report.coarsening;
-        out["intermediate_wall_thickness"] = report.wall_thickness;
-        out["intermediate_wall_limited"] = report.wall_limited;
         out["intermediate_undefined_triangles"] = report.undefined_triangles;
         out["intermediate_cell_vertices"] = report.cell_vertices;
         out["intermediate_faces"] = report.intermediate_faces;

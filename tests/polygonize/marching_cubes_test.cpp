@@ -385,44 +385,6 @@ TEST(MarchingCubes, RemovedCapStaysOpenAtASmallRadiusAndClosesAtALargeOne)
     EXPECT_EQ(closed_topo.euler_characteristic, 2);
 }
 
-TEST(MarchingCubes, IntermediateGridKeepsTwoCellsAcrossThinWalls)
-{
-    // The thin plate, 2 x 2 x 0.05: nearly every sample has the other face 0.05 behind it.
-    const PointCloud plate_samples = sample_shape(Shape::Plate, {.count = 40000, .seed = 3});
-    const PointField plate(
-        compute_surfels(plate_samples, {.radius_scale = default_field_radius_scale}).surfels);
-    const double cell = default_cell_size(plate);
-    const WallSurvey walls = survey_walls(plate, 0.08);
-    EXPECT_EQ(walls.surveyed, 20000U);
-    EXPECT_GT(static_cast<double>(walls.walled), 0.9 * static_cast<double>(walls.surveyed));
-    EXPECT_NEAR(walls.median_thickness, 0.05, 0.002);
-    // Coarsened for a face limit of a hundredth (ten times the field's cell, 0.1 and more), the
-    // grid keeps two cells across the plate.
-    const IntermediateGrid grid =
-        intermediate_grid(plate, cell, intermediate_grid(plate, cell).estimated_faces / 100.0);
-    EXPECT_TRUE(grid.wall_limited);
-    EXPECT_NEAR(grid.wall_thickness, 0.05, 0.002);
-    EXPECT_NEAR(grid.cell, 0.5 * grid.wall_thickness, 1e-12);
-    EXPECT_NEAR(grid.coarsening, grid.cell / cell, 1e-12);
-    EXPECT_GT(grid.coarsening, 1.0);
-    EXPECT_EQ(grid.min_defined_corners, 1);
-}
-
-TEST(MarchingCubes, IntermediateGridIsCoarsenedFreelyWithoutWalls)
-{
-    // A sphere of radius 1 has no wall within a reach of 0.2: its grid is coarsened freely.
-    const PointCloud ball_samples = sample_shape(Shape::Sphere, {.count = 20000, .seed = 8});
-    const PointField ball(
-        compute_surfels(ball_samples, {.radius_scale = default_field_radius_scale}).surfels);
-    EXPECT_EQ(survey_walls(ball, 0.2).walled, 0U);
-    const double ball_cell = default_cell_size(ball);
-    const IntermediateGrid free = intermediate_grid(
-        ball, ball_cell, intermediate_grid(ball, ball_cell).estimated_faces / 100.0);
-    EXPECT_FALSE(free.wall_limited);
-    EXPECT_NEAR(free.coarsening, 10.0, 1e-9);
-    EXPECT_EQ(survey_walls(ball, 0.0).surveyed, 0U);
-}
-
 TEST(MarchingCubes, IntermediateGridIsCoarsenedToTheFaceLimitAndKeepsHolesOpen)
 {
     // The estimate 3 A / h² against the mesh at the field's own cell.

@@ -78,34 +78,7 @@ struct IntermediateGrid
     double coarsening = 1.0;      ///< cell over the field's cell; 1 keeps the field's own grid
     int min_defined_corners = 8;  ///< for MarchingCubesOptions: 1 on a coarsened grid
     double estimated_faces = 0.0; ///< faces at the field's cell (estimate_marching_cubes_faces)
-    /// The median thickness of the thin walls survey_walls() found within two coarse cells (0
-    /// where none, or on the field's own grid).
-    double wall_thickness = 0.0;
-    /// Whether the walls kept the grid finer than the face limit alone would (two cells across).
-    bool wall_limited = false;
 };
-
-/// survey_walls() looks at about this many samples (every n / this-th).
-inline constexpr std::size_t wall_survey_samples = 20000;
-
-/// The share of the surveyed samples with a wall behind them from which the intermediate grid
-/// keeps two cells across the walls' median thickness (intermediate_grid()). Below it, the
-/// walls are a few strays behind a scan's surface: fandisk, spot and teapot scans of
-/// bench/peers/virtual_scan.py have 0.02-0.44% walled, the clean and noisy 100k plates of
-/// bench/peers 95%, the 100k cone (its 45° rim) 11%, the bunny (its ears) 5%.
-inline constexpr double min_wall_share = 0.01;
-
-/// \brief The thin walls of a field's samples: of every (size / wall_survey_samples)-th
-/// surfel, the nearest surfel within `reach` that faces away from it (normals turned by more
-/// than 120°) and lies behind it, within 45° of its normal's line; its distance along the
-/// normal is the wall's thickness there.
-struct WallSurvey
-{
-    std::size_t surveyed = 0;      ///< samples looked at
-    std::size_t walled = 0;        ///< of them, with a wall behind within the reach
-    double median_thickness = 0.0; ///< the walled samples' median thickness (0 if none)
-};
-[[nodiscard]] WallSurvey survey_walls(const PointField& field, double reach);
 
 /// \brief The field's cell (`cell`, e.g. default_cell_size) where its marching cubes would have
 /// at most `max_faces` triangles; else a cell coarser by √(estimated faces / max_faces), whose
@@ -115,11 +88,7 @@ struct WallSurvey
 /// scale, and refinement projects every finer vertex onto the field itself, so the fine
 /// marching-cubes mesh is never built (on a clean 1M-sample blobby, whose field's mesh has
 /// 1.68M faces: marching cubes, debris and decimation 20.1 s → 8.4 s, and closed where the
-/// field's own grid left 2 pinholes at concave creases). A coarse cell more than half as wide
-/// as the samples' thin walls (survey_walls() within two cells, on at least min_wall_share of
-/// them) is made half their median thickness, or the field's cell if that is coarser: across
-/// a wall of 1.7 coarse cells (the noisy thin plate of bench/peers at 4 intermediate faces per
-/// base face) the one-corner cells joined holes on its two faces into a tunnel.
+/// field's own grid left 2 pinholes at concave creases).
 /// \throw InvalidInput if the cell or max_faces is not positive and finite
 [[nodiscard]] IntermediateGrid intermediate_grid(const PointField& field, double cell,
                                                  double max_faces = max_intermediate_faces);

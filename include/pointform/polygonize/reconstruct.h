@@ -102,18 +102,8 @@ struct SemiRegularReport
 /// faces a base face at the default share), on simulated scans of three shapes at seeds not
 /// tuned on (fandisk and spot at 11-15, the teapot at 4-8; bench/peers/virtual_scan.py): mean
 /// F@0.5% 0.9709 -> 0.9734, Chamfer 0.0935 -> 0.0909% of the diagonal, triangles under 20°
-/// 0.67% -> 0.32% (at most 4.00% -> 1.84%), 18% less time. From 8 to 4, with thin walls kept
-/// two cells across (intermediate_grid(); the 1M inputs of bench/peers, capped at
-/// max_intermediate_faces, already had 4.3), on the same 15 scans: Chamfer lower on 12
-/// (geometric mean 0.1369 -> 0.1302% of the diagonal, `pointform distance` against the mesh),
-/// mean F@0.5% 0.9733 -> 0.9750; teapot scan 1 2.17 -> 1.60 s, fandisk scans 1 and 3 -8%. On
-/// the 19 inputs of the 100k sweep (clean and noisy shapes, the bunny, four scans) geometric
-/// mean Chamfer +0.8%: the clean teapot (`data/meshes/teapot.obj`, whose lid's thin walls keep
-/// its grid near the field's own) 0.0380 -> 0.0464, and +30-37% at three other samplings;
-/// without the walls' limit it was 15-24% closer, but the noisy thin plate, whose holes on its
-/// two faces overlap, opened into a tunnel (Hausdorff 0.82 -> 1.31%; 0.90 with it). Ratios 3, 5
-/// and 6 also came out closer than 8 on the scans, each with another base mesh that lost.
-inline constexpr double intermediate_faces_per_base_face = 4.0;
+/// 0.67% -> 0.32% (at most 4.00% -> 1.84%), 18% less time.
+inline constexpr double intermediate_faces_per_base_face = 8.0;
 
 /// \brief The most faces the automatic base mesh's intermediate mesh should have:
 /// intermediate_faces_per_base_face times the base-face target expected from the field's
@@ -239,9 +229,6 @@ struct ReconstructReport
     double cell = 0.0;
     /// `cell` over the field's cell (intermediate_grid()); 1 on the field's own grid.
     double coarsening = 1.0;
-    /// The samples' thin walls the coarsened grid kept two cells across (IntermediateGrid).
-    double wall_thickness = 0.0;
-    bool wall_limited = false;
     std::size_t intermediate_faces = 0;
     std::size_t intermediate_vertices = 0;
     /// Triangles dropped past the field's defined region on a coarsened grid, and vertices inside
