@@ -914,6 +914,10 @@ struct PointField::Impl
     std::vector<Eigen::Vector4f> crease;
     /// Per grid slot, with crease: the other face's plane at a concave crease (CreaseFit::other).
     std::vector<Eigen::Vector4f> other_plane;
+    /// Per grid slot: the distance from the sample to its memo_size()-th nearest (itself the
+    /// first), from the fit's search; empty when the fit takes fewer. Bounds a search of the
+    /// kd-tree from a query near the sample (far_bound()).
+    std::vector<float> reach;
     Aabb box;
     Aabb local_box;  ///< box, relative to the cloud's origin
     Aabb sample_box; ///< the samples' bounding box, relative to the origin
@@ -976,6 +980,17 @@ struct PointField::Impl
     /// False (and the buffers overwritten) otherwise.
     [[nodiscard]] bool recall_neighbours(const NeighbourMemo& memo, const Vec3f& query,
                                          std::uint32_t* slot, float* dist2) const;
+    /// A squared distance from `query` that the memo's memo_size() candidates all lie within
+    /// (the farthest of them): a bound for the search of memo_size() neighbours that
+    /// recall_neighbours() could not spare, close to their true distance when the query has
+    /// moved little (the samples of a projection's line). Infinity when the memo is empty.
+    [[nodiscard]] float memo_bound(const NeighbourMemo& memo, const Vec3f& query) const;
+    /// A squared distance from a query that at least memo_size() samples lie within, given a
+    /// sample (grid `slot`) at squared distance `d2` from it: that sample's reach beyond the
+    /// distance (the triangle inequality), and the memo's bound if tighter. Infinity when
+    /// neither is known.
+    [[nodiscard]] float far_bound(std::uint32_t slot, float d2, const NeighbourMemo* memo,
+                                  const Vec3f& query) const;
 
     /// The value at `p` (relative to the origin) where the far grid proves that no influence
     /// ball reaches and every candidate sample's surface puts `p` inside; false (and `out`
@@ -1231,6 +1246,9 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
     m.packed.assign(m.grid->slot_count(), PackedSurfel{});
     if (blends(options.fit) && options.rim_reach < 1.0)
         m.rim.assign(m.grid->slot_count(), Eigen::Vector3f::Zero());
+    const std::size_t reach_rank = m.memo_size();
+    if (k >= reach_rank)
+        m.reach.assign(m.grid->slot_count(), 0.0F);
     if (options.fit == PlaneFit::Quadric && options.crease_fit)
     {
         m.crease.assign(m.grid->slot_count(), Eigen::Vector4f::Zero());
@@ -1270,6 +1288,8 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
             // The ball to the last neighbour holds k samples: π d² / k of surface per sample.
             area += std::numbers::pi * static_cast<double>(d2[k - 1]) / static_cast<double>(k);
             const std::uint32_t i = fit_grid.original_index(samples[q]);
+            if (!m.reach.empty())
+                m.reach[m.grid->slot_of(i)] = std::sqrt(d2[reach_rank - 1]);
             PackedSurfel packed;
             packed.position = m.surfels.positions[i];
             packed.radius = m.surfels.radii[i];
@@ -1440,7 +1460,8 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
         // The grid has already turned the query down (found == 0: its cells were scanned for
         // want, or the query lies beyond their reach): straight to the kd-tree.
         const std::size_t ask = memo != nullptr ? m.memo_size() : want;
-        found = m.grid->knn_far(query, ask, std::span(slot, ask), std::span(dist2, ask));
+        found = m.grid->knn_far(query, ask, std::span(slot, ask), std::span(dist2, ask),
+                                m.far_bound(nearest_slot[0], nearest_d2, memo, query));
         if (memo != nullptr)
         {
             m.remember_neighbours(*memo, query, found, slot, dist2);
@@ -1673,6 +1694,32 @@ bool PointField::Impl::recall_neighbours(const NeighbourMemo& memo, const Vec3f&
         dist2[i] = distance2(i);
     }
     return true;
+}
+
+float PointField::Impl::memo_bound(const NeighbourMemo& memo, const Vec3f& query) const
+{
+    if (memo.field != id)
+        return std::numeric_limits<float>::infinity();
+    const std::size_t count = memo_size();
+    std::array<float, memo_capacity> d2{};
+    grid->squared_distances(query, std::span(memo.slot.data(), count), std::span(d2.data(), count));
+    // Measured as the kd-tree measures (the same float sums), so its slack covers the rest.
+    return *std::max_element(d2.begin(), d2.begin() + static_cast<std::ptrdiff_t>(count));
+}
+
+float PointField::Impl::far_bound(std::uint32_t slot, float d2, const NeighbourMemo* memo,
+                                  const Vec3f& query) const
+{
+    float bound2 =
+        memo != nullptr ? memo_bound(*memo, query) : std::numeric_limits<float>::infinity();
+    if (!reach.empty())
+    {
+        // In double, widened by far more than the rounding of either term: the kd-tree's own
+        // slack covers the float sums of the distances it compares against it.
+        const double by_sample = (std::sqrt(static_cast<double>(d2)) + reach[slot]) * (1.0 + 1e-6);
+        bound2 = std::min(bound2, static_cast<float>(by_sample * by_sample));
+    }
+    return bound2;
 }
 
 FieldSample PointField::evaluate_within(const Vec3d& world_point, double /*lo*/, double hi) const

@@ -94,9 +94,15 @@ public:
     /// nanoflann's tree and 8 s with the Morton tree before this.
     /// `original`: the caller's index of each of the tree's points (null: the same), whose
     /// order those copies keep.
+    /// `bound2`: the search's bound until it is full (points at or beyond it are not offered),
+    /// with the same slack as the bound it takes then.
     OrderedKnnResult(std::size_t capacity, std::uint32_t* indices, float* distances,
-                     const std::uint32_t* original)
-        : capacity_(capacity), indices_(indices), distances_(distances), original_(original)
+                     const std::uint32_t* original, float bound2 = infinity)
+        : capacity_(capacity),
+          indices_(indices),
+          distances_(distances),
+          original_(original),
+          bound_(slackened(bound2))
     {}
 
     [[nodiscard]] std::size_t size() const { return count_; }
@@ -120,28 +126,31 @@ public:
         }
         distances_[i] = dist;
         indices_[i] = index;
-        if (full())
-        {
-            // The bound only changes here: worked out once, not at every node of the search.
-            // Above the smallest normal float the slack is already more than one ulp.
-            constexpr float slack = 1.0F + 0x1p-16F;
-            const float worst = distances_[capacity_ - 1];
-            bound_ = worst >= std::numeric_limits<float>::min() ? worst * slack
-                                                                : std::nextafter(worst, infinity);
-        }
+        if (full()) // the bound only changes here: not worked out at every node of the search
+            bound_ = std::min(bound_, slackened(distances_[capacity_ - 1]));
         return true;
     }
 
     [[nodiscard]] float worstDist() const { return bound_; }
 
 private:
+    static constexpr float infinity = std::numeric_limits<float>::infinity();
+
+    /// A squared distance `worst` widened by the slack (above the smallest normal float already
+    /// more than one ulp).
+    static float slackened(float worst)
+    {
+        constexpr float slack = 1.0F + 0x1p-16F;
+        return worst >= std::numeric_limits<float>::min() ? worst * slack
+                                                          : std::nextafter(worst, infinity);
+    }
+
     std::size_t capacity_;
     std::uint32_t* indices_;
     float* distances_;
     const std::uint32_t* original_;
     std::size_t count_ = 0;
-    static constexpr float infinity = std::numeric_limits<float>::infinity();
-    float bound_ = infinity; ///< worstDist(): infinite until full
+    float bound_; ///< worstDist(): the given bound until full
 };
 
 /// The nearest point found, as nanoflann's KNNResultSet of one keeps it (a point replaces it only
@@ -516,12 +525,20 @@ std::span<const std::uint32_t> KdTree::spatial_order() const
 std::size_t KdTree::knn(const Vec3f& query, std::size_t k, std::span<std::uint32_t> indices,
                         std::span<float> squared_distances) const
 {
+    return knn(query, k, std::numeric_limits<float>::infinity(), indices, squared_distances);
+}
+
+std::size_t KdTree::knn(const Vec3f& query, std::size_t k, float bound2,
+                        std::span<std::uint32_t> indices, std::span<float> squared_distances) const
+{
     k = std::min(k, size());
     check_buffer_size("KdTree::knn", "indices", indices.size(), k);
     check_buffer_size("KdTree::knn", "squared_distances", squared_distances.size(), k);
     if (k == 0)
         return 0;
-    OrderedKnnResult result(k, indices.data(), squared_distances.data(), impl_->caller_index());
+    // NaN: no bound.
+    OrderedKnnResult result(k, indices.data(), squared_distances.data(), impl_->caller_index(),
+                            bound2 >= 0.0F ? bound2 : std::numeric_limits<float>::infinity());
     impl_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
     return result.size();
 }

@@ -1096,7 +1096,7 @@ void PointGrid::squared_distances(const Vec3f& query, std::span<const std::uint3
 }
 
 std::size_t PointGrid::knn_far(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
-                               std::span<float> squared_distances) const
+                               std::span<float> squared_distances, float bound2) const
 {
     k = std::min(k, count_);
     check_buffer_size("PointGrid::knn_far", "slots", slots.size(), k);
@@ -1115,7 +1115,7 @@ std::size_t PointGrid::knn_far(const Vec3f& query, std::size_t k, std::span<std:
         index = index_heap;
         d2 = d2_heap;
     }
-    const std::size_t found = fallback_->knn(query, k, index, d2);
+    const std::size_t found = fallback_->knn(query, k, bound2, index, d2);
     for (std::size_t i = 0; i < found; ++i)
     {
         slots[i] = slot_of_[index[i]];

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <vector>
@@ -325,6 +326,62 @@ TEST(KdTree, TiesAtTheKthNeighbourGoToTheLowestIndices)
             if (k > 1)
             {
                 EXPECT_GT(tied, 10U) << "k " << k; // the case under test does occur
+            }
+        }
+    }
+}
+
+/// A bound that k points lie within (KdTree::knn() with bound2) changes nothing, bit for bit,
+/// from the tightest (the k-th distance itself, ties at it included) to one from the triangle
+/// inequality (a point of the tree and its own k-th distance), near the points and far from
+/// them; a bound that fewer lie within gives those, nearest first.
+TEST(KdTree, BoundedKnnMatchesUnbounded)
+{
+    const std::vector<Vec3f> points = clustered_points(41);
+    std::vector<Vec3f> queries = random_points(60, 42);
+    for (std::size_t i = 0; i < 60; ++i)
+        queries.push_back(queries[i] * 6.0F); // far outside the points' box
+    for (std::size_t i = 0; i < points.size(); i += 11)
+        queries.push_back(points[i]); // on a site: ties at distance 0
+    for (const std::size_t leaf : {1, 16})
+    {
+        const KdTree tree(points, {.leaf_size = leaf});
+        for (const std::size_t k : {1, 9, 40, 41})
+        {
+            std::vector<std::uint32_t> want(k);
+            std::vector<float> want_d2(k);
+            std::vector<std::uint32_t> got(k);
+            std::vector<float> got_d2(k);
+            for (const Vec3f& q : queries)
+            {
+                ASSERT_EQ(tree.knn(q, k, want, want_d2), k);
+                // The tree's point nearest the query and its own k-th distance.
+                std::vector<std::uint32_t> near_index(k);
+                std::vector<float> near_d2(k);
+                tree.knn(points[want[0]], k, near_index, near_d2);
+                const double by_point = (std::sqrt(static_cast<double>(want_d2[0])) +
+                                         std::sqrt(static_cast<double>(near_d2[k - 1]))) *
+                                        (1.0 + 1e-6);
+                for (const float bound2 : {want_d2[k - 1], 1.5F * want_d2[k - 1],
+                                           static_cast<float>(by_point * by_point),
+                                           std::numeric_limits<float>::infinity()})
+                {
+                    std::fill(got.begin(), got.end(), ~std::uint32_t{0});
+                    ASSERT_EQ(tree.knn(q, k, bound2, got, got_d2), k);
+                    EXPECT_EQ(got, want) << "leaf " << leaf << " k " << k;
+                    EXPECT_EQ(got_d2, want_d2);
+                }
+                // Too small a bound: only the nearest within it (up to the slack).
+                if (k > 1 && want_d2[0] < want_d2[k - 1] * 0.5F)
+                {
+                    const float small = want_d2[k - 1] * 0.5F;
+                    const std::size_t inside = static_cast<std::size_t>(
+                        std::count_if(want_d2.begin(), want_d2.end(),
+                                      [&](float d2) { return d2 < small * (1.0F + 0x1p-16F); }));
+                    ASSERT_EQ(tree.knn(q, k, small, got, got_d2), inside);
+                    for (std::size_t j = 0; j < inside; ++j)
+                        EXPECT_EQ(got[j], want[j]);
+                }
             }
         }
     }

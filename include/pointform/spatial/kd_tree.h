@@ -67,6 +67,14 @@ public:
     std::size_t knn(const Vec3f& query, std::size_t k, std::span<std::uint32_t> indices,
                     std::span<float> squared_distances) const;
 
+    /// \brief knn() given a squared distance `bound2` that at least min(k, size()) points lie
+    /// strictly within (say, the farthest of k points found for a nearby query, measured from
+    /// this one): the search skips every subtree beyond it from the start, which far from the
+    /// points (over a hole, say) saves most of the tree. The same answer as knn(), bit for bit,
+    /// when the bound holds; fewer points (those within it) when it does not.
+    std::size_t knn(const Vec3f& query, std::size_t k, float bound2,
+                    std::span<std::uint32_t> indices, std::span<float> squared_distances) const;
+
     /// \brief The single nearest point; returns its index, or invalid if the tree is empty.
     [[nodiscard]] PointId nearest(const Vec3f& query, float* squared_distance = nullptr) const;
 

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -51,9 +52,12 @@ public:
 
     /// \brief knn() of a query that knn_nearby() has already turned down (returned 0 for at
     /// least k): the kd-tree's answer, without scanning the grid's cells again.
+    /// \param bound2  a squared distance that at least min(k, point count) points lie strictly
+    ///        within, or infinity: it only speeds the search (KdTree::knn())
     /// \param slots, squared_distances  caller buffers of size >= min(k, point count)
     std::size_t knn_far(const Vec3f& query, std::size_t k, std::span<std::uint32_t> slots,
-                        std::span<float> squared_distances) const;
+                        std::span<float> squared_distances,
+                        float bound2 = std::numeric_limits<float>::infinity()) const;
 
     /// \brief knn_nearby() for many queries at once: query i's answer (the same neighbours, in
     /// the same order, with the same distances, bit for bit) goes to found[i] (the count, or 0)
