@@ -99,6 +99,7 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
         out["rim_reach"] = options.rim_reach;
         out["min_component_samples"] = debris.min_samples;
         out["components_removed"] = debris.removed_components;
+        out["components_scattered"] = debris.scattered_components;
         out["faces_removed"] = debris.removed_faces;
         out["max_handle"] = options.max_handle;
         out["handles"] = report_json(handles);
@@ -138,10 +139,14 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
     print_row("cell", format_number(cell) + " (" + std::string(to_string(options.fit)) + " field)");
     print_row("vertices", std::to_string(result.mesh.vertex_count()));
     print_row("faces", std::to_string(result.mesh.face_count()));
-    print_row("components", std::to_string(topo.components) + " (" +
-                                std::to_string(debris.removed_components) +
-                                " removed: fewer than " + std::to_string(debris.min_samples) +
-                                " samples nearest)");
+    print_row(
+        "components",
+        std::to_string(topo.components) + " (" + std::to_string(debris.removed_components) +
+            " removed: fewer than " + std::to_string(debris.min_samples) + " samples nearest" +
+            (debris.scattered_components > 0 ? ", or held up by scattered samples (" +
+                                                   std::to_string(debris.scattered_components) + ")"
+                                             : std::string()) +
+            ")");
     print_row("handles", describe_handle_cuts(handles, options.max_handle));
     print_row("holes filled", holes.skipped_not_manifold
                                   ? std::string("none (the mesh is not an oriented 2-manifold)")

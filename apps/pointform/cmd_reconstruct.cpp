@@ -87,7 +87,11 @@ void run_reconstruct(const ReconstructCommandOptions& options, const GlobalOptio
                   "removed " + std::to_string(report.debris.removed_components) + " of " +
                       std::to_string(report.debris.components) + " components (" +
                       std::to_string(report.debris.removed_faces) + " faces) that fewer than " +
-                      std::to_string(report.debris.min_samples) + " samples are nearest to");
+                      std::to_string(report.debris.min_samples) + " samples are nearest to" +
+                      (report.debris.scattered_components > 0
+                           ? " or that scattered samples hold up (" +
+                                 std::to_string(report.debris.scattered_components) + ")"
+                           : std::string()));
         print_row("handles", describe_handle_cuts(report.handles, options.reconstruct.max_handle));
         print_base_mesh(*base_stats);
     }

@@ -9,10 +9,14 @@
 #include "pointform/spatial/spatial_sort.h"
 #include "pointform/spatial/triangle_bvh.h"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <vector>
 
 namespace pointform {
@@ -25,9 +29,14 @@ namespace {
 /// sample (in Morton order) that is, or else a search bounded by the rest's distance. The
 /// nearest triangle of the whole mesh is in the component found, as an exact search finds it,
 /// but for exact ties, which go to the rest.
-std::vector<std::size_t> component_support(const TriMesh& mesh,
-                                           const std::vector<std::uint32_t>& face_component,
-                                           std::size_t components, const PointCloud& samples)
+struct Support
+{
+    std::vector<std::size_t> count;     ///< per component
+    std::vector<std::uint32_t> nearest; ///< per sample: its component, or none
+};
+
+Support component_support(const TriMesh& mesh, const std::vector<std::uint32_t>& face_component,
+                          std::size_t components, const PointCloud& samples)
 {
     std::vector<std::size_t> faces_of(components, 0);
     for (const std::uint32_t c : face_component)
@@ -103,7 +112,61 @@ std::vector<std::size_t> component_support(const TriMesh& mesh,
     for (const std::uint32_t c : nearest)
         if (c != none)
             ++support[c];
-    return support;
+    return {std::move(support), std::move(nearest)};
+}
+
+/// The sample and its 16 nearest: the neighbourhood of the scattered-sample test.
+constexpr std::size_t scatter_k = 17;
+/// The samples of a component tested at most (evenly spread over its supporters in index order).
+constexpr std::size_t scatter_tests = 256;
+/// The samples whose reach gives the cloud's median at most (every stride-th).
+constexpr std::size_t reach_probes = 4096;
+
+/// Whether `i`'s neighbourhood fills a volume (see scattered_volume) and reaches farther than
+/// `limit2` (squared).
+bool scattered(const KdTree& tree, const PointCloud& samples, std::size_t i, float limit2)
+{
+    std::array<std::uint32_t, scatter_k> index{};
+    std::array<float, scatter_k> d2{};
+    const std::size_t found = tree.knn(samples.positions[i], scatter_k, index, d2);
+    if (found < scatter_k || !(d2[found - 1] > limit2))
+        return false;
+    const Vec3d origin = samples.positions[i].cast<double>();
+    Vec3d sum = Vec3d::Zero();
+    Mat3d outer = Mat3d::Zero();
+    for (std::size_t j = 0; j < found; ++j)
+    {
+        const Vec3d d = samples.positions[index[j]].cast<double>() - origin;
+        sum += d;
+        outer.noalias() += d * d.transpose();
+    }
+    const auto count = static_cast<double>(found);
+    const Vec3d mean = sum / count;
+    const Mat3d covariance = outer / count - mean * mean.transpose();
+    const Eigen::SelfAdjointEigenSolver<Mat3d> solver(covariance, Eigen::EigenvaluesOnly);
+    const Vec3d& lambda = solver.eigenvalues();
+    return lambda[0] > scattered_volume * lambda[2];
+}
+
+/// The square of scattered_reach times the median reach (to the 16th nearest) of every
+/// stride-th sample.
+float scattered_limit2(const KdTree& tree, const PointCloud& samples)
+{
+    const std::size_t stride = std::max<std::size_t>(1, samples.size() / reach_probes);
+    std::vector<float> reach2;
+    std::array<std::uint32_t, scatter_k> index{};
+    std::array<float, scatter_k> d2{};
+    for (std::size_t i = 0; i < samples.size(); i += stride)
+    {
+        const std::size_t found = tree.knn(samples.positions[i], scatter_k, index, d2);
+        if (found > 0)
+            reach2.push_back(d2[found - 1]);
+    }
+    if (reach2.empty())
+        return std::numeric_limits<float>::infinity();
+    const auto middle = reach2.begin() + static_cast<std::ptrdiff_t>(reach2.size() / 2);
+    std::nth_element(reach2.begin(), middle, reach2.end());
+    return static_cast<float>(scattered_reach * scattered_reach * static_cast<double>(*middle));
 }
 
 } // namespace
@@ -114,7 +177,8 @@ std::size_t default_min_component_samples(std::size_t samples)
 }
 
 ComponentFilterReport remove_unsupported_components(TriMesh& mesh, const PointCloud& samples,
-                                                    std::size_t min_samples)
+                                                    std::size_t min_samples,
+                                                    const KdTree* sample_tree)
 {
     ComponentFilterReport report;
     report.min_samples = min_samples;
@@ -141,8 +205,8 @@ ComponentFilterReport remove_unsupported_components(TriMesh& mesh, const PointCl
     if (report.components < 2 || min_samples == 0 || samples.empty())
         return report;
 
-    const std::vector<std::size_t> support =
-        component_support(mesh, face_component, report.components, samples);
+    const Support found = component_support(mesh, face_component, report.components, samples);
+    const std::vector<std::size_t>& support = found.count;
     std::vector<char> keep(report.components, 0);
     for (std::size_t c = 0; c < report.components; ++c)
         keep[c] = support[c] >= min_samples ? 1 : 0;
@@ -150,6 +214,45 @@ ComponentFilterReport remove_unsupported_components(TriMesh& mesh, const PointCl
     const auto best = static_cast<std::size_t>(std::max_element(support.begin(), support.end()) -
                                                support.begin());
     keep[best] = 1;
+    // The others kept, unless their support is mostly scattered samples (every one tested, or
+    // scatter_tests of them spread evenly in index order).
+    std::vector<std::vector<std::uint32_t>> tested(report.components);
+    std::size_t candidates = 0;
+    for (std::size_t c = 0; c < report.components; ++c)
+        candidates += keep[c] != 0 && c != best ? 1 : 0;
+    if (candidates > 0)
+    {
+        std::vector<std::size_t> seen(report.components, 0);
+        for (std::size_t i = 0; i < samples.size(); ++i)
+        {
+            const std::uint32_t c = found.nearest[i];
+            if (c == std::numeric_limits<std::uint32_t>::max() || keep[c] == 0 || c == best)
+                continue;
+            // Taken where the count crosses a multiple of support / scatter_tests.
+            const std::size_t before = seen[c]++ * scatter_tests / support[c];
+            const std::size_t after = seen[c] * scatter_tests / support[c];
+            if (after > before)
+                tested[c].push_back(static_cast<std::uint32_t>(i));
+        }
+        std::optional<KdTree> own_tree;
+        if (sample_tree == nullptr)
+            own_tree.emplace(samples.positions);
+        const KdTree& tree = sample_tree != nullptr ? *sample_tree : *own_tree;
+        const float limit2 = scattered_limit2(tree, samples);
+        for (std::size_t c = 0; c < report.components; ++c)
+        {
+            if (tested[c].empty())
+                continue;
+            std::size_t count = 0;
+            for (const std::uint32_t i : tested[c])
+                count += scattered(tree, samples, i, limit2) ? 1 : 0;
+            if (2 * count > tested[c].size())
+            {
+                keep[c] = 0;
+                ++report.scattered_components;
+            }
+        }
+    }
     for (std::size_t c = 0; c < report.components; ++c)
         report.removed_components += keep[c] == 0 ? 1 : 0;
     if (report.removed_components == 0)

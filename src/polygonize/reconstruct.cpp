@@ -361,7 +361,8 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
         report.debris = remove_unsupported_components(
             mc.mesh, samples,
             options.min_component_samples ? *options.min_component_samples
-                                          : default_min_component_samples(samples.size()));
+                                          : default_min_component_samples(samples.size()),
+            &field.tree());
         clock.lap("debris");
         report.handles = cut_short_handles(mc.mesh, options.max_handle * field.median_radius());
         clock.lap("handles");

@@ -263,7 +263,8 @@ nlohmann::json report_json(const ReconstructReport& report, const ReconstructOpt
         out["debris"] = {{"components", report.debris.components},
                          {"removed_components", report.debris.removed_components},
                          {"removed_faces", report.debris.removed_faces},
-                         {"min_samples", report.debris.min_samples}};
+                         {"min_samples", report.debris.min_samples},
+                         {"scattered_components", report.debris.scattered_components}};
         out["handles"] = report_json(report.handles);
     }
     else if (report.picked)

@@ -140,5 +140,65 @@ TEST(Components, SupportedComponentsStay)
     EXPECT_EQ(default_min_component_samples(1000000), 1000U);
 }
 
+/// 10k samples of the unit sphere and `sprayed` points spread evenly through the cube of side 4
+/// around it (a spray of stray returns), raw; and beside it, when `sparse` > 0, a second unit
+/// sphere 3.5 away sampled by `sparse` points.
+PointCloud sphere_with_spray(std::size_t sprayed, std::size_t sparse)
+{
+    PointCloud cloud = sample_shape(Shape::Sphere, {.count = 10000, .seed = 2});
+    cloud.normals.clear();
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<float> uni(-2.0F, 2.0F);
+    for (std::size_t i = 0; i < sprayed; ++i)
+        cloud.positions.emplace_back(uni(rng), uni(rng), uni(rng));
+    if (sparse > 0)
+        for (const Vec3f& p : sample_shape(Shape::Sphere, {.count = sparse, .seed = 5}).positions)
+            cloud.positions.push_back(p + Vec3f(3.5F, 0.0F, 0.0F));
+    return cloud;
+}
+
+TEST(Components, SheetsOverAScatteredSprayAreRemoved)
+{
+    // The spray's samples reach far and their neighbourhoods fill a volume: the sheets the field
+    // makes over them are held up by hundreds of them (more than min_samples), but by scattered
+    // samples only.
+    const PointField field(
+        compute_surfels(sphere_with_spray(200, 0), {.radius_scale = 1.5}).surfels);
+    TriMesh mesh = marching_cubes(field, grid_over(field.bounds(), default_cell_size(field))).mesh;
+    ASSERT_GT(analyze_topology(mesh).components, 1U) << "no sheets: the test tests nothing";
+    TriMesh again = mesh;
+    const ComponentFilterReport report =
+        remove_unsupported_components(mesh, field.surfels(), 32, &field.tree());
+    ASSERT_GE(report.scattered_components, 1U);
+    EXPECT_EQ(report.removed_components, report.components - 1);
+    const MeshTopology after = analyze_topology(mesh);
+    EXPECT_EQ(after.components, 1U);
+    EXPECT_TRUE(after.is_closed());
+    EXPECT_EQ(after.euler_characteristic, 2);
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+        ASSERT_NEAR(mesh.vertices.world(v).norm(), 1.0, 0.02);
+    // The same without a tree given (one is built).
+    EXPECT_EQ(remove_unsupported_components(again, field.surfels(), 32).scattered_components,
+              report.scattered_components);
+    EXPECT_EQ(again.triangles, mesh.triangles);
+}
+
+TEST(Components, ASparselySampledObjectIsNotScattered)
+{
+    // A second sphere sampled by 250 points (40 times more sparsely: its reach over four times
+    // the cloud's median, but its samples on a sheet) stays, as a noisy one sampled as densely
+    // as the rest does (SupportedComponentsStay).
+    const PointField field(
+        compute_surfels(sphere_with_spray(0, 250), {.radius_scale = 1.5}).surfels);
+    TriMesh mesh = marching_cubes(field, grid_over(field.bounds(), default_cell_size(field))).mesh;
+    ASSERT_EQ(analyze_topology(mesh).components, 2U);
+    const TriMesh copy = mesh;
+    const ComponentFilterReport report =
+        remove_unsupported_components(mesh, field.surfels(), 32, &field.tree());
+    EXPECT_EQ(report.removed_components, 0U);
+    EXPECT_EQ(report.scattered_components, 0U);
+    EXPECT_EQ(mesh.triangles, copy.triangles);
+}
+
 } // namespace
 } // namespace pointform

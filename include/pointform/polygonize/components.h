@@ -5,6 +5,7 @@
 
 #include "pointform/geometry/point_cloud.h"
 #include "pointform/geometry/tri_mesh.h"
+#include "pointform/spatial/kd_tree.h"
 
 #include <cstddef>
 
@@ -17,6 +18,9 @@ struct ComponentFilterReport
     std::size_t removed_components = 0; ///< components removed
     std::size_t removed_faces = 0;      ///< their faces
     std::size_t min_samples = 0;        ///< the support a component needed
+    /// Of the removed components, those with support enough but held up by scattered samples
+    /// (see remove_unsupported_components()).
+    std::size_t scattered_components = 0;
 };
 
 /// \brief The support a component of a reconstruction needs by default: 0.1% of the samples,
@@ -26,10 +30,29 @@ struct ComponentFilterReport
 /// \brief Removes the connected components of `mesh` that fewer than `min_samples` of `samples`
 /// have as their nearest part of the mesh (exact closest point on the triangles): the debris of
 /// a field around a few stray samples or a flipped normal, which the samples do not describe as
-/// a surface. Vertices of removed components are dropped and the rest renumbered in order
-/// (every vertex attribute kept); components are vertex-connected. Deterministic whatever the
-/// thread count. `min_samples` = 0 keeps every component.
+/// a surface. Also removed, but for the best-supported component, those whose support is mostly
+/// scattered samples: samples whose 16 nearest spread through a volume rather than along a
+/// sheet (the least eigenvalue of their covariance above scattered_volume times the largest)
+/// and reach farther than scattered_reach times the cloud's median reach (the distance to the
+/// 16th nearest), a spray of stray returns through the space around a scan, over which the
+/// field makes sheets that no surface supports. (A noisy surface sampled as densely as the
+/// rest is not scattered, nor is a sparse one whose samples lie on a sheet.) Up to 256 of a
+/// component's samples are tested, spread evenly in index order. Vertices of removed
+/// components are dropped and the rest renumbered in order (every vertex attribute kept);
+/// components are vertex-connected. Deterministic whatever the thread count. `min_samples` = 0
+/// keeps every component.
+/// \param sample_tree  a kd-tree over samples.positions (as PointField::tree()), or null: one
+///        is built when a component is to be tested
 ComponentFilterReport remove_unsupported_components(TriMesh& mesh, const PointCloud& samples,
-                                                    std::size_t min_samples);
+                                                    std::size_t min_samples,
+                                                    const KdTree* sample_tree = nullptr);
+
+/// remove_unsupported_components(): a sample is scattered when its reach is more than this
+/// many times the cloud's median ...
+inline constexpr double scattered_reach = 4.0;
+/// ... and its neighbourhood a volume: its covariance's least eigenvalue more than this share of
+/// the largest (16 points spread evenly through a ball score about 0.35, and 95% of such
+/// neighbourhoods above 0.17; a sheet near 0, a sphere sampled by 100 points under 0.1).
+inline constexpr double scattered_volume = 0.15;
 
 } // namespace pointform
