@@ -150,6 +150,25 @@ TEST(Reconstruct, ClustersOfStraysDoNotSpoilTheSurface)
     expect_unit_sphere(reconstruct(surfels.surfels));
 }
 
+// A spray of stray returns through the space around a scanned sphere (150 points spread evenly
+// through the cube of side 6 around it): far from each other and from the sphere, none isolated,
+// each with a radius that reaches its fellows, so the field made a sheet through them many times
+// the sphere's area, held up by more samples than debris needs. The sheet's support is scattered
+// samples (remove_unsupported_components()): it goes, and the sphere comes out as without them.
+TEST(Reconstruct, ASprayOfStraysThroughSpaceDoesNotSpoilTheSurface)
+{
+    PointCloud points = sample_shape(Shape::Sphere, {.count = 5000, .seed = 33});
+    points.normals.clear();
+    points.radii.clear();
+    std::mt19937 random(9);
+    std::uniform_real_distribution<float> side(-3.0F, 3.0F);
+    for (int i = 0; i < 150; ++i)
+        points.positions.emplace_back(side(random), side(random), side(random));
+    const ReconstructReport report = reconstruct(surfels_from_samples(points).surfels);
+    EXPECT_GE(report.debris.scattered_components, 1U);
+    expect_unit_sphere(report);
+}
+
 // Coordinates quantized by a scanner or a file format (here a sphere's 30k samples rounded to a
 // grid of 0.03 of its radius, about the samples' spacing): many samples fall on one place, and
 // a place with more samples than a row had neighbours of no reach and a radius of 0 ("the cloud
