@@ -6,10 +6,9 @@
 #include "pointform/core/disjoint_sets.h"
 #include "pointform/core/parallel.h"
 #include "pointform/geometry/mesh_topology.h"
+#include "pointform/hermite/normals.h"
 #include "pointform/spatial/spatial_sort.h"
 #include "pointform/spatial/triangle_bvh.h"
-
-#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <array>
@@ -131,20 +130,7 @@ bool scattered(const KdTree& tree, const PointCloud& samples, std::size_t i, flo
     const std::size_t found = tree.knn(samples.positions[i], scatter_k, index, d2);
     if (found < scatter_k || !(d2[found - 1] > limit2))
         return false;
-    const Vec3d origin = samples.positions[i].cast<double>();
-    Vec3d sum = Vec3d::Zero();
-    Mat3d outer = Mat3d::Zero();
-    for (std::size_t j = 0; j < found; ++j)
-    {
-        const Vec3d d = samples.positions[index[j]].cast<double>() - origin;
-        sum += d;
-        outer.noalias() += d * d.transpose();
-    }
-    const auto count = static_cast<double>(found);
-    const Vec3d mean = sum / count;
-    const Mat3d covariance = outer / count - mean * mean.transpose();
-    const Eigen::SelfAdjointEigenSolver<Mat3d> solver(covariance, Eigen::EigenvaluesOnly);
-    const Vec3d& lambda = solver.eigenvalues();
+    const Vec3d lambda = fit_plane(samples.positions, std::span(index).first(found)).eigenvalues;
     return lambda[0] > scattered_volume * lambda[2];
 }
 
@@ -216,12 +202,12 @@ ComponentFilterReport remove_unsupported_components(TriMesh& mesh, const PointCl
     keep[best] = 1;
     // The others kept, unless their support is mostly scattered samples (every one tested, or
     // scatter_tests of them spread evenly in index order).
-    std::vector<std::vector<std::uint32_t>> tested(report.components);
     std::size_t candidates = 0;
     for (std::size_t c = 0; c < report.components; ++c)
         candidates += keep[c] != 0 && c != best ? 1 : 0;
     if (candidates > 0)
     {
+        std::vector<std::vector<std::uint32_t>> tested(report.components);
         std::vector<std::size_t> seen(report.components, 0);
         for (std::size_t i = 0; i < samples.size(); ++i)
         {

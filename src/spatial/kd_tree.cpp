@@ -536,7 +536,7 @@ std::size_t KdTree::knn(const Vec3f& query, std::size_t k, float bound2,
     check_buffer_size("KdTree::knn", "squared_distances", squared_distances.size(), k);
     if (k == 0)
         return 0;
-    // NaN: no bound.
+    // NaN or negative: no bound.
     OrderedKnnResult result(k, indices.data(), squared_distances.data(), impl_->caller_index(),
                             bound2 >= 0.0F ? bound2 : std::numeric_limits<float>::infinity());
     impl_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
