@@ -83,15 +83,19 @@ void run_reconstruct(const ReconstructCommandOptions& options, const GlobalOptio
                       ", " + fit + " field; degenerate " +
                       describe_degenerate(report.degenerate_triangles, report.degenerate_kept) +
                       ")");
-        print_row("debris",
-                  "removed " + std::to_string(report.debris.removed_components) + " of " +
-                      std::to_string(report.debris.components) + " components (" +
-                      std::to_string(report.debris.removed_faces) + " faces) that fewer than " +
-                      std::to_string(report.debris.min_samples) + " samples are nearest to" +
-                      (report.debris.scattered_components > 0
-                           ? " or that scattered samples hold up (" +
-                                 std::to_string(report.debris.scattered_components) + ")"
-                           : std::string()));
+        print_row(
+            "debris",
+            "removed " + std::to_string(report.debris.removed_components) + " of " +
+                std::to_string(report.debris.components) + " components (" +
+                std::to_string(report.debris.removed_faces) + " faces) that fewer than " +
+                std::to_string(report.debris.min_samples) + " samples are nearest to" +
+                (report.debris.scattered_components > 0
+                     ? " or that scattered samples hold up (" +
+                           std::to_string(report.debris.scattered_components) + ")"
+                     : std::string()) +
+                (report.stray_samples > 0 ? "; " + std::to_string(report.stray_samples) +
+                                                " stray samples, not where marching cubes starts"
+                                          : std::string()));
         print_row("handles", describe_handle_cuts(report.handles, options.reconstruct.max_handle));
         print_base_mesh(*base_stats);
     }

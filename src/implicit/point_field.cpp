@@ -6,6 +6,7 @@
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 #include "pointform/hermite/crease_fit.h"
+#include "pointform/hermite/scatter.h"
 #include "pointform/spatial/feature_grid.h"
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/point_grid.h"
@@ -918,6 +919,8 @@ struct PointField::Impl
     /// first), from the fit's search; empty when the fit takes fewer. Bounds a search of the
     /// kd-tree from a query near the sample (far_bound()).
     std::vector<float> reach;
+    /// The stray samples (ScatterTest::stray()), ascending.
+    std::vector<std::uint32_t> strays;
     Aabb box;
     Aabb local_box;  ///< box, relative to the cloud's origin
     Aabb sample_box; ///< the samples' bounding box, relative to the origin
@@ -1343,6 +1346,21 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
         m.area += area;
     }
 
+    // The stray samples: only those whose reach, as the fit's search measured it, is near the
+    // limit or past it are tested (a search of their own each).
+    const ScatterTest scatter = scatter_test(m.tree, m.surfels.positions);
+    const bool reach_known = !m.reach.empty() && reach_rank == scatter_neighbourhood;
+    const std::vector<std::uint32_t> candidates = parallel_collect<std::uint32_t>(
+        n, 4096, [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& out) {
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                const float r =
+                    reach_known ? m.reach[m.grid->slot_of(static_cast<std::uint32_t>(i))] : 0.0F;
+                if (!reach_known || r * r > 0.999F * scatter.limit2)
+                    out.push_back(static_cast<std::uint32_t>(i));
+            }
+        });
+    m.strays = find_strays(m.tree, m.surfels.positions, scatter, candidates);
     float max_radius = 0.0F;
     for (const float r : m.surfels.radii)
     {
@@ -1842,11 +1860,23 @@ Aabb PointField::bounds() const
 void PointField::append_seeds(std::vector<Vec3d>& seeds) const
 {
     const PointCloud& s = impl_->surfels;
-    seeds.reserve(seeds.size() + s.size());
+    const std::vector<std::uint32_t>& strays = impl_->strays;
+    seeds.reserve(seeds.size() + s.size() - strays.size());
+    auto next = strays.begin();
     for (std::size_t i = 0; i < s.size(); ++i)
     {
+        if (next != strays.end() && *next == i)
+        {
+            ++next;
+            continue;
+        }
         seeds.push_back(s.world(i));
     }
+}
+
+std::span<const std::uint32_t> PointField::stray_samples() const
+{
+    return impl_->strays;
 }
 
 const PointCloud& PointField::surfels() const

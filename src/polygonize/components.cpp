@@ -6,12 +6,11 @@
 #include "pointform/core/disjoint_sets.h"
 #include "pointform/core/parallel.h"
 #include "pointform/geometry/mesh_topology.h"
-#include "pointform/hermite/normals.h"
+#include "pointform/hermite/scatter.h"
 #include "pointform/spatial/spatial_sort.h"
 #include "pointform/spatial/triangle_bvh.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -114,46 +113,8 @@ Support component_support(const TriMesh& mesh, const std::vector<std::uint32_t>&
     return {std::move(support), std::move(nearest)};
 }
 
-/// The sample and its 16 nearest: the neighbourhood of the scattered-sample test.
-constexpr std::size_t scatter_k = 17;
 /// The samples of a component tested at most (evenly spread over its supporters in index order).
 constexpr std::size_t scatter_tests = 256;
-/// The samples whose reach gives the cloud's median at most (every stride-th).
-constexpr std::size_t reach_probes = 4096;
-
-/// Whether `i`'s neighbourhood fills a volume (see scattered_volume) and reaches farther than
-/// `limit2` (squared).
-bool scattered(const KdTree& tree, const PointCloud& samples, std::size_t i, float limit2)
-{
-    std::array<std::uint32_t, scatter_k> index{};
-    std::array<float, scatter_k> d2{};
-    const std::size_t found = tree.knn(samples.positions[i], scatter_k, index, d2);
-    if (found < scatter_k || !(d2[found - 1] > limit2))
-        return false;
-    const Vec3d lambda = fit_plane(samples.positions, std::span(index).first(found)).eigenvalues;
-    return lambda[0] > scattered_volume * lambda[2];
-}
-
-/// The square of scattered_reach times the median reach (to the 16th nearest) of every
-/// stride-th sample.
-float scattered_limit2(const KdTree& tree, const PointCloud& samples)
-{
-    const std::size_t stride = std::max<std::size_t>(1, samples.size() / reach_probes);
-    std::vector<float> reach2;
-    std::array<std::uint32_t, scatter_k> index{};
-    std::array<float, scatter_k> d2{};
-    for (std::size_t i = 0; i < samples.size(); i += stride)
-    {
-        const std::size_t found = tree.knn(samples.positions[i], scatter_k, index, d2);
-        if (found > 0)
-            reach2.push_back(d2[found - 1]);
-    }
-    if (reach2.empty())
-        return std::numeric_limits<float>::infinity();
-    const auto middle = reach2.begin() + static_cast<std::ptrdiff_t>(reach2.size() / 2);
-    std::nth_element(reach2.begin(), middle, reach2.end());
-    return static_cast<float>(scattered_reach * scattered_reach * static_cast<double>(*middle));
-}
 
 } // namespace
 
@@ -224,14 +185,14 @@ ComponentFilterReport remove_unsupported_components(TriMesh& mesh, const PointCl
         if (sample_tree == nullptr)
             own_tree.emplace(samples.positions);
         const KdTree& tree = sample_tree != nullptr ? *sample_tree : *own_tree;
-        const float limit2 = scattered_limit2(tree, samples);
+        const ScatterTest test = scatter_test(tree, samples.positions);
         for (std::size_t c = 0; c < report.components; ++c)
         {
             if (tested[c].empty())
                 continue;
             std::size_t count = 0;
             for (const std::uint32_t i : tested[c])
-                count += scattered(tree, samples, i, limit2) ? 1 : 0;
+                count += test.scattered(tree, samples.positions, i) ? 1 : 0;
             if (2 * count > tested[c].size())
             {
                 keep[c] = 0;

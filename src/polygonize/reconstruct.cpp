@@ -338,6 +338,7 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
         const double cell = intermediate.cell;
         report.cell = cell;
         report.coarsening = intermediate.coarsening;
+        report.stray_samples = field.stray_samples().size();
         const CellGrid grid = grid_over(field.bounds(), cell);
         check_marching_cubes_memory(field, cell);
         // The intermediate mesh's vertex normals are not used (the base mesh is made from its

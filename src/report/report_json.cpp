@@ -264,7 +264,8 @@ nlohmann::json report_json(const ReconstructReport& report, const ReconstructOpt
                          {"removed_components", report.debris.removed_components},
                          {"removed_faces", report.debris.removed_faces},
                          {"min_samples", report.debris.min_samples},
-                         {"scattered_components", report.debris.scattered_components}};
+                         {"scattered_components", report.debris.scattered_components},
+                         {"stray_samples", report.stray_samples}};
         out["handles"] = report_json(report.handles);
     }
     else if (report.picked)

@@ -247,6 +247,42 @@ TEST(PointField, KeepsItsSamplesInMortonOrderAndIsTheSameForAnyOrder)
     EXPECT_EQ(a.median_radius(), b.median_radius());
 }
 
+TEST(PointField, StraysAreNoSeeds)
+{
+    // A sphere's 8,000 samples and 150 points sprayed through the cube of side 6 around it,
+    // with normals and radii estimated as for a scan.
+    PointCloud points = sample_shape(Shape::Sphere, {.count = 8000, .seed = 3});
+    points.normals.clear();
+    std::mt19937 random(12);
+    std::uniform_real_distribution<float> side(-3.0F, 3.0F);
+    for (int i = 0; i < 150; ++i)
+        points.positions.emplace_back(side(random), side(random), side(random));
+    const PointField field(compute_surfels(points).surfels);
+    const std::span<const std::uint32_t> strays = field.stray_samples();
+    EXPECT_GE(strays.size(), 135U);
+    EXPECT_LE(strays.size(), 150U);
+    std::vector<Vec3d> seeds;
+    field.append_seeds(seeds);
+    ASSERT_EQ(seeds.size(), field.surfels().size() - strays.size());
+    // The seeds are the other samples, in order.
+    std::size_t next = 0;
+    std::size_t seed = 0;
+    for (std::size_t i = 0; i < field.surfels().size(); ++i)
+    {
+        if (next < strays.size() && strays[next] == i)
+        {
+            EXPECT_GT(std::abs(field.surfels().world(i).norm() - 1.0), 0.05)
+                << "a sample of the sphere";
+            ++next;
+            continue;
+        }
+        ASSERT_EQ(seeds[seed++], field.surfels().world(i));
+    }
+    // A clean sphere has none.
+    const PointField clean(sphere_surfels(6000, 0.15F));
+    EXPECT_TRUE(clean.stray_samples().empty());
+}
+
 TEST(PointField, SuccessiveEvaluationsAreTheBatchsBitForBit)
 {
     // One by one, an evaluation near the one before takes its neighbours from it when they are

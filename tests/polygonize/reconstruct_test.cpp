@@ -153,19 +153,25 @@ TEST(Reconstruct, ClustersOfStraysDoNotSpoilTheSurface)
 // A spray of stray returns through the space around a scanned sphere (150 points spread evenly
 // through the cube of side 6 around it): far from each other and from the sphere, none isolated,
 // each with a radius that reaches its fellows, so the field made a sheet through them many times
-// the sphere's area, held up by more samples than debris needs. The sheet's support is scattered
-// samples (remove_unsupported_components()): it goes, and the sphere comes out as without them.
+// the sphere's area, held up by more samples than debris needs. The spray's samples are strays
+// (PointField::stray_samples()), from which marching cubes does not start: the sheet is never
+// made (it was, and then removed as debris held up by scattered samples), and the sphere comes
+// out as without them.
 TEST(Reconstruct, ASprayOfStraysThroughSpaceDoesNotSpoilTheSurface)
 {
     PointCloud points = sample_shape(Shape::Sphere, {.count = 5000, .seed = 33});
     points.normals.clear();
     points.radii.clear();
+    const ReconstructReport clean = reconstruct(surfels_from_samples(points).surfels);
     std::mt19937 random(9);
     std::uniform_real_distribution<float> side(-3.0F, 3.0F);
     for (int i = 0; i < 150; ++i)
         points.positions.emplace_back(side(random), side(random), side(random));
     const ReconstructReport report = reconstruct(surfels_from_samples(points).surfels);
-    EXPECT_GE(report.debris.scattered_components, 1U);
+    EXPECT_EQ(clean.stray_samples, 0U);
+    EXPECT_GE(report.stray_samples, 135U); // of 150, and a few lie near the sphere
+    EXPECT_LE(report.stray_samples, 150U);
+    EXPECT_LT(report.intermediate_faces, clean.intermediate_faces + clean.intermediate_faces / 10);
     expect_unit_sphere(report);
 }
 

@@ -8,7 +8,9 @@
 #include "pointform/spatial/kd_tree.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
+#include <span>
 #include <string_view>
 
 namespace pointform {
@@ -156,7 +158,16 @@ public:
                          std::span<const double> hi, std::span<FieldSample> out) const override;
     [[nodiscard]] double cost() const override;
     [[nodiscard]] Aabb bounds() const override;
+    /// \brief The samples' positions, but for the strays (stray_samples()): a surface that only
+    /// strays hold up is no part of the scan (marching cubes, which follows the surface from
+    /// these seeds, does not look for it), and a surface that other samples hold up too is
+    /// found from theirs.
     void append_seeds(std::vector<Vec3d>& seeds) const override;
+
+    /// \brief The samples (indices into surfels(), ascending) that ScatterTest::stray() finds
+    /// stray: returns sprayed through the space around a scan, or standing off a surface, whose
+    /// influence radii (many times the others') give the field sheets far from any surface.
+    [[nodiscard]] std::span<const std::uint32_t> stray_samples() const;
 
     /// \brief The samples, with unit normals, in Morton order (spatial_order()), not
     /// necessarily the order given: the field is the same whatever order its samples come in.

@@ -238,6 +238,9 @@ struct ReconstructReport
     std::size_t degenerate_triangles = 0;
     std::size_t degenerate_kept = 0;
     ComponentFilterReport debris;
+    /// The samples that PointField::stray_samples() found stray: not seeds of the marching
+    /// cubes, so that the sheets only they hold up are not made.
+    std::size_t stray_samples = 0;
     /// The short handles cut from the intermediate mesh (ReconstructOptions::max_handle).
     HandleCutReport handles;
     /// The picked base mesh, when ReconstructOptions::base_mesh or picked_vertices was given, and

@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#include "pointform/hermite/scatter.h"
+
+#include "pointform/geometry/shapes.h"
+
+#include "support/thread_counts.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <numeric>
+#include <random>
+#include <vector>
+
+namespace pointform {
+namespace {
+
+/// Every sample a candidate.
+std::vector<std::uint32_t> all_of(std::size_t n)
+{
+    std::vector<std::uint32_t> all(n);
+    std::iota(all.begin(), all.end(), 0U);
+    return all;
+}
+
+std::vector<std::uint32_t> strays_of(const std::vector<Vec3f>& positions)
+{
+    const KdTree tree(positions);
+    return find_strays(tree, positions, scatter_test(tree, positions), all_of(positions.size()));
+}
+
+/// 10k samples of the unit sphere, then `sprayed` points spread evenly through the cube of
+/// side 6 around it.
+std::vector<Vec3f> sphere_with_spray(std::size_t sprayed, unsigned seed)
+{
+    std::vector<Vec3f> positions =
+        sample_shape(Shape::Sphere, {.count = 10000, .seed = 2}).positions;
+    std::mt19937 random(seed);
+    std::uniform_real_distribution<float> side(-3.0F, 3.0F);
+    for (std::size_t i = 0; i < sprayed; ++i)
+        positions.emplace_back(side(random), side(random), side(random));
+    return positions;
+}
+
+TEST(Scatter, ASprayIsStrayAndTheSurfaceIsNot)
+{
+    for (const unsigned seed : {1U, 2U, 3U})
+    {
+        const std::vector<Vec3f> positions = sphere_with_spray(200, seed);
+        const std::vector<std::uint32_t> strays = strays_of(positions);
+        EXPECT_TRUE(std::is_sorted(strays.begin(), strays.end()));
+        // None of the sphere's; nearly all of the spray (a few lie beside the sphere, their
+        // nearest its samples, a reach like theirs).
+        EXPECT_TRUE(
+            std::all_of(strays.begin(), strays.end(), [](std::uint32_t i) { return i >= 10000; }))
+            << "seed " << seed;
+        EXPECT_GE(strays.size(), 180U) << "seed " << seed;
+    }
+}
+
+TEST(Scatter, StraysBesideASurfaceAreFound)
+{
+    // 60 returns 0.4-0.8 off the sphere (its median reach about 0.08): their nearest are the
+    // sphere's, on a sheet, but they stand off it. (Nearer ones reach no farther than the
+    // limit: the field's fit takes them.)
+    std::vector<Vec3f> positions =
+        sample_shape(Shape::Sphere, {.count = 10000, .seed = 2}).positions;
+    std::mt19937 random(4);
+    std::normal_distribution<float> gauss;
+    std::uniform_real_distribution<float> off(1.4F, 1.8F);
+    for (int i = 0; i < 60; ++i)
+        positions.push_back(Vec3f(gauss(random), gauss(random), gauss(random)).normalized() *
+                            off(random));
+    const std::vector<std::uint32_t> strays = strays_of(positions);
+    EXPECT_TRUE(
+        std::all_of(strays.begin(), strays.end(), [](std::uint32_t i) { return i >= 10000; }));
+    EXPECT_EQ(strays.size(), 60U);
+}
+
+TEST(Scatter, SparseSurfacesAreNotStray)
+{
+    // A second sphere 3.5 away sampled 40 times more sparsely (250 points: reach six times the
+    // median, but on a sheet, among its own), and a plane whose far half is sampled 25 times
+    // more sparsely than its near half: no strays.
+    std::vector<Vec3f> spheres = sample_shape(Shape::Sphere, {.count = 10000, .seed = 2}).positions;
+    for (const Vec3f& p : sample_shape(Shape::Sphere, {.count = 250, .seed = 5}).positions)
+        spheres.push_back(p + Vec3f(3.5F, 0.0F, 0.0F));
+    EXPECT_TRUE(strays_of(spheres).empty());
+
+    std::vector<Vec3f> plane;
+    std::mt19937 random(7);
+    std::uniform_real_distribution<float> unit(0.0F, 1.0F);
+    for (int i = 0; i < 25000; ++i)
+        plane.emplace_back(unit(random), unit(random), 0.0F);
+    for (int i = 0; i < 1000; ++i)
+        plane.emplace_back(1.0F + unit(random), unit(random), 0.0F);
+    EXPECT_TRUE(strays_of(plane).empty());
+}
+
+TEST(Scatter, SmallCloudsAndTheLimit)
+{
+    // Fewer than 17 samples: no neighbourhood to judge, no strays.
+    const std::vector<Vec3f> few = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 5, 0)};
+    const KdTree tree(few);
+    EXPECT_TRUE(find_strays(tree, few, scatter_test(tree, few), all_of(few.size())).empty());
+    // The limit is scattered_reach² times the median squared reach.
+    std::vector<Vec3f> grid;
+    for (int x = 0; x < 20; ++x)
+        for (int y = 0; y < 20; ++y)
+            grid.emplace_back(static_cast<float>(x), static_cast<float>(y), 0.0F);
+    const KdTree grid_tree(grid);
+    const ScatterTest test = scatter_test(grid_tree, grid);
+    // Inside a unit grid the 16th nearest other point is √5 away (4 at 1, 4 at √2, 4 at 2, then
+    // 8 at √5), and most points are inside.
+    EXPECT_NEAR(test.limit2, scattered_reach * scattered_reach * 5.0, 1e-3);
+    EXPECT_TRUE(strays_of(grid).empty());
+    // Only candidates are tested.
+    const std::vector<Vec3f> sprayed = sphere_with_spray(200, 1);
+    const KdTree sprayed_tree(sprayed);
+    EXPECT_TRUE(
+        find_strays(sprayed_tree, sprayed, scatter_test(sprayed_tree, sprayed), {}).empty());
+}
+
+TEST(Scatter, TheSameStraysWhateverTheThreadCount)
+{
+    const std::vector<Vec3f> positions = sphere_with_spray(2000, 6);
+    const auto runs = test::at_thread_counts([&] { return strays_of(positions); });
+    EXPECT_GT(runs[0].size(), 1000U);
+    for (std::size_t i = 1; i < runs.size(); ++i)
+        EXPECT_EQ(runs[i], runs[0]) << i + 1 << " threads";
+}
+
+} // namespace
+} // namespace pointform
