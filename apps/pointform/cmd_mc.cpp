@@ -100,6 +100,7 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
         out["min_component_samples"] = debris.min_samples;
         out["components_removed"] = debris.removed_components;
         out["components_scattered"] = debris.scattered_components;
+        out["stray_samples"] = field.stray_samples().size();
         out["faces_removed"] = debris.removed_faces;
         out["max_handle"] = options.max_handle;
         out["handles"] = report_json(handles);
@@ -146,7 +147,11 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
             (debris.scattered_components > 0 ? ", or held up by scattered samples (" +
                                                    std::to_string(debris.scattered_components) + ")"
                                              : std::string()) +
-            ")");
+            ")" +
+            (field.stray_samples().empty()
+                 ? std::string()
+                 : "; " + std::to_string(field.stray_samples().size()) +
+                       " stray samples, not where marching cubes starts"));
     print_row("handles", describe_handle_cuts(handles, options.max_handle));
     print_row("holes filled", holes.skipped_not_manifold
                                   ? std::string("none (the mesh is not an oriented 2-manifold)")
