@@ -166,6 +166,9 @@ ScatterTest scatter_test(const KdTree& tree, std::span<const Vec3f> positions)
         return {.limit2 = std::numeric_limits<float>::infinity()};
     const auto middle = reach2.begin() + static_cast<std::ptrdiff_t>(reach2.size() / 2);
     std::nth_element(reach2.begin(), middle, reach2.end());
+    // Most samples on top of 16 others (a cloud of copies): no spacing to judge by.
+    if (!(*middle > 0.0F))
+        return {.limit2 = std::numeric_limits<float>::infinity()};
     return {.limit2 = static_cast<float>(scattered_reach * scattered_reach *
                                          static_cast<double>(*middle))};
 }

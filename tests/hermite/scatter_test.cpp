@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <numeric>
 #include <random>
@@ -117,6 +118,15 @@ TEST(Scatter, SmallCloudsAndTheLimit)
     // 8 at √5), and most points are inside.
     EXPECT_NEAR(test.limit2, scattered_reach * scattered_reach * 5.0, 1e-3);
     EXPECT_TRUE(strays_of(grid).empty());
+    // A cloud of copies (each place 20 times) has no spacing to judge by: no strays.
+    std::vector<Vec3f> copies;
+    for (const Vec3f& p : grid)
+        for (int c = 0; c < 20; ++c)
+            copies.push_back(p);
+    copies.emplace_back(100.0F, 100.0F, 100.0F);
+    const KdTree copies_tree(copies);
+    EXPECT_TRUE(std::isinf(scatter_test(copies_tree, copies).limit2));
+    EXPECT_TRUE(strays_of(copies).empty());
     // Only candidates are tested.
     const std::vector<Vec3f> sprayed = sphere_with_spray(200, 1);
     const KdTree sprayed_tree(sprayed);

@@ -39,7 +39,8 @@ inline constexpr double stray_isolation = 4.0;
 struct ScatterTest
 {
     /// The squared reach above which a sample may be scattered: scattered_reach times the
-    /// median reach, squared (infinite for a cloud of fewer than 17 samples).
+    /// median reach, squared (infinite for a cloud of fewer than 17 samples, or one whose median
+    /// reach is 0: most samples copies of 16 others).
     float limit2 = 0.0F;
 
     /// \brief Whether sample `i` of `positions` (over which `tree` is built) is scattered:
