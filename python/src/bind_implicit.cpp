@@ -122,6 +122,27 @@ void bind_implicit(py::module_& m)
                 return py::float_(self.point->median_radius());
             },
             "The median influence radius of a point field's surfels (None for other fields).")
+        .def_property_readonly(
+            "strays",
+            [](const FieldHandle& self) -> py::object {
+                if (!self.point)
+                    return py::none();
+                const std::span<const std::uint32_t> strays = self.point->stray_samples();
+                py::array_t<double> out({static_cast<py::ssize_t>(strays.size()), py::ssize_t{3}});
+                auto view = out.mutable_unchecked<2>();
+                for (std::size_t k = 0; k < strays.size(); ++k)
+                {
+                    const Vec3d p = self.point->surfels().world(strays[k]);
+                    for (py::ssize_t a = 0; a < 3; ++a)
+                        view(static_cast<py::ssize_t>(k), a) = p[a];
+                }
+                return std::move(out);
+            },
+            "The positions (K by 3, float64) of a point field's stray samples (None for other "
+            "fields): samples past 4 times the median reach to the 16th nearest that fill a "
+            "volume, stand off their neighbours' plane or are isolated from them, and the groups "
+            "of such samples most of which are; marching cubes does not start from them, so "
+            "sheets only they hold up are not made (a spray of stray returns round a scan).")
         .def("__repr__",
              [](const FieldHandle& self) { return "<pointform.Field " + self.description + ">"; });
 
