@@ -74,9 +74,8 @@ bool ScatterTest::stray(const KdTree& tree, std::span<const Vec3f> positions, st
            stray_isolation * stray_isolation * static_cast<double>(*middle);
 }
 
-std::vector<std::uint32_t> find_strays(const KdTree& tree, std::span<const Vec3f> positions,
-                                       const ScatterTest& test,
-                                       std::span<const std::uint32_t> candidates)
+Strays find_strays(const KdTree& tree, std::span<const Vec3f> positions, const ScatterTest& test,
+                   std::span<const std::uint32_t> candidates)
 {
     PF_ASSERT(std::is_sorted(candidates.begin(), candidates.end()));
     // Each candidate's reach tested exactly, its 16 nearest kept, and the test's verdict.
@@ -137,17 +136,17 @@ std::vector<std::uint32_t> find_strays(const KdTree& tree, std::span<const Vec3f
         ++members[g];
         group_strays[g] += tested[c].stray ? 1 : 0;
     }
+    Strays out;
     for (std::size_t c = 0; c < candidates.size(); ++c)
     {
         const std::size_t g = groups.find(c);
-        if (tested[c].over && 2 * group_strays[g] > members[g])
-            tested[c].stray = true;
+        const bool sprayed = tested[c].over && 2 * group_strays[g] > members[g];
+        if (sprayed)
+            out.sprayed.push_back(candidates[c]);
+        if (sprayed || tested[c].stray)
+            out.samples.push_back(candidates[c]);
     }
-    std::vector<std::uint32_t> strays;
-    for (std::size_t c = 0; c < candidates.size(); ++c)
-        if (tested[c].stray)
-            strays.push_back(candidates[c]);
-    return strays;
+    return out;
 }
 
 ScatterTest scatter_test(const KdTree& tree, std::span<const Vec3f> positions)

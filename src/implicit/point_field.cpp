@@ -921,6 +921,9 @@ struct PointField::Impl
     std::vector<float> reach;
     /// The stray samples (ScatterTest::stray()), ascending.
     std::vector<std::uint32_t> strays;
+    /// Per grid slot: 1 for a member of a spray (Strays::sprayed), which neither blends nor
+    /// defines the field; empty when there are none.
+    std::vector<std::uint8_t> stray_slot;
     Aabb box;
     Aabb local_box;  ///< box, relative to the cloud's origin
     Aabb sample_box; ///< the samples' bounding box, relative to the origin
@@ -1360,7 +1363,16 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
                     out.push_back(static_cast<std::uint32_t>(i));
             }
         });
-    m.strays = find_strays(m.tree, m.surfels.positions, scatter, candidates);
+    Strays strays = find_strays(m.tree, m.surfels.positions, scatter, candidates);
+    m.strays = std::move(strays.samples);
+    // A spray's members blend with nothing; a stray among the samples of a sparse part that are
+    // not strays still blends (the part may need it).
+    if (!strays.sprayed.empty() && blends(options.fit))
+    {
+        m.stray_slot.assign(m.grid->slot_count(), 0);
+        for (const std::uint32_t i : strays.sprayed)
+            m.stray_slot[m.grid->slot_of(i)] = 1;
+    }
     float max_radius = 0.0F;
     for (const float r : m.surfels.radii)
     {
@@ -1486,11 +1498,37 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
             found = std::min(found, want);
         }
     }
-    const PackedSurfel& nearest = m.packed[slot[0]];
+    std::size_t used = found == want && found > 1 ? found - 1 : found;
+    // Bandwidth: the distance of the first sample not blended (or a little beyond the last).
+    double bandwidth = found > 0 ? std::sqrt(static_cast<double>(dist2[found - 1])) : 0.0;
+    if (used == found)
+    {
+        bandwidth *= 1.5;
+    }
+    // A spray's members (Strays::sprayed) neither blend nor define the field: it is what the
+    // others make of it near them, with the same bandwidth.
+    const std::uint32_t nearest_of_all = slot[0];
+    if (!m.stray_slot.empty())
+    {
+        std::size_t kept = 0;
+        std::size_t kept_used = 0;
+        for (std::size_t j = 0; j < found; ++j)
+        {
+            if (m.stray_slot[slot[j]] != 0)
+                continue;
+            kept_used += j < used ? 1 : 0;
+            slot[kept] = slot[j];
+            dist2[kept] = dist2[j];
+            ++kept;
+        }
+        found = kept;
+        used = kept_used;
+    }
+    const PackedSurfel& nearest = m.packed[found > 0 ? slot[0] : nearest_of_all];
     // Defined inside the union of the blended samples' influence balls, so that a gap next to
     // a sample with a small radius is covered by its neighbours' balls.
     out.defined = false;
-    for (std::size_t j = 0; j < found && !out.defined; ++j)
+    for (std::size_t j = 0; j < found && used > 0 && !out.defined; ++j)
     {
         const PackedSurfel& s = m.packed[slot[j]];
         const auto r = static_cast<double>(s.radius);
@@ -1506,13 +1544,6 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
         return out;
     }
 
-    const std::size_t used = found == want && found > 1 ? found - 1 : found;
-    // Bandwidth: the distance of the first sample not blended (or a little beyond the last).
-    double bandwidth = std::sqrt(static_cast<double>(dist2[found - 1]));
-    if (used == found)
-    {
-        bandwidth *= 1.5;
-    }
     if (!(bandwidth > 0.0))
     {
         out.value = nearest.distance(p, &out.gradient);

@@ -30,7 +30,8 @@ std::vector<std::uint32_t> all_of(std::size_t n)
 std::vector<std::uint32_t> strays_of(const std::vector<Vec3f>& positions)
 {
     const KdTree tree(positions);
-    return find_strays(tree, positions, scatter_test(tree, positions), all_of(positions.size()));
+    return find_strays(tree, positions, scatter_test(tree, positions), all_of(positions.size()))
+        .samples;
 }
 
 /// 10k samples of the unit sphere, then `sprayed` points spread evenly through the cube of
@@ -101,12 +102,46 @@ TEST(Scatter, SparseSurfacesAreNotStray)
     EXPECT_TRUE(strays_of(plane).empty());
 }
 
+TEST(Scatter, SprayedAreTheStraysOfGroupsMostlyStray)
+{
+    // The spray's strays are nearly all in sprays (groups mostly strays).
+    const std::vector<Vec3f> positions = sphere_with_spray(200, 1);
+    const KdTree tree(positions);
+    const Strays spray =
+        find_strays(tree, positions, scatter_test(tree, positions), all_of(positions.size()));
+    EXPECT_GE(spray.sprayed.size(), 180U);
+    EXPECT_TRUE(std::includes(spray.samples.begin(), spray.samples.end(), spray.sprayed.begin(),
+                              spray.sprayed.end()));
+    // A plane whose far half is sampled 25 times more sparsely (its reach five times the
+    // median), with five of that half's samples lifted 0.05 off it (about 0.7 of their reach):
+    // those five are strays (and a few beside them), but among a thousand samples past the
+    // limit that are not, so in no spray.
+    std::vector<Vec3f> plane;
+    std::mt19937 random(7);
+    std::uniform_real_distribution<float> unit(0.0F, 1.0F);
+    for (int i = 0; i < 25000; ++i)
+        plane.emplace_back(unit(random), unit(random), 0.0F);
+    for (int i = 0; i < 1000; ++i)
+        plane.emplace_back(1.1F + 0.9F * unit(random), unit(random), i % 200 == 0 ? 0.05F : 0.0F);
+    const KdTree plane_tree(plane);
+    const Strays lifted =
+        find_strays(plane_tree, plane, scatter_test(plane_tree, plane), all_of(plane.size()));
+    // (A few beside them lean toward them: their neighbours' plane tilts.)
+    std::size_t lifted_strays = 0;
+    for (const std::uint32_t i : lifted.samples)
+        lifted_strays += plane[i].z() == 0.05F ? 1 : 0;
+    EXPECT_EQ(lifted_strays, 5U);
+    EXPECT_LE(lifted.samples.size(), 20U);
+    EXPECT_TRUE(lifted.sprayed.empty());
+}
+
 TEST(Scatter, SmallCloudsAndTheLimit)
 {
     // Fewer than 17 samples: no neighbourhood to judge, no strays.
     const std::vector<Vec3f> few = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 5, 0)};
     const KdTree tree(few);
-    EXPECT_TRUE(find_strays(tree, few, scatter_test(tree, few), all_of(few.size())).empty());
+    EXPECT_TRUE(
+        find_strays(tree, few, scatter_test(tree, few), all_of(few.size())).samples.empty());
     // The limit is scattered_reach² times the median squared reach.
     std::vector<Vec3f> grid;
     for (int x = 0; x < 20; ++x)
@@ -130,8 +165,8 @@ TEST(Scatter, SmallCloudsAndTheLimit)
     // Only candidates are tested.
     const std::vector<Vec3f> sprayed = sphere_with_spray(200, 1);
     const KdTree sprayed_tree(sprayed);
-    EXPECT_TRUE(
-        find_strays(sprayed_tree, sprayed, scatter_test(sprayed_tree, sprayed), {}).empty());
+    EXPECT_TRUE(find_strays(sprayed_tree, sprayed, scatter_test(sprayed_tree, sprayed), {})
+                    .samples.empty());
 }
 
 TEST(Scatter, TheSameStraysWhateverTheThreadCount)

@@ -62,16 +62,23 @@ struct ScatterTest
 /// reach is taken over every stride-th sample, at most 4,096 of them. Deterministic.
 [[nodiscard]] ScatterTest scatter_test(const KdTree& tree, std::span<const Vec3f> positions);
 
-/// \brief The strays (ScatterTest::stray()) among `candidates` (ascending indices into
-/// `positions`, over which `tree` is built; every sample whose reach may be over test.limit2),
-/// ascending; and with them every candidate over the limit of a group most of whom are strays
-/// (groups: candidates over the limit, joined to those of their 16 nearest that are over it
-/// too), a spray's few whose neighbourhood happens to lie flat. A surface sampled sparsely but
-/// evenly, away from strays, has none. Deterministic whatever the
-/// thread count.
-[[nodiscard]] std::vector<std::uint32_t> find_strays(const KdTree& tree,
-                                                     std::span<const Vec3f> positions,
-                                                     const ScatterTest& test,
-                                                     std::span<const std::uint32_t> candidates);
+/// \brief What find_strays() found (indices into the cloud, ascending).
+struct Strays
+{
+    /// The strays: those ScatterTest::stray() finds, and every member of a spray.
+    std::vector<std::uint32_t> samples;
+    /// The members of sprays: groups (samples past the reach limit, joined to those of their 16
+    /// nearest that are past it too) most of whose members are strays. A stray alone is a group
+    /// of one; a stray among many samples past the limit that are not (a part sampled sparsely
+    /// but evenly, where a few samples stand off its plane) is in none.
+    std::vector<std::uint32_t> sprayed;
+};
+
+/// \brief The strays among `candidates` (ascending indices into `positions`, over which `tree`
+/// is built; every sample whose reach may be over test.limit2). A surface sampled sparsely but
+/// evenly, away from strays, has none. Deterministic whatever the thread count.
+[[nodiscard]] Strays find_strays(const KdTree& tree, std::span<const Vec3f> positions,
+                                 const ScatterTest& test,
+                                 std::span<const std::uint32_t> candidates);
 
 } // namespace pointform
