@@ -47,6 +47,22 @@ std::vector<Vec3f> sphere_with_spray(std::size_t sprayed, unsigned seed)
     return positions;
 }
 
+/// 25,000 points spread evenly over the unit square of the plane z = 0, then 1,000 over the
+/// square beside it from x = `from` to 2 (25 times more sparsely over a unit side), every
+/// 200th of those lifted `lift` off the plane.
+std::vector<Vec3f> half_sparse_plane(float from, float lift)
+{
+    std::vector<Vec3f> plane;
+    std::mt19937 random(7);
+    std::uniform_real_distribution<float> unit(0.0F, 1.0F);
+    for (int i = 0; i < 25000; ++i)
+        plane.emplace_back(unit(random), unit(random), 0.0F);
+    for (int i = 0; i < 1000; ++i)
+        plane.emplace_back(from + (2.0F - from) * unit(random), unit(random),
+                           i % 200 == 0 ? lift : 0.0F);
+    return plane;
+}
+
 TEST(Scatter, ASprayIsStrayAndTheSurfaceIsNot)
 {
     for (const unsigned seed : {1U, 2U, 3U})
@@ -92,14 +108,7 @@ TEST(Scatter, SparseSurfacesAreNotStray)
         spheres.push_back(p + Vec3f(3.5F, 0.0F, 0.0F));
     EXPECT_TRUE(strays_of(spheres).empty());
 
-    std::vector<Vec3f> plane;
-    std::mt19937 random(7);
-    std::uniform_real_distribution<float> unit(0.0F, 1.0F);
-    for (int i = 0; i < 25000; ++i)
-        plane.emplace_back(unit(random), unit(random), 0.0F);
-    for (int i = 0; i < 1000; ++i)
-        plane.emplace_back(1.0F + unit(random), unit(random), 0.0F);
-    EXPECT_TRUE(strays_of(plane).empty());
+    EXPECT_TRUE(strays_of(half_sparse_plane(1.0F, 0.0F)).empty());
 }
 
 TEST(Scatter, SprayedAreTheStraysOfGroupsMostlyStray)
@@ -116,13 +125,7 @@ TEST(Scatter, SprayedAreTheStraysOfGroupsMostlyStray)
     // median), with five of that half's samples lifted 0.05 off it (about 0.7 of their reach):
     // those five are strays (and a few beside them), but among a thousand samples past the
     // limit that are not, so in no spray.
-    std::vector<Vec3f> plane;
-    std::mt19937 random(7);
-    std::uniform_real_distribution<float> unit(0.0F, 1.0F);
-    for (int i = 0; i < 25000; ++i)
-        plane.emplace_back(unit(random), unit(random), 0.0F);
-    for (int i = 0; i < 1000; ++i)
-        plane.emplace_back(1.1F + 0.9F * unit(random), unit(random), i % 200 == 0 ? 0.05F : 0.0F);
+    const std::vector<Vec3f> plane = half_sparse_plane(1.1F, 0.05F);
     const KdTree plane_tree(plane);
     const Strays lifted =
         find_strays(plane_tree, plane, scatter_test(plane_tree, plane), all_of(plane.size()));
