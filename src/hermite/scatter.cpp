@@ -23,85 +23,112 @@ constexpr std::size_t scatter_k = scatter_neighbourhood;
 /// The samples whose reach gives the cloud's median at most (every stride-th).
 constexpr std::size_t reach_probes = 4096;
 
+/// A sample and its nearest (itself usually first), nearest first.
+struct Neighbourhood
+{
+    std::array<std::uint32_t, scatter_k> index{};
+    std::array<float, scatter_k> d2{};
+    std::size_t found = 0;
+
+    Neighbourhood(const KdTree& tree, std::span<const Vec3f> positions, std::size_t i)
+        : found(tree.knn(positions[i], scatter_k, index, d2))
+    {}
+
+    /// Whether all 16 nearest were found and the reach² is over `limit2`.
+    [[nodiscard]] bool past(float limit2) const
+    {
+        return found == scatter_k && d2[found - 1] > limit2;
+    }
+};
+
+/// The nearest of sample `i` but itself.
+struct Others
+{
+    std::array<std::uint32_t, scatter_k - 1> index{};
+    std::size_t count = 0;
+
+    Others() = default;
+    Others(const Neighbourhood& near, std::size_t i)
+    {
+        for (std::size_t j = 0; j < near.found && count < index.size(); ++j)
+            if (near.index[j] != i)
+                index[count++] = near.index[j];
+    }
+};
+
+/// Whether the neighbourhood fills a volume (scattered_volume).
+bool fills_volume(std::span<const Vec3f> positions, const Neighbourhood& near)
+{
+    const Vec3d lambda = fit_plane(positions, std::span(near.index).first(near.found)).eigenvalues;
+    return lambda[0] > scattered_volume * lambda[2];
+}
+
+/// Whether sample `i` stands off the plane of `others` (stray_offset) or is isolated from them
+/// (stray_isolation).
+bool stands_apart(const KdTree& tree, std::span<const Vec3f> positions, std::size_t i,
+                  const Neighbourhood& near, const Others& others)
+{
+    const LocalPlane plane = fit_plane(positions, std::span(others.index).first(others.count));
+    if (plane.degenerate)
+        return false;
+    const double offset = std::abs(plane.normal.dot(positions[i].cast<double>() - plane.centroid));
+    if (offset > stray_offset * std::sqrt(static_cast<double>(near.d2[near.found - 1])))
+        return true;
+    // Isolated from its nearest: they lie far closer together than it lies from them.
+    std::array<float, scatter_k> reach2{};
+    for (std::size_t j = 0; j < others.count; ++j)
+    {
+        const Neighbourhood theirs(tree, positions, others.index[j]);
+        reach2[j] = theirs.d2[theirs.found - 1];
+    }
+    const auto middle = reach2.begin() + static_cast<std::ptrdiff_t>(others.count / 2);
+    std::nth_element(reach2.begin(), middle,
+                     reach2.begin() + static_cast<std::ptrdiff_t>(others.count));
+    return static_cast<double>(near.d2[near.found - 1]) >
+           stray_isolation * stray_isolation * static_cast<double>(*middle);
+}
+
 } // namespace
 
 bool ScatterTest::scattered(const KdTree& tree, std::span<const Vec3f> positions,
                             std::size_t i) const
 {
-    std::array<std::uint32_t, scatter_k> index{};
-    std::array<float, scatter_k> d2{};
-    const std::size_t found = tree.knn(positions[i], scatter_k, index, d2);
-    if (found < scatter_k || !(d2[found - 1] > limit2))
-        return false;
-    const Vec3d lambda = fit_plane(positions, std::span(index).first(found)).eigenvalues;
-    return lambda[0] > scattered_volume * lambda[2];
+    const Neighbourhood near(tree, positions, i);
+    return near.past(limit2) && fills_volume(positions, near);
 }
 
 bool ScatterTest::stray(const KdTree& tree, std::span<const Vec3f> positions, std::size_t i) const
 {
-    std::array<std::uint32_t, scatter_k> index{};
-    std::array<float, scatter_k> d2{};
-    const std::size_t found = tree.knn(positions[i], scatter_k, index, d2);
-    if (found < scatter_k || !(d2[found - 1] > limit2))
-        return false;
-    const LocalPlane all = fit_plane(positions, std::span(index).first(found));
-    if (all.eigenvalues[0] > scattered_volume * all.eigenvalues[2])
-        return true;
-    // The plane of the others (the sample itself is one of the nearest, usually the first).
-    std::array<std::uint32_t, scatter_k> others{};
-    std::size_t count = 0;
-    for (std::size_t j = 0; j < found; ++j)
-        if (index[j] != i)
-            others[count++] = index[j];
-    const LocalPlane plane = fit_plane(positions, std::span(others).first(count));
-    if (plane.degenerate)
-        return false;
-    const double offset = std::abs(plane.normal.dot(positions[i].cast<double>() - plane.centroid));
-    if (offset > stray_offset * std::sqrt(static_cast<double>(d2[found - 1])))
-        return true;
-    // Isolated from its nearest: they lie far closer together than it lies from them.
-    std::array<float, scatter_k> reach2{};
-    std::array<std::uint32_t, scatter_k> their_index{};
-    std::array<float, scatter_k> their_d2{};
-    for (std::size_t j = 0; j < count; ++j)
-    {
-        const std::size_t their = tree.knn(positions[others[j]], scatter_k, their_index, their_d2);
-        reach2[j] = their_d2[their - 1];
-    }
-    const auto middle = reach2.begin() + static_cast<std::ptrdiff_t>(count / 2);
-    std::nth_element(reach2.begin(), middle, reach2.begin() + static_cast<std::ptrdiff_t>(count));
-    return static_cast<double>(d2[found - 1]) >
-           stray_isolation * stray_isolation * static_cast<double>(*middle);
+    const Neighbourhood near(tree, positions, i);
+    return near.past(limit2) && (fills_volume(positions, near) ||
+                                 stands_apart(tree, positions, i, near, Others(near, i)));
 }
 
 Strays find_strays(const KdTree& tree, std::span<const Vec3f> positions, const ScatterTest& test,
                    std::span<const std::uint32_t> candidates)
 {
     PF_ASSERT(std::is_sorted(candidates.begin(), candidates.end()));
-    // Each candidate's reach tested exactly, its 16 nearest kept, and the test's verdict.
+    // Each candidate's reach tested exactly, its 16 nearest kept, and the test's verdict (as
+    // ScatterTest::stray() gives it, from the one search).
     struct Candidate
     {
-        std::array<std::uint32_t, scatter_k - 1> others{};
-        std::uint8_t count = 0;
+        Others others;
         bool over = false;
         bool stray = false;
     };
     std::vector<Candidate> tested(candidates.size());
     parallel_blocks(candidates.size(), 256, [&](std::size_t begin, std::size_t end) {
-        std::array<std::uint32_t, scatter_k> index{};
-        std::array<float, scatter_k> d2{};
         for (std::size_t c = begin; c < end; ++c)
         {
             const std::uint32_t i = candidates[c];
-            const std::size_t found = tree.knn(positions[i], scatter_k, index, d2);
+            const Neighbourhood near(tree, positions, i);
             Candidate& t = tested[c];
-            t.over = found == scatter_k && d2[found - 1] > test.limit2;
+            t.over = near.past(test.limit2);
             if (!t.over)
                 continue;
-            for (std::size_t j = 0; j < found && t.count < t.others.size(); ++j)
-                if (index[j] != i)
-                    t.others[t.count++] = index[j];
-            t.stray = test.stray(tree, positions, i);
+            t.others = Others(near, i);
+            t.stray =
+                fills_volume(positions, near) || stands_apart(tree, positions, i, near, t.others);
         }
     });
     // The candidates over the limit, joined to those of their 16 nearest that are over it too:
@@ -119,9 +146,9 @@ Strays find_strays(const KdTree& tree, std::span<const Vec3f> positions, const S
     {
         if (!tested[c].over)
             continue;
-        for (std::size_t j = 0; j < tested[c].count; ++j)
+        for (std::size_t j = 0; j < tested[c].others.count; ++j)
         {
-            const std::size_t o = candidate_of(tested[c].others[j]);
+            const std::size_t o = candidate_of(tested[c].others.index[j]);
             if (o < candidates.size() && tested[o].over)
                 groups.unite(c, o);
         }
@@ -153,13 +180,11 @@ ScatterTest scatter_test(const KdTree& tree, std::span<const Vec3f> positions)
 {
     const std::size_t stride = std::max<std::size_t>(1, positions.size() / reach_probes);
     std::vector<float> reach2;
-    std::array<std::uint32_t, scatter_k> index{};
-    std::array<float, scatter_k> d2{};
     for (std::size_t i = 0; i < positions.size(); i += stride)
     {
-        const std::size_t found = tree.knn(positions[i], scatter_k, index, d2);
-        if (found > 0)
-            reach2.push_back(d2[found - 1]);
+        const Neighbourhood near(tree, positions, i);
+        if (near.found > 0)
+            reach2.push_back(near.d2[near.found - 1]);
     }
     if (reach2.empty())
         return {.limit2 = std::numeric_limits<float>::infinity()};
