@@ -212,18 +212,24 @@ CreasePlane crease_plane(CreaseNeighbourhood& hood, std::span<const Vec3f> posit
             .wedge = wedge};
 }
 
+bool clean_table(std::span<const Vec3f> positions, const KnnTable& table)
+{
+    // The median flatness of a fixed subsample of the rows (as the point field tests its own
+    // neighbourhoods).
+    const std::size_t n = table.rows();
+    const std::size_t stride = std::max<std::size_t>(1, n / clean_test_rows);
+    std::vector<double> flat((n + stride - 1) / stride);
+    for (std::size_t r = 0; r < flat.size(); ++r)
+        flat[r] = flatness(positions, table.neighbors(r * stride));
+    return clean_cloud(flat);
+}
+
 std::size_t refit_crease_normals(std::span<const Vec3f> positions, const KnnTable& table,
                                  std::span<Vec3f> normals)
 {
     const std::size_t n = positions.size();
     PF_ASSERT(table.rows() == n && normals.size() == n);
-    // Clean: the median flatness of a fixed subsample of the rows (as the point field tests its
-    // own neighbourhoods).
-    const std::size_t stride = std::max<std::size_t>(1, n / clean_test_rows);
-    std::vector<double> flat((n + stride - 1) / stride);
-    for (std::size_t r = 0; r < flat.size(); ++r)
-        flat[r] = flatness(positions, table.neighbors(r * stride));
-    if (!clean_cloud(flat))
+    if (!clean_table(positions, table))
         return 0;
     const std::size_t blocks = (n + crease_refit_block - 1) / crease_refit_block;
     // Each block's refitted normals, applied once every block has read the old ones.

@@ -47,6 +47,38 @@ Moments moments_of(std::span<const Vec3f> positions, std::span<const std::uint32
     return {mean + shift, outer / count - mean * mean.transpose()};
 }
 
+/// moments_of() with NeighbourWeights::Local: each point weighted by (1 − d² / far2)³, d its
+/// distance from `centre` (the fitted point) and far2 the squared distance of the row's farthest
+/// (KnnTable::farthest2()). The sums are taken about the centre. Falls back on the uniform moments
+/// where every point sits at the centre.
+Moments local_moments_of(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices,
+                         const Vec3f& centre, float far2)
+{
+    if (!(far2 > 0.0F))
+        return moments_of(positions, indices);
+    const Vec3d shift = centre.cast<double>();
+    const double inverse = 1.0 / static_cast<double>(far2);
+    double total = 0.0;
+    Vec3d sum = Vec3d::Zero();
+    Mat3d outer = Mat3d::Zero();
+    for (const auto index : indices)
+    {
+        const Vec3d p = positions[index].cast<double>() - shift;
+        const double d2 = p.squaredNorm();
+        // The point itself is left out: at its own place it would weigh most, and tie the plane
+        // to itself (a stray off a surface took a plane through it, not the surface's).
+        const double t = d2 > 0.0 ? std::max(0.0, 1.0 - d2 * inverse) : 0.0;
+        const double w = t * t * t;
+        total += w;
+        sum += w * p;
+        outer.noalias() += (w * p) * p.transpose();
+    }
+    if (!(total > 0.0))
+        return moments_of(positions, indices);
+    const Vec3d mean = sum / total;
+    return {mean + shift, outer / total - mean * mean.transpose()};
+}
+
 /// The sum of the principal 2×2 minors of a symmetric matrix (λ0λ1 + λ0λ2 + λ1λ2): about
 /// λ1λ2 when λ0 is small, zero on a line, to double rounding (the closed-form eigen-solve leaves
 /// an exact line's middle eigenvalue at up to a few 1e-9 of the largest).
@@ -164,6 +196,33 @@ Vec3d fast_normal(const Mat3d& c, const Cubic& cubic, double lambda)
     return longest / std::sqrt(length2);
 }
 
+/// NeighbourWeights::Local refits a normal where the uniform fit's least eigenvalue is over this
+/// share of the middle one: where the neighbourhood reaches another sheet or bends round a crease
+/// its normal is ill-defined, and elsewhere the two fits agree. On the clean 100k plate 2.2
+/// spacings thick, 44% of the samples, whose normals more than 30° off fall from 12.6% to 0.08%;
+/// on clean CAD shapes (fandisk, the part of bench/peers) 3-4%, at their creases.
+constexpr double local_ambiguity = 0.2;
+
+/// Whether a fast cubic's least root λ0 is over local_ambiguity of the middle one: λ1 and λ2 are
+/// the roots of λ² − (I1 − λ0) λ + (I2 − λ0 (I1 − λ0)).
+bool ambiguous(const Cubic& cubic, double lambda0)
+{
+    const double sum = cubic.i1 - lambda0;
+    const double product = cubic.i2 - lambda0 * sum;
+    const double lambda1 = 0.5 * (sum - std::sqrt(std::max(0.0, sum * sum - 4.0 * product)));
+    return lambda0 > local_ambiguity * lambda1;
+}
+
+/// Sample i's normal refitted with NeighbourWeights::Local, kept where that fit spans a plane.
+void refit_locally(std::span<const Vec3f> positions, const KnnTable& neighbors, std::size_t i,
+                   Vec3f& normal)
+{
+    const LocalPlane fit = solve_plane(
+        local_moments_of(positions, neighbors.neighbors(i), positions[i], neighbors.farthest2(i)));
+    if (!fit.degenerate)
+        normal = fit.normal.cast<float>();
+}
+
 } // namespace
 
 LocalPlane fit_plane(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices)
@@ -179,8 +238,9 @@ LocalPlane fit_plane(std::span<const Vec3f> positions, std::span<const std::uint
 }
 
 Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
-                         const ProgressCallback& progress)
+                         const ProgressCallback& progress, NeighbourWeights weights)
 {
+    const bool local = weights == NeighbourWeights::Local;
     // The rows' indices are checked below as each fit reads them.
     check_knn_table_shape(neighbors, positions.size(), "estimate_normals");
     Normals result;
@@ -213,12 +273,16 @@ Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neigh
                     if (fast.squaredNorm() > 0.0)
                     {
                         result.normals[i] = fast.cast<float>();
+                        if (local && ambiguous(cubics[g], lambda[g]))
+                            refit_locally(positions, neighbors, i, result.normals[i]);
                         continue;
                     }
                     const LocalPlane fit = solve_plane(moments[g]);
                     result.normals[i] = fit.normal.cast<float>();
                     if (fit.degenerate)
                         flat.push_back(static_cast<std::uint32_t>(i));
+                    else if (local && fit.eigenvalues[0] > local_ambiguity * fit.eigenvalues[1])
+                        refit_locally(positions, neighbors, i, result.normals[i]);
                 }
             }
         },

@@ -182,6 +182,36 @@ TEST(ComputeSurfels, NoisyCloudHandedOverComesBackWhole)
 // sphere's 1/3): the input check looks at the bulk then, and the sphere gets its normals. Points
 // on a line stay a line with a far point beside them. Beyond 1e18 float distances overflow: a
 // clear error.
+// A clean plate whose faces lie 2.2 sample spacings apart: its normals come from the nearest
+// neighbours (NeighbourWeights::Local), so the orientation finds each face's side. With every
+// neighbour alike, about a tenth of the faces' normals turned more than 30° (the far face's
+// samples at the neighbourhood's edge) and 1% were turned over (at 100k samples), and the field
+// made a surface with hundreds of handles through the plate.
+TEST(ComputeSurfels, AThinPlatesFacesFaceOut)
+{
+    constexpr std::size_t count = 30000;
+    const double spacing = std::sqrt(8.3 / static_cast<double>(count));
+    const PointCloud plate =
+        sample_shape(Shape::Plate, {.count = count, .seed = 5, .thickness = 2.2 * spacing});
+    PointCloud input = plate;
+    input.normals.clear();
+    const SurfelResult result = compute_surfels(input);
+    std::size_t faces = 0;
+    std::size_t out = 0;
+    std::size_t flipped = 0;
+    for (std::size_t i = 0; i < plate.size(); ++i)
+    {
+        if (std::abs(plate.normals[i].z()) < 0.99F)
+            continue;
+        ++faces;
+        out += result.surfels.normals[i].dot(plate.normals[i]) > 0.9F ? 1 : 0;
+        flipped += result.surfels.normals[i].dot(plate.normals[i]) < 0.0F ? 1 : 0;
+    }
+    // Within 26° but for a few by the rim, where the far face and the side are both near.
+    EXPECT_GT(static_cast<double>(out), 0.98 * static_cast<double>(faces));
+    EXPECT_LT(static_cast<double>(flipped), 0.001 * static_cast<double>(faces));
+}
+
 TEST(ComputeSurfels, AFarOutlierDoesNotMakeASurfaceALine)
 {
     PointCloud cloud = sample_shape(Shape::Sphere, {.count = 5000, .seed = 14});

@@ -206,6 +206,14 @@ double flatness(std::span<const Vec3f> positions, std::span<const std::uint32_t>
 /// clean_flatness.
 bool clean_cloud(std::vector<double>& flatness);
 
+/// Rows of a table whose flatness refit_crease_normals() takes the median of (every
+/// n / clean_test_rows-th).
+inline constexpr std::size_t clean_test_rows = 20000;
+
+/// Whether a cloud is clean by its neighbour table: clean_cloud() over the flatness() of every
+/// n / clean_test_rows-th row.
+bool clean_table(std::span<const Vec3f> positions, const KnnTable& table);
+
 /// Whether sample i (neighbourhood `hood`, normal `normal`, farthest neighbour at `reach`) is
 /// at the edge of a convex wedge: some neighbour's normal turns from its own by 120-143°
 /// (between wall_cosine and wedge_cosine), and some plane through the sample, with its own normal
@@ -270,17 +278,12 @@ CreasePlane crease_plane(CreaseNeighbourhood& hood, std::span<const Vec3f> posit
 /// Samples a block of refit_crease_normals() takes (its parallel blocks).
 inline constexpr std::size_t crease_refit_block = 4096;
 
-/// Rows of a table whose flatness refit_crease_normals() takes the median of (every
-/// n / clean_test_rows-th).
-inline constexpr std::size_t clean_test_rows = 20000;
-
-/// \brief Refits the estimated, oriented normals of a clean cloud (clean_cloud() over the
-/// flatness of its table's rows) at its creases to each sample's own face (crease_plane() over
-/// the sample's row of `table`, the sample itself in it): a principal component normal there
-/// is a blend of the faces'. Every refit reads the normals as they were, so the result does not
-/// depend on the order or the threads. A noisy cloud keeps its normals: its planes would be
-/// fitted to the noise (crease_plane()).
-/// \return how many normals changed
+/// \brief Refits the estimated, oriented normals of a clean cloud (clean_table()) at its creases
+/// to each sample's own face (crease_plane() over the sample's row of `table`, the sample itself
+/// in it): a principal component normal there is a blend of the faces'. Every refit reads the
+/// normals as they were, so the result does not depend on the order or the threads. A noisy cloud
+/// keeps its normals: its planes would be fitted to the noise (crease_plane()). \return how many
+/// normals changed
 std::size_t refit_crease_normals(std::span<const Vec3f> positions, const KnnTable& table,
                                  std::span<Vec3f> normals);
 

@@ -64,12 +64,32 @@ struct Normals
     std::vector<std::uint32_t> degenerate;
 };
 
+/// \brief How estimate_normals() weighs the neighbours of a point in its fit.
+enum class NeighbourWeights
+{
+    /// Every neighbour alike: the principal component of the neighbourhood.
+    Uniform,
+    /// Where the uniform fit's normal is ill-defined (its least eigenvalue over a fifth of the
+    /// middle one), refitted with each neighbour weighted by (1 − d² / d_k²)³, d its distance
+    /// from the point and d_k the farthest's (the point itself left out): the nearest count most.
+    /// Where a neighbourhood reaches another sheet (the far side of a part thinner than the
+    /// neighbourhood), the few samples of it at the neighbourhood's edge turn the principal
+    /// component far off: on a clean plate 2.2 sample spacings thick (`pointform sample plate
+    /// --thickness 0.02`, 100k samples) 12.6% of the faces' normals are more than 30° off with
+    /// uniform weights, 0.08% with these. Under noise the refit rests on fewer samples and
+    /// follows the noise: for clean clouds (compute_surfels() chooses).
+    Local,
+};
+
 /// \brief Estimates a normal for every point by PCA over the given neighbourhoods, in parallel.
 /// \param positions  N points
 /// \param neighbors  an N by k table (e.g. knn_batch of the points against themselves)
+/// \param weights    how the neighbours count; a Local refit that spans no plane keeps the
+///                   uniform fit's normal
 /// \throw InvalidInput if the table does not have N rows or is malformed (check_knn_table())
 [[nodiscard]] Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
-                                       const ProgressCallback& progress = {});
+                                       const ProgressCallback& progress = {},
+                                       NeighbourWeights weights = NeighbourWeights::Uniform);
 
 /// \brief One-off: builds a kd-tree, finds k neighbours and estimates normals.
 /// \throw InvalidInput if there are not more than k points, or k < 3
