@@ -11,7 +11,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -213,13 +215,60 @@ bool ambiguous(const Cubic& cubic, double lambda0)
     return lambda0 > local_ambiguity * lambda1;
 }
 
-/// Sample i's normal refitted with NeighbourWeights::Local, kept where that fit spans a plane.
+/// Neighbours farther than this share of the farthest's distance from the refitted plane are
+/// off it: parallel_sheet() looks at them.
+constexpr double off_sheet = 0.25;
+
+/// How evenly the neighbours off a refitted plane must stand off it (the spread of their heights
+/// over their mean) to be a parallel sheet.
+constexpr double sheet_spread = 0.3;
+
+/// Whether the neighbours of sample i that stand off the plane through it with normal n (more
+/// than off_sheet of the farthest's distance) all lie on one side of it, at heights within
+/// sheet_spread of their mean: a sheet parallel to the sample's own, the far side of a part
+/// thinner than the neighbourhood. Past a crease the other face rises with the distance from
+/// the edge, and its heights spread. On the clean 100k shapes of bench/peers 0.2-0.3% of the
+/// samples by creases pass (the blobby, the part, fandisk), and 41% of the thin plate's.
+bool parallel_sheet(std::span<const Vec3f> positions, std::span<const std::uint32_t> row,
+                    std::size_t i, const Vec3d& n, double reach)
+{
+    const Vec3d centre = positions[i].cast<double>();
+    std::size_t count = 0;
+    int side = 0;
+    double lowest = std::numeric_limits<double>::infinity();
+    double highest = 0.0;
+    double sum = 0.0;
+    for (const std::uint32_t j : row)
+    {
+        const double h = (positions[j].cast<double>() - centre).dot(n);
+        const double height = std::abs(h);
+        if (!(height > off_sheet * reach))
+            continue;
+        const int this_side = h > 0.0 ? 1 : -1;
+        if (side != 0 && this_side != side)
+            return false;
+        side = this_side;
+        ++count;
+        lowest = std::min(lowest, height);
+        highest = std::max(highest, height);
+        sum += height;
+    }
+    return count > 0 && highest - lowest < sheet_spread * sum / static_cast<double>(count);
+}
+
+/// Sample i's normal refitted with NeighbourWeights::Local, kept where that fit spans a plane
+/// and its neighbours off the plane are a parallel sheet (parallel_sheet()). At a crease the
+/// refit would take the sample's own face, and the point field's crease fits, which start from
+/// the blended normal, filled the concave grooves of the clean 100k blobby of bench/peers
+/// deeper (its Hausdorff distance 0.26 -> 0.32% of the diagonal).
 void refit_locally(std::span<const Vec3f> positions, const KnnTable& neighbors, std::size_t i,
                    Vec3f& normal)
 {
-    const LocalPlane fit = solve_plane(
-        local_moments_of(positions, neighbors.neighbors(i), positions[i], neighbors.farthest2(i)));
-    if (!fit.degenerate)
+    const std::span<const std::uint32_t> row = neighbors.neighbors(i);
+    const LocalPlane fit =
+        solve_plane(local_moments_of(positions, row, positions[i], neighbors.farthest2(i)));
+    if (!fit.degenerate && parallel_sheet(positions, row, i, fit.normal,
+                                          std::sqrt(static_cast<double>(neighbors.farthest2(i)))))
         normal = fit.normal.cast<float>();
 }
 

@@ -23,9 +23,7 @@ namespace pointform {
 namespace {
 
 /// 20k samples of the unit sphere plus six clusters of 10 to 30 stray points 2 to 2.5 from its
-/// centre (clear of the sphere's field), one on each axis, so that no two clusters hold up one
-/// sheet together (two clusters of 10 and 30 drawn 0.32 apart made a sheet held by 40 samples,
-/// more than the rule's 32): raw points, as a scanner's stray returns come.
+/// centre (clear of the sphere's field): raw points, as a scanner's stray returns come.
 PointCloud sphere_with_stray_clusters()
 {
     PointCloud cloud = sample_shape(Shape::Sphere, {.count = 20000, .seed = 2});
@@ -35,9 +33,8 @@ PointCloud sphere_with_stray_clusters()
     std::uniform_real_distribution<double> uni(0.0, 1.0);
     for (int c = 0; c < 6; ++c)
     {
-        Vec3d axis = Vec3d::Zero();
-        axis[c / 2] = c % 2 == 0 ? 1.0 : -1.0;
-        const Vec3d centre = axis * (2.0 + 0.5 * uni(rng));
+        Vec3d d(gauss(rng), gauss(rng), gauss(rng));
+        const Vec3d centre = d.normalized() * (2.0 + 0.5 * uni(rng));
         for (int i = 0; i < 10 + 4 * c; ++i)
             cloud.positions.emplace_back(
                 (centre + 0.04 * Vec3d(gauss(rng), gauss(rng), gauss(rng))).cast<float>());

@@ -111,13 +111,14 @@ TEST(Reconstruct, TheIntermediateMeshHasAFewFacesPerBaseFace)
 // field's bounds and made marching cubes' cells larger than the sphere ("no triangles"); it is
 // left out (surfels_from_samples()), and the sphere comes out as without it.
 // A clean plate 2.2 sample spacings thick (30k samples): the neighbourhood of a face's sample
-// reaches the far face, and with principal-component normals a tenth of them turned more than
-// 30° and 1% were oriented the wrong way (at 100k samples the field's surface had 293 handles
+// reaches the far face, and with principal-component normals a sixth of them turned more than
+// 26° and 1% were oriented the wrong way (at 100k samples the field's surface had 293 handles
 // through the plate, 292 of them cut, a Hausdorff distance of 2.1% of the diagonal). With the
-// normals refitted to the nearest neighbours (NeighbourWeights::Local) the plate is one closed
-// surface, its rim rounded by about a spacing, its faces' vertices within a fifth of the
-// thickness of the box's but for a few dimples (24 of 7,308 here; with `pointform reconstruct`
-// on these samples 10 of 17,000, where the principal components left 1,021 and cut 10 handles).
+// normals refitted to the nearest neighbours by a parallel sheet (NeighbourWeights::Local) the
+// plate is one closed surface, its rim rounded by about a spacing, its faces' vertices within a
+// fifth of the thickness of the box's but for a few dimples (7 of 7,178 here; `pointform
+// reconstruct` of these samples 9 of 7,576, where the principal components left 1,021 of 18,172
+// and cut 10 handles).
 TEST(Reconstruct, AThinCleanPlateIsOneClosedSurface)
 {
     constexpr std::size_t count = 30000;

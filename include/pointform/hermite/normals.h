@@ -70,14 +70,16 @@ enum class NeighbourWeights
     /// Every neighbour alike: the principal component of the neighbourhood.
     Uniform,
     /// Where the uniform fit's normal is ill-defined (its least eigenvalue over a fifth of the
-    /// middle one), refitted with each neighbour weighted by (1 − d² / d_k²)³, d its distance
-    /// from the point and d_k the farthest's (the point itself left out): the nearest count most.
-    /// Where a neighbourhood reaches another sheet (the far side of a part thinner than the
-    /// neighbourhood), the few samples of it at the neighbourhood's edge turn the principal
-    /// component far off: on a clean plate 2.2 sample spacings thick (`pointform sample plate
-    /// --thickness 0.02`, 100k samples) 12.6% of the faces' normals are more than 30° off with
-    /// uniform weights, 0.08% with these. Under noise the refit rests on fewer samples and
-    /// follows the noise: for clean clouds (compute_surfels() chooses).
+    /// middle one) and the neighbourhood reaches a parallel sheet (the far side of a part
+    /// thinner than the neighbourhood), refitted with each neighbour weighted by
+    /// (1 − d² / d_k²)³, d its distance from the point and d_k the farthest's (the point itself
+    /// left out): the nearest count most. The few samples of the far side at the
+    /// neighbourhood's edge turn the principal component far off: on a clean plate 2.2 sample
+    /// spacings thick (`pointform sample plate --thickness 0.02`, 100k samples) 12.6% of the
+    /// faces' normals are more than 30° off with uniform weights, 0.1% with these. Creases keep
+    /// their blended normals, which the point field's crease fits start from. Under noise the
+    /// refit would rest on fewer samples and follow the noise: for clean clouds
+    /// (compute_surfels() chooses).
     Local,
 };
 
