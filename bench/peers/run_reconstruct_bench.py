@@ -38,7 +38,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from run_normals_bench import run_measured  # noqa: E402
 from plyio import write_ply  # noqa: E402
 from run_surface_bench import (BUNNY_MESH, SCANNED_MESHES, VARIANTS, evaluate_isolated,  # noqa: E402
-                               load_points)
+                               load_points, sample_args)
 from virtual_scan import scan, surface_samples  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
@@ -133,7 +133,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--pointform", default="build/release/apps/pointform/pointform")
     ap.add_argument("--shapes", default="sphere,torus,blobby,part,plate,bunny,fandisk",
-                    help="analytic shapes of `pointform sample`, bunny (the shipped scan, "
+                    help="analytic shapes of `pointform sample`, thin-plate (its plate 0.02 "
+                         "thick), bunny (the shipped scan, "
                          "clean only, against the Stanford reconstruction bun_zipper), and "
                          "fandisk, spot or teapot (simulated scans of data/meshes/, against the mesh: "
                          "--scan-seeds; --size and --variants do not apply)")
@@ -176,8 +177,8 @@ def main(argv=None) -> int:
                 write_points(truth_path,
                              surface_samples(truth_mesh, 200000, np.random.default_rng(99))[0])
             else:
-                run_measured([args.pointform, "sample", shape, "-n", "200000", "--seed", "99",
-                              "-o", truth_path], env, 600, work / "truth")
+                run_measured([args.pointform, "sample", *sample_args(shape), "-n", "200000",
+                              "--seed", "99", "-o", truth_path], env, 600, work / "truth")
             truth = load_points(truth_path)
             variants = (args.variants.split(",") if shape not in SCANNED_MESHES else
                         [f"scan {seed}" for seed in args.scan_seeds.split(",")])
@@ -190,7 +191,8 @@ def main(argv=None) -> int:
                 elif shape in SCANNED_MESHES:
                     write_points(raw, scan(str(SCANNED_MESHES[shape]), int(variant.split()[1])))
                 else:
-                    run_measured([args.pointform, "sample", shape, "-n", str(args.size), "-o",
+                    run_measured([args.pointform, "sample", *sample_args(shape), "-n",
+                                  str(args.size), "-o",
                                   work / "with_normals.ply", *VARIANTS[variant]], env, 600,
                                  work / "sample")
                     # Raw points: no tool may see the true normals.

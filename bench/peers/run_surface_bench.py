@@ -100,6 +100,17 @@ def _blobby_distance(p: np.ndarray) -> np.ndarray:
 # The Stanford bunny's own reconstruction: the truth of the shipped scan (its vertices).
 BUNNY_MESH = HERE.parent.parent / "data" / "bunny" / "bun_zipper.ply"
 # Meshes that run_reconstruct_bench.py scans (virtual_scan.py): each is the truth of its scans.
+# The thickness of the "thin-plate" shape (`pointform sample plate --thickness`): 2.2 sample
+# spacings at 100k samples, where a neighbourhood of 16 reaches the far face.
+THIN_PLATE = 0.02
+
+
+def sample_args(shape: str) -> list[str]:
+    """The arguments of `pointform sample` that draw `shape` (an analytic shape's name, or
+    "thin-plate")."""
+    return ["plate", "--thickness", str(THIN_PLATE)] if shape == "thin-plate" else [shape]
+
+
 SCANNED_MESHES = {"fandisk": HERE.parent.parent / "data" / "meshes" / "fandisk.obj",
                   "spot": HERE.parent.parent / "data" / "meshes" / "spot.obj",
                   "teapot": HERE.parent.parent / "data" / "meshes" / "teapot.obj"}
@@ -142,6 +153,8 @@ def _signed_distance(shape: str, p: np.ndarray) -> np.ndarray:
         return np.linalg.norm(p - np.concatenate([c, np.zeros((len(p), 2))], 1), axis=1) - 1.0
     if shape == "plate":
         return _box_sdf(p, (-1.0, -1.0, -0.025), (1.0, 1.0, 0.025))
+    if shape == "thin-plate":
+        return _box_sdf(p, (-1.0, -1.0, -0.5 * THIN_PLATE), (1.0, 1.0, 0.5 * THIN_PLATE))
     if shape == "blobby":
         inside = np.any([np.linalg.norm(p - np.array(c), axis=1) < r for c, r in BLOBBY], axis=0)
         return np.where(inside, -1.0, 1.0) * _blobby_distance(p)

@@ -207,7 +207,7 @@ TEST(ComputeSurfels, AThinPlatesFacesFaceOut)
         out += result.surfels.normals[i].dot(plate.normals[i]) > 0.9F ? 1 : 0;
         flipped += result.surfels.normals[i].dot(plate.normals[i]) < 0.0F ? 1 : 0;
     }
-    // Within 26°: 97.2% (83.7% with every neighbour alike), the rest mostly by the rim, where
+    // Within 26°: 97.1% (83.7% with every neighbour alike), the rest mostly by the rim, where
     // the far face and the side are both near; turned over: 8 of 28,922 (307).
     EXPECT_GT(static_cast<double>(out), 0.96 * static_cast<double>(faces));
     EXPECT_LT(static_cast<double>(flipped), 0.001 * static_cast<double>(faces));
