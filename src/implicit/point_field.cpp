@@ -918,7 +918,7 @@ struct PointField::Impl
     /// Per grid slot: the distance from the sample to its memo_size()-th nearest (itself the
     /// first), from the fit's search; empty when the fit takes fewer. Bounds a search of the
     /// kd-tree from a query near the sample (far_bound()).
-    std::vector<float> reach;
+    std::vector<float> slot_reach;
     /// The stray samples (ScatterTest::stray()), ascending.
     std::vector<std::uint32_t> strays;
     /// Per grid slot: 1 for a member of a spray (Strays::sprayed), which neither blends nor
@@ -1254,7 +1254,7 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
         m.rim.assign(m.grid->slot_count(), Eigen::Vector3f::Zero());
     const std::size_t reach_rank = m.memo_size();
     if (k >= reach_rank)
-        m.reach.assign(m.grid->slot_count(), 0.0F);
+        m.slot_reach.assign(m.grid->slot_count(), 0.0F);
     if (options.fit == PlaneFit::Quadric && options.crease_fit)
     {
         m.crease.assign(m.grid->slot_count(), Eigen::Vector4f::Zero());
@@ -1294,8 +1294,8 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
             // The ball to the last neighbour holds k samples: π d² / k of surface per sample.
             area += std::numbers::pi * static_cast<double>(d2[k - 1]) / static_cast<double>(k);
             const std::uint32_t i = fit_grid.original_index(samples[q]);
-            if (!m.reach.empty())
-                m.reach[m.grid->slot_of(i)] = std::sqrt(d2[reach_rank - 1]);
+            if (!m.slot_reach.empty())
+                m.slot_reach[m.grid->slot_of(i)] = std::sqrt(d2[reach_rank - 1]);
             PackedSurfel packed;
             packed.position = m.surfels.positions[i];
             packed.radius = m.surfels.radii[i];
@@ -1352,13 +1352,14 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
     // The stray samples: only those whose reach, as the fit's search measured it, is near the
     // limit or past it are tested (a search of their own each).
     const ScatterTest scatter = scatter_test(m.tree, m.surfels.positions);
-    const bool reach_known = !m.reach.empty() && reach_rank == scatter_neighbourhood;
+    const bool reach_known = !m.slot_reach.empty() && reach_rank == scatter_neighbourhood;
     const std::vector<std::uint32_t> candidates = parallel_collect<std::uint32_t>(
         n, 4096, [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& out) {
             for (std::size_t i = begin; i < end; ++i)
             {
-                const float r =
-                    reach_known ? m.reach[m.grid->slot_of(static_cast<std::uint32_t>(i))] : 0.0F;
+                const float r = reach_known
+                                    ? m.slot_reach[m.grid->slot_of(static_cast<std::uint32_t>(i))]
+                                    : 0.0F;
                 if (!reach_known || r * r > 0.999F * scatter.limit2)
                     out.push_back(static_cast<std::uint32_t>(i));
             }
@@ -1761,11 +1762,13 @@ float PointField::Impl::far_bound(std::uint32_t slot, float d2, const NeighbourM
 {
     float bound2 =
         memo != nullptr ? memo_bound(*memo, query) : std::numeric_limits<float>::infinity();
-    if (!reach.empty())
+    if (!slot_reach.empty())
     {
         // In double, widened by far more than the rounding of either term: the kd-tree's own
         // slack covers the float sums of the distances it compares against it.
-        const double by_sample = (std::sqrt(static_cast<double>(d2)) + reach[slot]) * (1.0 + 1e-6);
+        const double by_sample =
+            (std::sqrt(static_cast<double>(d2)) + static_cast<double>(slot_reach[slot])) *
+            (1.0 + 1e-6);
         bound2 = std::min(bound2, static_cast<float>(by_sample * by_sample));
     }
     return bound2;
