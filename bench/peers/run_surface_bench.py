@@ -99,7 +99,6 @@ def _blobby_distance(p: np.ndarray) -> np.ndarray:
 
 # The Stanford bunny's own reconstruction: the truth of the shipped scan (its vertices).
 BUNNY_MESH = HERE.parent.parent / "data" / "bunny" / "bun_zipper.ply"
-# Meshes that run_reconstruct_bench.py scans (virtual_scan.py): each is the truth of its scans.
 # The thickness of the "thin-plate" shape (`pointform sample plate --thickness`): 2.2 sample
 # spacings at 100k samples, where a neighbourhood of 16 reaches the far face.
 THIN_PLATE = 0.02
@@ -111,6 +110,7 @@ def sample_args(shape: str) -> list[str]:
     return ["plate", "--thickness", str(THIN_PLATE)] if shape == "thin-plate" else [shape]
 
 
+# Meshes that run_reconstruct_bench.py scans (virtual_scan.py): each is the truth of its scans.
 SCANNED_MESHES = {"fandisk": HERE.parent.parent / "data" / "meshes" / "fandisk.obj",
                   "spot": HERE.parent.parent / "data" / "meshes" / "spot.obj",
                   "teapot": HERE.parent.parent / "data" / "meshes" / "teapot.obj"}

@@ -205,14 +205,19 @@ Vec3d fast_normal(const Mat3d& c, const Cubic& cubic, double lambda)
 /// 3-4%, at their creases (where parallel_sheet() keeps most of them from the refit).
 constexpr double local_ambiguity = 0.2;
 
-/// Whether a fast cubic's least root λ0 is over local_ambiguity of the middle one: λ1 and λ2 are
-/// the roots of λ² − (I1 − λ0) λ + (I2 − λ0 (I1 − λ0)).
+/// Whether a fit's least eigenvalue λ0 is over local_ambiguity of the middle one λ1.
+bool ambiguous(double lambda0, double lambda1)
+{
+    return lambda0 > local_ambiguity * lambda1;
+}
+
+/// ambiguous() for a fast cubic's least root λ0: λ1 and λ2 are the roots of
+/// λ² − (I1 − λ0) λ + (I2 − λ0 (I1 − λ0)).
 bool ambiguous(const Cubic& cubic, double lambda0)
 {
     const double sum = cubic.i1 - lambda0;
     const double product = cubic.i2 - lambda0 * sum;
-    const double lambda1 = 0.5 * (sum - std::sqrt(std::max(0.0, sum * sum - 4.0 * product)));
-    return lambda0 > local_ambiguity * lambda1;
+    return ambiguous(lambda0, 0.5 * (sum - std::sqrt(std::max(0.0, sum * sum - 4.0 * product))));
 }
 
 /// Neighbours farther than this share of the farthest's distance from the refitted plane are
@@ -285,10 +290,10 @@ void refit_locally(std::span<const Vec3f> positions, const KnnTable& neighbors, 
                    Vec3f& normal)
 {
     const std::span<const std::uint32_t> row = neighbors.neighbors(i);
-    const LocalPlane fit =
-        solve_plane(local_moments_of(positions, row, positions[i], neighbors.farthest2(i)));
-    if (!fit.degenerate && parallel_sheet(positions, row, i, fit.normal,
-                                          std::sqrt(static_cast<double>(neighbors.farthest2(i)))))
+    const float far2 = neighbors.farthest2(i);
+    const LocalPlane fit = solve_plane(local_moments_of(positions, row, positions[i], far2));
+    if (!fit.degenerate &&
+        parallel_sheet(positions, row, i, fit.normal, std::sqrt(static_cast<double>(far2))))
         normal = fit.normal.cast<float>();
 }
 
@@ -350,7 +355,7 @@ Normals estimate_normals(std::span<const Vec3f> positions, const KnnTable& neigh
                     result.normals[i] = fit.normal.cast<float>();
                     if (fit.degenerate)
                         flat.push_back(static_cast<std::uint32_t>(i));
-                    else if (local && fit.eigenvalues[0] > local_ambiguity * fit.eigenvalues[1])
+                    else if (local && ambiguous(fit.eigenvalues[0], fit.eigenvalues[1]))
                         refit_locally(positions, neighbors, i, result.normals[i]);
                 }
             }

@@ -326,8 +326,9 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
     if (by_graph)
         guide = detail::grow_guide(positions, table, graph_options, lent.scratch());
     const double guide_seconds = timer.take();
-    // A clean cloud's normals weigh the nearest neighbours most (NeighbourWeights::Local: thin
-    // parts and creases); a noisy cloud's take every neighbour alike, averaging the noise.
+    // A clean cloud's normals are refitted to the nearest neighbours where the neighbourhood
+    // reaches the far side of a thin part (NeighbourWeights::Local); a noisy cloud's take every
+    // neighbour alike, averaging the noise.
     const NeighbourWeights weights =
         detail::clean_table(positions, table) ? NeighbourWeights::Local : NeighbourWeights::Uniform;
     Normals normals = estimate_normals(positions, table, options.progress, weights);

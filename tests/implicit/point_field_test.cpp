@@ -523,10 +523,7 @@ std::size_t turn_to_the_truth(std::vector<Vec3f>& normals, const std::vector<Vec
 
 /// The surfels of raw points (normals estimated), each normal turned to the side of `truth`'s
 /// (the solid's outward normals, one per raw point): the orientation must have agreed with it
-/// everywhere or nowhere, but for 1 sample in 5,000 (a sample on a sharp edge, its normal refitted
-/// to its nearest neighbours (NeighbourWeights::Local) and theirs turned 90° across the edge, can
-/// take either side: 1 of the convex edge's 12,000). Unturned if the surfels are not one per point
-/// (the caller asserts it).
+/// everywhere or nowhere. Unturned if the surfels are not one per point (the caller asserts it).
 PointCloud oriented_as_the_solid(const PointCloud& raw, const std::vector<Vec3f>& truth,
                                  const SurfelOptions& options)
 {
@@ -534,8 +531,7 @@ PointCloud oriented_as_the_solid(const PointCloud& raw, const std::vector<Vec3f>
     if (surfels.size() != truth.size())
         return surfels;
     const std::size_t flipped = turn_to_the_truth(surfels.normals, truth);
-    const std::size_t few = surfels.size() / 5000;
-    EXPECT_TRUE(flipped <= few || flipped >= surfels.size() - few) << flipped << " flipped";
+    EXPECT_TRUE(flipped == 0 || flipped == surfels.size()) << flipped << " flipped";
     return surfels;
 }
 

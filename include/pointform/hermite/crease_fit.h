@@ -282,8 +282,8 @@ inline constexpr std::size_t crease_refit_block = 4096;
 /// to each sample's own face (crease_plane() over the sample's row of `table`, the sample itself
 /// in it): a principal component normal there is a blend of the faces'. Every refit reads the
 /// normals as they were, so the result does not depend on the order or the threads. A noisy cloud
-/// keeps its normals: its planes would be fitted to the noise (crease_plane()). \return how many
-/// normals changed
+/// keeps its normals: its planes would be fitted to the noise (crease_plane()).
+/// \return how many normals changed
 std::size_t refit_crease_normals(std::span<const Vec3f> positions, const KnnTable& table,
                                  std::span<Vec3f> normals);
 
