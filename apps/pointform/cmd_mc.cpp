@@ -168,7 +168,7 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
                   "% of the diagonal; mean " + format_number(distance.mean) + ")");
     print_timings(timings);
     warn_unoriented(options.input, input.unoriented);
-    warn_isolated(options.input, input.isolated, input.copies);
+    warn_isolated(options.input, input.isolated, input.copies, input.off_surface);
 }
 
 } // namespace

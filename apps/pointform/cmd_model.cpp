@@ -192,7 +192,7 @@ void run_model(const ModelCommandOptions& options, const GlobalOptions& global)
     for (const LoadedScan& scan : arguments.scans())
     {
         warn_unoriented(scan.path, scan.unoriented);
-        warn_isolated(scan.path, scan.isolated, scan.copies);
+        warn_isolated(scan.path, scan.isolated, scan.copies, scan.off_surface);
     }
 }
 

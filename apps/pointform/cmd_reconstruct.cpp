@@ -113,7 +113,7 @@ void run_reconstruct(const ReconstructCommandOptions& options, const GlobalOptio
     print_semi_regular(run, options.refine);
     print_timings(timings);
     warn_unoriented(options.input, input.unoriented);
-    warn_isolated(options.input, input.isolated, input.copies);
+    warn_isolated(options.input, input.isolated, input.copies, input.off_surface);
 }
 
 } // namespace

@@ -34,7 +34,8 @@ void warn_unoriented(const std::string& path, std::size_t unoriented)
     }
 }
 
-void warn_isolated(const std::string& path, std::size_t isolated, std::size_t copies)
+void warn_isolated(const std::string& path, std::size_t isolated, std::size_t copies,
+                   std::size_t off_surface)
 {
     if (copies > 0)
     {
@@ -49,6 +50,13 @@ void warn_isolated(const std::string& path, std::size_t isolated, std::size_t co
                      "pointform: warning: %s: %zu samples alone far from the rest (stray points) "
                      "were left out\n",
                      path.c_str(), isolated);
+    }
+    if (off_surface > 0)
+    {
+        std::fprintf(stderr,
+                     "pointform: warning: %s: %zu samples standing off the surface of their "
+                     "nearest (stray returns near it) were left out\n",
+                     path.c_str(), off_surface);
     }
 }
 

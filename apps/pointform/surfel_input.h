@@ -19,8 +19,10 @@ namespace pointform::cli {
 /// says nothing when there were none.
 void warn_unoriented(const std::string& path, std::size_t unoriented);
 
-/// \brief Warns on stderr that `isolated` samples of `path` (alone, far from the rest) and
-/// `copies` (at the very place of an earlier sample) were left out; says nothing of none.
-void warn_isolated(const std::string& path, std::size_t isolated, std::size_t copies);
+/// \brief Warns on stderr that `isolated` samples of `path` (alone, far from the rest),
+/// `off_surface` ones (standing off the surface of their nearest) and `copies` (at the very place
+/// of an earlier sample) were left out; says nothing of none.
+void warn_isolated(const std::string& path, std::size_t isolated, std::size_t copies,
+                   std::size_t off_surface);
 
 } // namespace pointform::cli

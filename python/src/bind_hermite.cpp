@@ -39,12 +39,14 @@ void bind_hermite(py::module_& m)
         "connected component (minimum spanning tree), and influence radii (radius_scale times "
         "the distance to the k-th neighbour); points with normals keep them (unless "
         "reestimate) and get radii if they have none. Samples without a usable normal are left "
-        "out and counted, and so are samples alone far from the rest (stray returns) and "
-        "samples at the very place of an earlier one where radii are computed. With "
+        "out and counted, and so are samples alone far from the rest (stray returns), samples "
+        "standing off the surface of their nearest (stray returns near it) and samples at the "
+        "very place of an earlier one where radii are computed. With "
         "sharp_creases, the estimated normals of a clean cloud at its creases are refitted to "
         "each sample's own face (`pointform normals --sharp-creases`). Returns the "
         "surfels (same origin) and a report: estimated_normals, estimated_radii, components, "
-        "flipped, crease_refits, degenerate, unoriented, isolated, copies. What `pointform "
+        "flipped, crease_refits, degenerate, unoriented, isolated, off_surface, copies. What "
+        "`pointform "
         "reconstruct` does to its input. Raises InvalidInput for fewer than k + 1 usable "
         "points, all coincident or collinear points, or k < 3 or a radius_scale not positive.");
 

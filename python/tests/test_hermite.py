@@ -45,7 +45,7 @@ def test_repeated_and_stray_samples_are_left_out_and_counted():
     strays = np.array([1.5, 0.0, 0.0]) + 0.01 * rng.standard_normal((5, 3))
     cloud = pointform.PointCloud(np.vstack([p, p, p, strays]))
     surfels, report = pointform.surfels(cloud)
-    assert report["copies"] == 4000 and report["isolated"] == 5
+    assert report["copies"] == 4000 and report["isolated"] == 5 and report["off_surface"] == 0
     assert len(surfels) == 2000
     assert np.array_equal(surfels.positions, cloud.positions[:2000])
     assert np.all(surfels.radii > 0)

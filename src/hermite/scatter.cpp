@@ -88,6 +88,115 @@ bool stands_apart(const KdTree& tree, std::span<const Vec3f> positions, std::siz
            stray_isolation * stray_isolation * static_cast<double>(*middle);
 }
 
+/// The RMS distance from their plane of the three quarters of a normal sample nearest its mean is
+/// 0.61 of the sample's deviation: off_surface() scales the kept neighbours' RMS by this.
+constexpr double trimmed_rms_to_deviation = 1.65;
+/// off_surface() reads at most this many entries of a row, and needs this many others at least.
+constexpr std::size_t off_surface_max_row = 64;
+constexpr std::size_t off_surface_min_row = 8;
+/// off_surface() passes over a sample whose nearest's centroid is nearer it than this many times
+/// their RMS distance from that centroid (a stray off the surface stands off by more than its
+/// nearest's spread; a sample among them by about a quarter of it).
+constexpr double off_surface_among = 0.5;
+
+/// Whether sample `i` stands off the surface of `row`'s other entries (off_surface_samples()).
+bool off_surface(std::span<const Vec3f> positions, std::span<const std::uint32_t> row,
+                 std::uint32_t i)
+{
+    std::array<std::uint32_t, off_surface_max_row> others{};
+    std::size_t count = 0;
+    for (const std::uint32_t j : row)
+        if (j != i && count < others.size())
+            others[count++] = j;
+    if (count < off_surface_min_row)
+        return false;
+    // Most samples lie among their nearest, near their centroid: nearer than
+    // off_surface_among times their RMS distance from it (a cheap pass that spares the rest).
+    {
+        Vec3d sum = Vec3d::Zero();
+        double square = 0.0;
+        const Vec3d p = positions[i].cast<double>();
+        for (std::size_t j = 0; j < count; ++j)
+        {
+            const Vec3d q = positions[others[j]].cast<double>() - p;
+            sum += q;
+            square += q.squaredNorm();
+        }
+        const Vec3d centre = sum / static_cast<double>(count);
+        const double spread2 = square / static_cast<double>(count) - centre.squaredNorm();
+        if (centre.squaredNorm() <= off_surface_among * off_surface_among * spread2)
+            return false;
+    }
+    const auto kept =
+        static_cast<std::size_t>(std::ceil(off_surface_kept * static_cast<double>(count)));
+    // The surface's share of the row: first those nearest the row's coordinate-wise median
+    // (other strays in the row, spread wider than the surface's samples, move it little where
+    // a plane through all of them would tilt towards them), then those nearest their plane.
+    std::array<std::pair<double, std::uint32_t>, off_surface_max_row> by_distance{};
+    std::array<float, off_surface_max_row> coordinate{};
+    Vec3f median;
+    for (Eigen::Index axis = 0; axis < 3; ++axis)
+    {
+        for (std::size_t j = 0; j < count; ++j)
+            coordinate[j] = positions[others[j]][axis];
+        const auto middle = coordinate.begin() + static_cast<std::ptrdiff_t>(count / 2);
+        std::nth_element(coordinate.begin(), middle,
+                         coordinate.begin() + static_cast<std::ptrdiff_t>(count));
+        median[axis] = *middle;
+    }
+    for (std::size_t j = 0; j < count; ++j)
+        by_distance[j] = {(positions[others[j]] - median).cast<double>().squaredNorm(), others[j]};
+    std::array<std::uint32_t, off_surface_max_row> near_plane{};
+    const auto nearest_kept = [&] {
+        // The `kept` smallest (ties by index, so the choice is the same on any machine).
+        std::nth_element(by_distance.begin(),
+                         by_distance.begin() + static_cast<std::ptrdiff_t>(kept - 1),
+                         by_distance.begin() + static_cast<std::ptrdiff_t>(count));
+        for (std::size_t j = 0; j < kept; ++j)
+            near_plane[j] = by_distance[j].second;
+        std::sort(near_plane.begin(), near_plane.begin() + static_cast<std::ptrdiff_t>(kept));
+        return fit_plane(positions, std::span(near_plane).first(kept));
+    };
+    const LocalPlane central = nearest_kept();
+    if (central.degenerate)
+        return false;
+    for (std::size_t j = 0; j < count; ++j)
+        by_distance[j] = {
+            std::abs(central.normal.dot(positions[others[j]].cast<double>() - central.centroid)),
+            others[j]};
+    const LocalPlane plane = nearest_kept();
+    if (plane.degenerate)
+        return false;
+    const double noise = trimmed_rms_to_deviation * std::sqrt(plane.eigenvalues[0]);
+    const double spread = std::sqrt(0.5 * (plane.eigenvalues[1] + plane.eigenvalues[2]));
+    const double height = plane.normal.dot(positions[i].cast<double>() - plane.centroid);
+    const double off = std::abs(height);
+    if (!(off > off_surface_noise * noise && off > off_surface_spacing * spread))
+        return false;
+    // Others off the plane too: the sample's own face at a crease (seen at a grazing angle, so
+    // sampled more sparsely than the other face), or other strays. Two or fewer: alone off the
+    // surface, or too few to say. More: a face of its own if it lies on their plane.
+    const double beside = std::max(off_surface_beside * noise, 0.25 * spread);
+    std::array<std::uint32_t, off_surface_max_row + 1> apart{};
+    std::size_t apart_count = 0;
+    for (std::size_t j = 0; j < count; ++j)
+        if (std::abs(plane.normal.dot(positions[others[j]].cast<double>() - plane.centroid)) >
+            beside)
+            apart[apart_count++] = others[j];
+    if (apart_count < off_surface_others)
+        return true;
+    if (apart_count < off_surface_face)
+        return false;
+    apart[apart_count++] = i;
+    const LocalPlane face = fit_plane(positions, std::span(apart).first(apart_count));
+    if (face.degenerate)
+        return false;
+    for (std::size_t j = 0; j < apart_count; ++j)
+        if (std::abs(face.normal.dot(positions[apart[j]].cast<double>() - face.centroid)) > beside)
+            return true;
+    return false;
+}
+
 } // namespace
 
 bool ScatterTest::scattered(const KdTree& tree, std::span<const Vec3f> positions,
@@ -174,6 +283,46 @@ Strays find_strays(const KdTree& tree, std::span<const Vec3f> positions, const S
             out.samples.push_back(candidates[c]);
     }
     return out;
+}
+
+std::vector<std::uint32_t> off_surface_samples(std::span<const Vec3f> positions,
+                                               const KnnTable& neighbors)
+{
+    check_knn_table(neighbors, positions.size(), positions.size(), "off_surface_samples");
+    std::vector<std::uint32_t> found = parallel_collect<std::uint32_t>(
+        positions.size(), 4096,
+        [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& out) {
+            for (std::size_t i = begin; i < end; ++i)
+                if (off_surface(positions, neighbors.neighbors(i), static_cast<std::uint32_t>(i)))
+                    out.push_back(static_cast<std::uint32_t>(i));
+        });
+    // Those that lie on a plane with the nearest of them are a sheet (a thin part's far face).
+    constexpr std::size_t fellows = off_surface_sheet_neighbours + 1;
+    if (found.size() < fellows)
+        return found;
+    std::vector<Vec3f> at(found.size());
+    for (std::size_t c = 0; c < found.size(); ++c)
+        at[c] = positions[found[c]];
+    const KdTree tree(at);
+    std::vector<std::uint8_t> sheet(found.size(), 0);
+    parallel_blocks(found.size(), 256, [&](std::size_t begin, std::size_t end) {
+        std::array<std::uint32_t, fellows> index{};
+        std::array<float, fellows> d2{};
+        for (std::size_t c = begin; c < end; ++c)
+        {
+            const std::size_t got = tree.knn(at[c], fellows, index, d2);
+            const LocalPlane plane = fit_plane(at, std::span(index).first(got));
+            const double across = off_surface_sheet * off_surface_sheet;
+            sheet[c] =
+                !plane.degenerate && plane.eigenvalues[0] <= across * plane.eigenvalues[1] ? 1 : 0;
+        }
+    });
+    std::size_t kept = 0;
+    for (std::size_t c = 0; c < found.size(); ++c)
+        if (sheet[c] == 0)
+            found[kept++] = found[c];
+    found.resize(kept);
+    return found;
 }
 
 ScatterTest scatter_test(const KdTree& tree, std::span<const Vec3f> positions)

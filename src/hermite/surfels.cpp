@@ -7,6 +7,7 @@
 #include "pointform/core/parallel.h"
 #include "pointform/hermite/crease_fit.h"
 #include "pointform/hermite/normals.h"
+#include "pointform/hermite/scatter.h"
 #include "pointform/spatial/kd_tree.h"
 #include "pointform/spatial/spatial_sort.h"
 
@@ -246,6 +247,61 @@ private:
     std::vector<Vec3f> buffer_;
 };
 
+/// Rows of `table` (over `positions`, each the point itself and its nearest, nearest first) that
+/// hold one of `gone` (ascending) take the next nearest instead, from `tree`; the rows of `gone`
+/// stay as they are, and so does a row that too few other points could fill.
+void take_out_of_rows(const KdTree& tree, std::span<const Vec3f> positions,
+                      std::span<const std::uint32_t> gone, KnnTable& table)
+{
+    if (gone.empty())
+        return;
+    std::vector<std::uint8_t> is_gone(positions.size(), 0);
+    for (const std::uint32_t g : gone)
+        is_gone[g] = 1;
+    const std::size_t width = table.k;
+    const bool all_distances = table.has_all_distances();
+    parallel_blocks(table.rows(), 4096, [&](std::size_t begin, std::size_t end) {
+        std::vector<std::uint32_t> index;
+        std::vector<float> d2;
+        std::vector<std::uint32_t> row_index;
+        std::vector<float> row_d2;
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            const std::span<const std::uint32_t> row = table.neighbors(i);
+            if (is_gone[i] != 0 || std::none_of(row.begin(), row.end(),
+                                                [&](std::uint32_t j) { return is_gone[j] != 0; }))
+                continue;
+            row_index.clear();
+            row_d2.clear();
+            for (std::size_t want = width + 8;; want *= 2)
+            {
+                index.resize(want);
+                d2.resize(want);
+                const std::size_t got = tree.knn(positions[i], want, index, d2);
+                row_index.clear();
+                row_d2.clear();
+                for (std::size_t j = 0; j < got && row_index.size() < width; ++j)
+                    if (is_gone[index[j]] == 0)
+                    {
+                        row_index.push_back(index[j]);
+                        row_d2.push_back(d2[j]);
+                    }
+                if (row_index.size() == width || got < want)
+                    break;
+            }
+            if (row_index.size() < width)
+                continue;
+            std::copy(row_index.begin(), row_index.end(),
+                      table.indices.begin() + static_cast<std::ptrdiff_t>(i * width));
+            if (all_distances)
+                std::copy(row_d2.begin(), row_d2.end(),
+                          table.squared_distances.begin() + static_cast<std::ptrdiff_t>(i * width));
+            else
+                table.squared_distances[i] = row_d2.back();
+        }
+    });
+}
+
 /// compute_surfels() of `cloud`; when `owner` is given (the cloud that `cloud` views, no longer
 /// needed by the caller), its positions and colours are moved into the result, not copied.
 SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& options,
@@ -308,13 +364,20 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
     // Only the k-th distance is needed (radii, the orientation's flux); the tree goes once the
     // table is made.
     KnnTable table;
+    std::vector<std::uint32_t> off_surface; // indices into `positions`
     {
         const KdTree tree(positions);
         timer.lap("kd-tree");
         table = knn_batch(tree, positions, options.k + 1,
                           {.farthest_distance_only = true, .progress = options.progress});
+        timer.lap("knn");
+        if (options.off_surface)
+        {
+            off_surface = off_surface_samples(positions, table);
+            take_out_of_rows(tree, positions, off_surface, table);
+            timer.lap("off surface");
+        }
     }
-    timer.lap("knn");
     // The orientation's guide (noisy clouds) before the fine normals, so that the two never take
     // memory at once; its normals go into the lent array.
     const bool by_graph = options.orient == OrientMode::Mst || options.orient == OrientMode::Flip;
@@ -379,12 +442,16 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
         std::vector<Vec3f> spread_normals(n);
         std::vector<float> spread_radii(n);
         std::vector<std::uint8_t> isolated_place(positions.size(), 0);
+        std::vector<std::uint8_t> off_surface_place(positions.size(), 0);
         std::vector<std::uint8_t> unoriented_place(positions.size(), 0);
         for (const std::uint32_t p : result.isolated)
             isolated_place[p] = 1;
+        for (const std::uint32_t p : off_surface)
+            off_surface_place[p] = 1;
         for (const std::uint32_t p : oriented.unoriented)
             unoriented_place[p] = 1;
         result.isolated.clear();
+        off_surface.clear();
         oriented.unoriented.clear();
         for (std::size_t j = 0; j < n; ++j)
         {
@@ -393,6 +460,8 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
             spread_radii[j] = radii[p];
             if (isolated_place[p] != 0)
                 result.isolated.push_back(static_cast<std::uint32_t>(j));
+            if (off_surface_place[p] != 0)
+                off_surface.push_back(static_cast<std::uint32_t>(j));
             if (unoriented_place[p] != 0)
                 oriented.unoriented.push_back(static_cast<std::uint32_t>(j));
         }
@@ -404,6 +473,10 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
     for (auto& index : result.isolated)
         index = order[index];
     std::sort(result.isolated.begin(), result.isolated.end());
+    for (auto& index : off_surface)
+        index = order[index];
+    std::sort(off_surface.begin(), off_surface.end());
+    result.off_surface = std::move(off_surface);
     timer.lap("radius");
 
     // Back to the input order. The PCA normals' array (its pages already mapped) takes the

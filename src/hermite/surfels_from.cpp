@@ -6,6 +6,7 @@
 
 #include "pointform/core/error.h"
 #include "pointform/hermite/radius.h"
+#include "pointform/hermite/scatter.h"
 #include "pointform/hermite/surfels.h"
 #include "pointform/metrics/surface_sampling.h"
 #include "pointform/spatial/kd_tree.h"
@@ -74,6 +75,7 @@ SurfelsFromSamples surfels_from_samples(const PointCloudView& samples,
                                                     .radius_scale = options.radius_scale,
                                                     .radius_regions = options.radius_regions,
                                                     .sharp_creases = options.sharp_creases,
+                                                    .off_surface = true,
                                                     .progress = options.progress});
         out.surfels = std::move(result.surfels);
         out.estimated_normals = true;
@@ -83,13 +85,17 @@ SurfelsFromSamples surfels_from_samples(const PointCloudView& samples,
         out.flipped = result.orientation.flipped;
         out.degenerate = result.degenerate;
         out.unoriented = result.orientation.unoriented.size();
-        // The isolated samples and the copies first (their indices are the input's), then the
-        // unoriented.
+        // The isolated samples, those off the surface and the copies first (their indices are
+        // the input's), then the unoriented.
+        std::vector<std::uint32_t> apart;
+        std::set_union(result.isolated.begin(), result.isolated.end(), result.off_surface.begin(),
+                       result.off_surface.end(), std::back_inserter(apart));
         std::vector<std::uint32_t> left_out;
-        std::set_union(result.isolated.begin(), result.isolated.end(), result.copies.begin(),
-                       result.copies.end(), std::back_inserter(left_out));
+        std::set_union(apart.begin(), apart.end(), result.copies.begin(), result.copies.end(),
+                       std::back_inserter(left_out));
         out.copies = result.copies.size();
         out.isolated = result.isolated.size();
+        out.off_surface = apart.size() - result.isolated.size();
         drop_samples(out.surfels, left_out);
         drop_unoriented(out.surfels);
         return out;
@@ -125,7 +131,15 @@ SurfelsFromSamples surfels_from_samples(const PointCloudView& samples,
                                              influence_radii(reach, options.radius_scale),
                                              options.radius_regions);
         out.estimated_radii = true;
-        out.isolated = drop_samples(surfels, isolated_samples(surfels.positions, reach));
+        const std::vector<std::uint32_t> isolated = isolated_samples(surfels.positions, reach);
+        const std::vector<std::uint32_t> off_surface =
+            off_surface_samples(surfels.positions, reach);
+        std::vector<std::uint32_t> apart;
+        std::set_union(isolated.begin(), isolated.end(), off_surface.begin(), off_surface.end(),
+                       std::back_inserter(apart));
+        out.isolated = isolated.size();
+        out.off_surface = apart.size() - isolated.size();
+        drop_samples(surfels, apart);
     }
     return out;
 }

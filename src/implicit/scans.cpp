@@ -30,6 +30,7 @@ std::shared_ptr<const PointField> ScanLoading::load(const std::string& path)
     scan.estimated_normals = made.estimated_normals;
     scan.unoriented = made.unoriented;
     scan.isolated = made.isolated;
+    scan.off_surface = made.off_surface;
     scan.copies = made.copies;
     scan.field = std::make_shared<const PointField>(std::move(made.surfels), options_.field);
     index_.emplace(key, scans_.size());

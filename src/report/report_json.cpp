@@ -100,6 +100,7 @@ nlohmann::json report_json(const SurfelsFromSamples& surfels)
             {"degenerate", surfels.degenerate},
             {"unoriented", surfels.unoriented},
             {"isolated", surfels.isolated},
+            {"off_surface", surfels.off_surface},
             {"copies", surfels.copies}};
 }
 

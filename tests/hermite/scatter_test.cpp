@@ -3,7 +3,9 @@
 
 #include "pointform/hermite/scatter.h"
 
+#include "pointform/core/error.h"
 #include "pointform/geometry/shapes.h"
+#include "pointform/spatial/neighborhoods.h"
 
 #include "support/thread_counts.h"
 
@@ -14,6 +16,7 @@
 #include <cstdint>
 #include <numeric>
 #include <random>
+#include <utility>
 #include <vector>
 
 namespace pointform {
@@ -179,6 +182,97 @@ TEST(Scatter, TheSameStraysWhateverTheThreadCount)
     EXPECT_GT(runs[0].size(), 1000U);
     for (std::size_t i = 1; i < runs.size(); ++i)
         EXPECT_EQ(runs[i], runs[0]) << i + 1 << " threads";
+}
+
+std::vector<std::uint32_t> off_surface_of(const std::vector<Vec3f>& positions)
+{
+    const KdTree tree(positions);
+    return off_surface_samples(positions, knn_batch(tree, positions, 17));
+}
+
+TEST(OffSurface, StraysNearASurfaceAreFound)
+{
+    // 20k samples of the unit sphere (spacing about 0.025) and 50 returns 4-8 spacings off it,
+    // as near as a reach or two: no longer than a surface sample's reach, so no scatter test
+    // takes them; they stand off the plane of their nearest.
+    std::vector<Vec3f> positions =
+        sample_shape(Shape::Sphere, {.count = 20000, .seed = 3}).positions;
+    std::mt19937 random(5);
+    std::normal_distribution<float> gauss;
+    std::uniform_real_distribution<float> off(1.1F, 1.2F);
+    for (int i = 0; i < 50; ++i)
+        positions.push_back(Vec3f(gauss(random), gauss(random), gauss(random)).normalized() *
+                            off(random));
+    const std::vector<std::uint32_t> found = off_surface_of(positions);
+    EXPECT_TRUE(std::is_sorted(found.begin(), found.end()));
+    EXPECT_TRUE(
+        std::all_of(found.begin(), found.end(), [](std::uint32_t i) { return i >= 20000; }));
+    EXPECT_GE(found.size(), 48U);
+}
+
+TEST(OffSurface, CreasesCornersThinPartsAndNoiseAreNot)
+{
+    // Clean shapes with creases and corners (the part, the cone's apex and rim, the blobby's
+    // concave creases) and a plate 2.2 spacings thick: none.
+    for (const auto& [shape, thickness] :
+         {std::pair{Shape::Part, 0.05}, std::pair{Shape::Cone, 0.05},
+          std::pair{Shape::Blobby, 0.05}, std::pair{Shape::Plate, 0.02}})
+    {
+        const std::vector<Vec3f> positions =
+            sample_shape(shape, {.count = 100000, .seed = 4, .thickness = thickness}).positions;
+        EXPECT_TRUE(off_surface_of(positions).empty()) << static_cast<int>(shape);
+    }
+    // A noisy surface: a sample stands off it by the noise, which the test measures (a few of
+    // the farthest noise are taken, one in several thousand).
+    const std::vector<Vec3f> noisy =
+        sample_shape(Shape::Part, {.count = 100000, .seed = 4, .noise = 0.003}).positions;
+    EXPECT_LE(off_surface_of(noisy).size(), 30U);
+}
+
+TEST(OffSurface, ASparseFarFaceIsASheet)
+{
+    // A thin plate scanned from one side: a dense face, and its far face 0.1 away sampled 100
+    // times more sparsely, whose nearest are all the dense face's. Each far sample stands off
+    // that face, but the far samples lie on a plane together: none is taken.
+    std::mt19937 random(8);
+    std::uniform_real_distribution<float> side(0.0F, 2.0F);
+    std::vector<Vec3f> positions;
+    for (int i = 0; i < 40000; ++i)
+        positions.emplace_back(side(random), side(random), 0.0F);
+    for (int i = 0; i < 400; ++i)
+        positions.emplace_back(side(random), side(random), 0.1F);
+    EXPECT_TRUE(off_surface_of(positions).empty());
+    // Strays scattered through the space above it (0.04-0.3, 4-30 spacings of the dense face) do
+    // not lie on a plane: most taken (one with two others among its nearest stays, as a sample of
+    // a face at a crease does). (Strays spread over a wide area within a band much thinner
+    // than their own spacing would: they are kept, as a sparse face is.)
+    std::uniform_real_distribution<float> height(0.04F, 0.3F);
+    positions.resize(40000);
+    for (int i = 0; i < 40; ++i)
+        positions.emplace_back(side(random), side(random), height(random));
+    const std::vector<std::uint32_t> found = off_surface_of(positions);
+    EXPECT_GE(found.size(), 30U);
+    EXPECT_TRUE(
+        std::all_of(found.begin(), found.end(), [](std::uint32_t i) { return i >= 40000; }));
+}
+
+TEST(OffSurface, TheSameWhateverTheThreadCountAndRefusesABadTable)
+{
+    std::vector<Vec3f> positions =
+        sample_shape(Shape::Torus, {.count = 50000, .seed = 6}).positions;
+    std::mt19937 random(9);
+    std::uniform_real_distribution<float> box(-1.5F, 1.5F);
+    for (int i = 0; i < 2000; ++i)
+        positions.emplace_back(box(random), box(random), 0.5F * box(random));
+    const KdTree tree(positions);
+    const KnnTable table = knn_batch(tree, positions, 17);
+    const auto runs = test::at_thread_counts([&] { return off_surface_samples(positions, table); },
+                                             {.min_multi_block_loops = 2});
+    EXPECT_GT(runs[0].size(), 200U);
+    for (std::size_t i = 1; i < runs.size(); ++i)
+        EXPECT_EQ(runs[i], runs[0]) << i + 1 << " threads";
+    const std::vector<Vec3f> fewer(positions.begin(), positions.begin() + 1000);
+    EXPECT_THROW((void)off_surface_samples(fewer, table), InvalidInput);
 }
 
 } // namespace

@@ -6,12 +6,15 @@
 #include "pointform/hermite/surfels.h"
 
 #include "support/test_meshes.h"
+#include "support/thread_counts.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <random>
 
 namespace pointform {
 namespace {
@@ -61,6 +64,66 @@ TEST(SurfelsFromSamples, AStrayPointFarAwayIsLeftOut)
     const SurfelResult result = compute_surfels(clean);
     EXPECT_TRUE(result.isolated.empty());
     EXPECT_EQ(surfels_from_samples(clean).isolated, 0U);
+}
+
+// Stray returns near a surface (here 60, 4-8 sample spacings off a sphere: the nearer as near as
+// the reach of a surface sample, so not isolated) are left out, whether the normals are
+// estimated or given, and counted; where they are estimated, the other samples' are made
+// without them: every one within 5° of the sphere's (with the strays among their nearest, the
+// neighbours of a stray tilt by up to tens of degrees).
+TEST(SurfelsFromSamples, StraysNearTheSurfaceAreLeftOut)
+{
+    PointCloud points = sample_shape(Shape::Sphere, {.count = 20000, .seed = 26});
+    points.radii.clear();
+    std::mt19937 random(27);
+    std::normal_distribution<float> gauss;
+    std::uniform_real_distribution<float> off(1.1F, 1.2F);
+    for (int i = 0; i < 60; ++i)
+    {
+        const Vec3f direction = Vec3f(gauss(random), gauss(random), gauss(random)).normalized();
+        points.positions.push_back(direction * off(random));
+        points.normals.push_back(direction);
+    }
+    for (const bool estimate : {true, false})
+    {
+        const SurfelsFromSamples out = surfels_from_samples(points, {.reestimate = estimate});
+        // The farther ones are isolated (their reach over twice their nearest's), and counted so.
+        EXPECT_GT(out.off_surface, 10U) << "estimated " << estimate;
+        EXPECT_GE(out.isolated + out.off_surface, 57U) << "estimated " << estimate;
+        std::size_t off = 0;
+        for (std::size_t i = 0; i < out.surfels.size(); ++i)
+            off += out.surfels.positions[i].norm() > 1.01F ? 1 : 0;
+        EXPECT_EQ(off + out.isolated + out.off_surface, 60U) << "estimated " << estimate;
+        if (estimate)
+        {
+            std::size_t tilted = 0;
+            for (std::size_t i = 0; i < out.surfels.size(); ++i)
+                if (out.surfels.positions[i].norm() < 1.01F)
+                    tilted += out.surfels.normals[i].dot(out.surfels.positions[i].normalized()) <
+                                      std::cos(5.0F * std::numbers::pi_v<float> / 180.0F)
+                                  ? 1
+                                  : 0;
+            EXPECT_EQ(tilted, 0U);
+        }
+    }
+    // compute_surfels() names them (they keep surfels there) when asked, and by default does not.
+    PointCloud raw = points;
+    raw.normals.clear();
+    const SurfelResult named = compute_surfels(raw, {.off_surface = true});
+    EXPECT_EQ(named.surfels.size(), points.size());
+    EXPECT_GT(named.off_surface.size(), 20U);
+    EXPECT_TRUE(std::all_of(named.off_surface.begin(), named.off_surface.end(),
+                            [](std::uint32_t i) { return i >= 20000; }));
+    EXPECT_TRUE(compute_surfels(raw).off_surface.empty());
+    // The same whatever the thread count, the rows that held strays refilled in parallel.
+    const auto runs = test::at_thread_counts(
+        [&] { return compute_surfels(raw, {.off_surface = true}); }, {.min_multi_block_loops = 4});
+    for (std::size_t i = 1; i < runs.size(); ++i)
+    {
+        EXPECT_EQ(runs[0].off_surface, runs[i].off_surface) << "run " << i;
+        EXPECT_EQ(runs[0].surfels.normals, runs[i].surfels.normals) << "run " << i;
+        EXPECT_EQ(runs[0].surfels.radii, runs[i].surfels.radii) << "run " << i;
+    }
 }
 
 // A field has one surfel a place: copies of samples (here every sample twice, and one 40

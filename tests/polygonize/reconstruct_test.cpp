@@ -214,12 +214,39 @@ TEST(Reconstruct, ASprayOfStraysThroughSpaceDoesNotSpoilTheSurface)
     std::uniform_real_distribution<float> side(-3.0F, 3.0F);
     for (int i = 0; i < 150; ++i)
         points.positions.emplace_back(side(random), side(random), side(random));
-    const ReconstructReport report = reconstruct(surfels_from_samples(points).surfels);
+    const SurfelsFromSamples surfels = surfels_from_samples(points);
+    const ReconstructReport report = reconstruct(surfels.surfels);
     EXPECT_EQ(clean.stray_samples, 0U);
-    EXPECT_GE(report.stray_samples, 135U); // of 150, and a few lie near the sphere
-    EXPECT_LE(report.stray_samples, 150U);
+    // Of 150, and a few lie near the sphere; those standing off it are left out before.
+    EXPECT_GE(report.stray_samples + surfels.off_surface, 135U);
+    EXPECT_LE(report.stray_samples + surfels.off_surface, 150U);
     EXPECT_LT(report.intermediate_faces, clean.intermediate_faces + clean.intermediate_faces / 10);
     expect_unit_sphere(report);
+}
+
+// Stray returns near a scanned sphere, outside and inside it (200, 1%: 0.06-0.2 off it, 2.5-8
+// spacings of its samples), the nearer no farther from the sphere than a sample of it reaches,
+// so not isolated. Their fits raised tents off the sphere as high as they stand (up to 0.14 at
+// 20k samples); those off the surface (off_surface_samples()) are left out, the farther ones
+// isolated, and the sphere comes out closed, in one piece, as close to the truth as its
+// sampling density. (A stray nearer than two spacings is kept, and its tent stays as high.)
+TEST(Reconstruct, StraysNearTheSurfaceRaiseNoTents)
+{
+    PointCloud points = sample_shape(Shape::Sphere, {.count = 20000, .seed = 34});
+    points.normals.clear();
+    points.radii.clear();
+    std::mt19937 random(11);
+    std::normal_distribution<float> gauss;
+    std::uniform_real_distribution<float> off(0.06F, 0.2F);
+    for (int i = 0; i < 200; ++i)
+    {
+        const Vec3f direction = Vec3f(gauss(random), gauss(random), gauss(random)).normalized();
+        points.positions.push_back(direction * (1.0F + (i % 2 == 0 ? 1.0F : -1.0F) * off(random)));
+    }
+    const SurfelsFromSamples surfels = surfels_from_samples(points);
+    EXPECT_GT(surfels.off_surface, 60U);
+    EXPECT_GE(surfels.off_surface + surfels.isolated, 190U);
+    expect_unit_sphere(reconstruct(surfels.surfels));
 }
 
 // Coordinates quantized by a scanner or a file format (here a sphere's 30k samples rounded to a

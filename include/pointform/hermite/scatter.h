@@ -5,6 +5,7 @@
 
 #include "pointform/core/types.h"
 #include "pointform/spatial/kd_tree.h"
+#include "pointform/spatial/neighborhoods.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -80,5 +81,48 @@ struct Strays
 [[nodiscard]] Strays find_strays(const KdTree& tree, std::span<const Vec3f> positions,
                                  const ScatterTest& test,
                                  std::span<const std::uint32_t> candidates);
+
+/// \brief off_surface_samples(): of a sample's nearest, the share taken as the surface's: those
+/// nearest the plane of the share nearest their coordinate-wise median (the rest may be other
+/// strays, or the far face of a thin part) ...
+inline constexpr double off_surface_kept = 0.75;
+/// ... a sample stands off that surface when it lies farther from that plane than this many
+/// times the noise of the kept neighbours (their RMS distance from it, times 1.65: the RMS of the
+/// three quarters of a normal sample nearest its mean is 0.61 of its deviation) ...
+inline constexpr double off_surface_noise = 6.0;
+/// ... and than this many times their spread along it (their RMS distance from their centroid
+/// along one direction of the plane: about a sample spacing) ...
+inline constexpr double off_surface_spacing = 2.0;
+/// ... unless others of its nearest lie off that plane too (farther from it than
+/// off_surface_beside times the noise, and than a quarter of the spread): at least
+/// off_surface_others of them, and either fewer than off_surface_face or with the sample on one
+/// plane (each within that distance of it). A sample of a face at a crease, where its own face's
+/// samples are fewer than the other face's (a face seen at a grazing angle), has its own face
+/// among its nearest, off the other face's plane and on one with it; a stray among other
+/// strays has them off the plane but not on one with it; an isolated sample of a face, alone
+/// among the other face's samples, is taken as a stray.
+inline constexpr std::size_t off_surface_others = 2;
+inline constexpr std::size_t off_surface_face = 3;
+inline constexpr double off_surface_beside = 3.0;
+/// \brief Samples that stand off the surface by off_surface_samples()'s test but lie, with this
+/// many of the nearest such samples, on one plane (their spread across it at most
+/// off_surface_sheet times their least spread along it) are a sheet, not strays: the far face
+/// of a thin part scanned from one side, sampled more sparsely than its near face.
+inline constexpr std::size_t off_surface_sheet_neighbours = 8;
+inline constexpr double off_surface_sheet = 0.1;
+
+/// \brief The samples that stand off the surface of their nearest (see off_surface_kept and what
+/// follows it): a scanner's stray returns near a surface, where the reach of their nearest is
+/// no longer than a surface sample's (ScatterTest and isolated_samples() find those farther
+/// out). Such a sample's fit would raise a tent of the field over the surface. A sample of a
+/// noisy surface stands off it by the noise, which the test measures; one on a crease or a
+/// corner lies on its faces' planes; one of a thin part's face has its face among its nearest.
+/// In parallel; ascending; the same whatever the thread count.
+/// \param positions  N points
+/// \param neighbors  their N-row table of nearest (the point itself may be among them, and is
+///                   skipped), at least 8 others a row
+/// \throw InvalidInput if the table does not fit the points
+[[nodiscard]] std::vector<std::uint32_t> off_surface_samples(std::span<const Vec3f> positions,
+                                                             const KnnTable& neighbors);
 
 } // namespace pointform

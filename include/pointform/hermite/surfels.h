@@ -51,6 +51,13 @@ struct SurfelOptions
     /// (detail::refit_crease_normals()) instead of keeping the principal component normal, a
     /// blend of the faces' there. Off by default (README, `normals --sharp-creases`).
     bool sharp_creases = false;
+    /// Find the samples that stand off the surface of their nearest (off_surface_samples(): a
+    /// scanner's stray returns near a surface) and leave them out of every other sample's
+    /// neighbourhood, so that they tilt no normal, link no orientation and shorten no radius.
+    /// They keep surfels of their own, from their own nearest, and are listed in
+    /// SurfelResult::off_surface. Off by default (every sample's normal as its nearest give it);
+    /// surfels_from_samples() sets it and leaves them out.
+    bool off_surface = false;
     /// Optional progress report.
     ProgressCallback progress;
 };
@@ -73,13 +80,17 @@ struct SurfelResult
     /// The samples that lie alone far from the rest (isolated_samples()), ascending input
     /// indices: their surfels are kept here; surfels_from_samples() leaves them out.
     std::vector<std::uint32_t> isolated;
+    /// With SurfelOptions::off_surface, the samples that stand off the surface of their nearest
+    /// (off_surface_samples()), ascending input indices; their surfels are kept here, and
+    /// surfels_from_samples() leaves them out.
+    std::vector<std::uint32_t> off_surface;
     /// The samples at the very place of an earlier one (spatial_order()), ascending input
     /// indices: the surfels are computed once a place, and each copy has its original's normal
     /// and radius; surfels_from_samples() leaves the copies out.
     std::vector<std::uint32_t> copies;
     /// Wall-clock seconds by stage, in order: "check", "spatial sort" (with the copies), "kd-tree",
-    /// "knn", "normals", "orientation", "creases" (with SurfelOptions::sharp_creases), "radius",
-    /// "output order" (back to the input's order).
+    /// "knn", "off surface" (with SurfelOptions::off_surface), "normals", "orientation", "creases"
+    /// (with SurfelOptions::sharp_creases), "radius", "output order" (back to the input's order).
     std::vector<std::pair<std::string, double>> stage_seconds;
 };
 
@@ -139,6 +150,9 @@ struct SurfelsFromSamples
     /// Samples left out because they lie alone far from the rest (isolated_samples(); only
     /// where radii were computed here).
     std::size_t isolated = 0;
+    /// Samples left out because they stand off the surface of their nearest
+    /// (off_surface_samples(); only where radii were computed here), besides the isolated.
+    std::size_t off_surface = 0;
     /// Samples left out because an earlier sample lies at the very same place
     /// (spatial_order(); where normals or radii were computed here): a place is one surfel.
     std::size_t copies = 0;
@@ -148,7 +162,9 @@ struct SurfelsFromSamples
 /// normals estimated and oriented and radii computed (compute_surfels()); points with normals
 /// keep them and get automatic radii if they have none. Samples without a usable normal
 /// (zero, non-finite, or unorientable) are dropped and counted, and so are, where the radii are
-/// computed here, the samples that lie alone far from the rest (isolated_samples()).
+/// computed here, the samples that lie alone far from the rest (isolated_samples()) and those
+/// that stand off the surface of their nearest (off_surface_samples(); where normals are
+/// estimated here, the other samples' normals and radii are made without them).
 /// \throw InvalidInput as check_surfel_input(), for a radius_scale not positive and finite, or
 ///        when fewer than k + 1 samples with a usable normal are left
 [[nodiscard]] SurfelsFromSamples surfels_from_samples(

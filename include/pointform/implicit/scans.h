@@ -33,6 +33,7 @@ struct LoadedScan
     bool estimated_normals = false; ///< the file had no normals, or reestimate
     std::size_t unoriented = 0;     ///< samples left out for want of a usable normal
     std::size_t isolated = 0;       ///< samples left out as alone far from the rest
+    std::size_t off_surface = 0;    ///< samples left out as standing off the surface
     std::size_t copies = 0;         ///< samples left out at the very place of an earlier one
     std::shared_ptr<const PointField> field;
 };
