@@ -74,6 +74,11 @@ void register_sample(CLI::App& app, const GlobalOptions& global)
                     "Hole radius, fraction of the bounding-box diagonal")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--strays", options->sampling.strays,
+                    "Stray points spread through the bounding box grown by 30%, fraction of the "
+                    "count")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1.0));
     cmd->add_option("--thickness", options->sampling.thickness, "Plate thickness (side 2)")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);

@@ -40,7 +40,10 @@ from run_normals_bench import run_measured  # noqa: E402
 from virtual_scan import surface_samples  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
-VARIANTS = {"clean": [], "noisy+holes": ["--noise", "0.002", "--holes", "8", "--hole-radius", "0.04"]}
+# "strays" (not run by default): 1% stray points through the bounding box grown by 30%, the
+# nearer within a few spacings of the surface (near-surface stray returns).
+VARIANTS = {"clean": [], "noisy+holes": ["--noise", "0.002", "--holes", "8", "--hole-radius", "0.04"],
+            "strays": ["--strays", "0.01"]}
 
 
 # Shape::Blobby and Shape::Part of src/geometry/shapes.cpp (keep in sync).

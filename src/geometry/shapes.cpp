@@ -308,10 +308,11 @@ PointCloud sample_shape(Shape shape, const SampleOptions& options)
 {
     if (options.count == 0)
         throw InvalidInput("sample_shape: count must be positive");
-    if (!(options.noise >= 0.0) || !(options.hole_radius >= 0.0) || !(options.thickness > 0.0))
+    if (!(options.noise >= 0.0) || !(options.hole_radius >= 0.0) || !(options.thickness > 0.0) ||
+        !(options.strays >= 0.0) || !(options.strays <= 1.0))
         throw InvalidInput(
             "sample_shape: noise, hole radius and thickness must be non-negative "
-            "(thickness positive)");
+            "(thickness positive), strays a fraction from 0 to 1");
 
     std::mt19937_64 rng(options.seed);
     std::vector<Sample> samples;
@@ -348,6 +349,19 @@ PointCloud sample_shape(Shape shape, const SampleOptions& options)
             continue;
         cloud.positions.emplace_back(p.cast<float>());
         cloud.normals.emplace_back(s.normal.cast<float>());
+    }
+    const auto strays =
+        static_cast<std::size_t>(std::llround(options.strays * static_cast<double>(options.count)));
+    const Vec3d centre = box.center();
+    const Vec3d half = 0.65 * (box.max - box.min);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    for (std::size_t i = 0; i < strays; ++i)
+    {
+        const Vec3d offset(half.x() * unit(rng), half.y() * unit(rng), half.z() * unit(rng));
+        cloud.positions.emplace_back((centre + offset).cast<float>());
+        const double length = offset.norm();
+        cloud.normals.emplace_back(length > 0.0 ? Vec3f((offset / length).cast<float>())
+                                                : Vec3f(Vec3f::UnitZ()));
     }
     return cloud;
 }

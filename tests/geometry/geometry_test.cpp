@@ -224,6 +224,33 @@ TEST(Shapes, SamplesLieOnTheSurfaceWithUnitOutwardNormals)
     }
 }
 
+// Strays follow the samples: as many as the fraction asks, spread through the box grown by 30%
+// (some within it, some past it on every side), with unit normals; the samples before them are
+// the same as without them. A fraction outside 0-1 is refused.
+TEST(Shapes, StraysFollowTheSamplesThroughTheGrownBox)
+{
+    const PointCloud plain = sample_shape(Shape::Sphere, {.count = 5000, .seed = 3});
+    const PointCloud cloud = sample_shape(Shape::Sphere, {.count = 5000, .seed = 3, .strays = 0.1});
+    ASSERT_EQ(cloud.size(), 5500U);
+    ASSERT_EQ(cloud.normals.size(), 5500U);
+    for (std::size_t i = 0; i < 5000; ++i)
+        ASSERT_EQ(cloud.positions[i], plain.positions[i]) << i;
+    std::size_t past = 0;
+    std::size_t off = 0;
+    for (std::size_t i = 5000; i < cloud.size(); ++i)
+    {
+        const Vec3f p = cloud.positions[i];
+        EXPECT_LE(p.cwiseAbs().maxCoeff(), 1.3F + 1e-4F);
+        past += p.cwiseAbs().maxCoeff() > 1.0F ? 1 : 0;
+        off += std::abs(p.norm() - 1.0F) > 0.05F ? 1 : 0;
+        EXPECT_NEAR(cloud.normals[i].norm(), 1.0F, 1e-5F);
+    }
+    EXPECT_GT(past, 200U); // 1 - (1/1.3)^3 of them, 272 on average
+    EXPECT_GT(off, 400U);
+    EXPECT_THROW((void)sample_shape(Shape::Sphere, {.strays = 1.5}), InvalidInput);
+    EXPECT_THROW((void)sample_shape(Shape::Sphere, {.strays = -0.1}), InvalidInput);
+}
+
 /// The cone's signed distance bound: max(−z, (r + z − 1)/√2), zero on its surface, negative
 /// inside, the exact distance off a face (away from the rim and the apex).
 double cone_value(const Vec3d& p)

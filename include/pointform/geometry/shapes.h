@@ -80,6 +80,11 @@ struct SampleOptions
     double hole_radius = 0.05;
     /// Plate only: thickness of the plate (its side is 2).
     double thickness = 0.05;
+    /// Stray points added, as a fraction of `count`: spread evenly through the samples'
+    /// bounding box grown by 30% about its centre (inside the shape, near it and away from it,
+    /// as a scanner's stray returns), after the samples. They have no surface: their normals
+    /// point away from the box's centre. 0 = none.
+    double strays = 0.0;
 };
 
 /// \brief Samples a shape area-uniformly and returns positions with exact outward unit normals.
