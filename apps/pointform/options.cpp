@@ -200,6 +200,9 @@ void add_surfel_input_options(CLI::App& cmd, SurfelsFromSamplesOptions& options)
             "Where normals are estimated here (raw points, or --reestimate): in a clean "
             "cloud, refit each normal at a crease to its own face instead of keeping "
             "the PCA normal, a blend of the faces' there (see `pointform normals`)");
+    cmd.add_flag("--keep-off-surface", options.keep_off_surface,
+                 "Keep the samples that stand off the surface of their nearest (stray returns "
+                 "near it, left out by default; a face seen at a grazing angle may have a few)");
 }
 
 CLI::Option* add_sharp_creases_flag(CLI::App& cmd, bool& sharp)

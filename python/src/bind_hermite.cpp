@@ -18,12 +18,13 @@ void bind_hermite(py::module_& m)
     m.def(
         "surfels",
         [](const std::shared_ptr<Cloud>& cloud, std::size_t k, double radius_scale, bool reestimate,
-           bool sharp_creases) {
+           bool sharp_creases, bool keep_off_surface) {
             SurfelsFromSamples result = run_interruptible([&](const ProgressCallback& progress) {
                 return surfels_from_samples(cloud->view, {.k = k,
                                                           .radius_scale = radius_scale,
                                                           .reestimate = reestimate,
                                                           .sharp_creases = sharp_creases,
+                                                          .keep_off_surface = keep_off_surface,
                                                           .progress = progress});
             });
             return py::make_tuple(owned_cloud(std::move(result.surfels)),
@@ -31,8 +32,9 @@ void bind_hermite(py::module_& m)
         },
         py::arg("cloud"), py::kw_only(), py::arg("k") = default_neighbors,
         py::arg("radius_scale") = default_field_radius_scale, py::arg("reestimate") = false,
-        py::arg("sharp_creases") = false,
-        "surfels(cloud, *, k=16, radius_scale=1.5, reestimate=False, sharp_creases=False) -> "
+        py::arg("sharp_creases") = false, py::arg("keep_off_surface") = false,
+        "surfels(cloud, *, k=16, radius_scale=1.5, reestimate=False, sharp_creases=False, "
+        "keep_off_surface=False) -> "
         "(PointCloud, dict)\n\n"
         "Samples to the oriented surfels of a field (Level 1 or 2 -> 2, paper §4): raw points "
         "get PCA normals of their k nearest neighbours, oriented consistently in every "
@@ -40,8 +42,9 @@ void bind_hermite(py::module_& m)
         "the distance to the k-th neighbour); points with normals keep them (unless "
         "reestimate) and get radii if they have none. Samples without a usable normal are left "
         "out and counted, and so are samples alone far from the rest (stray returns), samples "
-        "standing off the surface of their nearest (stray returns near it) and samples at the "
-        "very place of an earlier one where radii are computed. With "
+        "standing off the surface of their nearest (stray returns near it; kept with "
+        "keep_off_surface) and samples at the very place of an earlier one where radii are "
+        "computed. With "
         "sharp_creases, the estimated normals of a clean cloud at its creases are refitted to "
         "each sample's own face (`pointform normals --sharp-creases`). Returns the "
         "surfels (same origin) and a report: estimated_normals, estimated_radii, components, "

@@ -39,6 +39,9 @@ def test_strays_of_a_spray(sphere_surfels):
     strays = pointform.Field(surfels).strays
     assert report["off_surface"] > 0
     assert 90 <= len(strays) + report["off_surface"] + report["isolated"] <= 100
+    kept, kept_report = pointform.surfels(pointform.PointCloud(np.vstack([sphere, spray])),
+                                          keep_off_surface=True)
+    assert kept_report["off_surface"] == 0 and len(kept) >= len(surfels) + report["off_surface"]
     assert np.all(np.abs(np.linalg.norm(strays, axis=1) - 1.0) > 0.05)
     assert pointform.scene("sphere([0,0,0], 1)").strays is None
 

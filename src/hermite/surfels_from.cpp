@@ -75,7 +75,7 @@ SurfelsFromSamples surfels_from_samples(const PointCloudView& samples,
                                                     .radius_scale = options.radius_scale,
                                                     .radius_regions = options.radius_regions,
                                                     .sharp_creases = options.sharp_creases,
-                                                    .off_surface = true,
+                                                    .off_surface = !options.keep_off_surface,
                                                     .progress = options.progress});
         out.surfels = std::move(result.surfels);
         out.estimated_normals = true;
@@ -133,7 +133,8 @@ SurfelsFromSamples surfels_from_samples(const PointCloudView& samples,
         out.estimated_radii = true;
         const std::vector<std::uint32_t> isolated = isolated_samples(surfels.positions, reach);
         const std::vector<std::uint32_t> off_surface =
-            off_surface_samples(surfels.positions, reach);
+            options.keep_off_surface ? std::vector<std::uint32_t>()
+                                     : off_surface_samples(surfels.positions, reach);
         std::vector<std::uint32_t> apart;
         std::set_union(isolated.begin(), isolated.end(), off_surface.begin(), off_surface.end(),
                        std::back_inserter(apart));

@@ -106,6 +106,10 @@ TEST(SurfelsFromSamples, StraysNearTheSurfaceAreLeftOut)
             EXPECT_EQ(tilted, 0U);
         }
     }
+    // Kept when asked.
+    const SurfelsFromSamples kept = surfels_from_samples(points, {.keep_off_surface = true});
+    EXPECT_EQ(kept.off_surface, 0U);
+    EXPECT_EQ(kept.surfels.size() + kept.isolated, points.size());
     // compute_surfels() names them (they keep surfels there) when asked, and by default does not.
     PointCloud raw = points;
     raw.normals.clear();

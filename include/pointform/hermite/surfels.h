@@ -125,6 +125,10 @@ struct SurfelsFromSamplesOptions
     /// Estimated normals at a clean cloud's creases refitted to their own face
     /// (SurfelOptions::sharp_creases).
     bool sharp_creases = false;
+    /// Keep the samples that stand off the surface of their nearest (off_surface_samples()),
+    /// which are otherwise left out: for a cloud whose faces seen at a grazing angle hold a few
+    /// samples each beside a densely sampled face, and no stray returns.
+    bool keep_off_surface = false;
     ProgressCallback progress;
 };
 
