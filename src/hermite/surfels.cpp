@@ -271,8 +271,6 @@ void take_out_of_rows(const KdTree& tree, std::span<const Vec3f> positions,
             if (is_gone[i] != 0 || std::none_of(row.begin(), row.end(),
                                                 [&](std::uint32_t j) { return is_gone[j] != 0; }))
                 continue;
-            row_index.clear();
-            row_d2.clear();
             for (std::size_t want = width + 8;; want *= 2)
             {
                 index.resize(want);
