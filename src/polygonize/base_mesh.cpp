@@ -1160,8 +1160,9 @@ std::size_t fit_base_faces_to_budget(std::size_t target, std::size_t vertex_budg
     const double faces_wanted = 2.0 * fill * static_cast<double>(vertex_budget);
     if (target == 0 || static_cast<double>(target) >= faces_wanted)
         return target;
-    const double levels =
-        std::round(std::log(faces_wanted / static_cast<double>(target)) / std::log(4.0));
+    // The level count J of log₄(faces_wanted / target), rounded toward the smaller base mesh.
+    const double levels = std::ceil(
+        std::log(faces_wanted / static_cast<double>(target)) / std::log(4.0) - smaller_base_bias);
     const double fitted = faces_wanted / std::pow(4.0, levels);
     return std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(fitted)));
 }

@@ -234,9 +234,12 @@ TEST(BaseMesh, ShapeRoundsStopWhenTheyGainLittle)
 
 TEST(BaseMesh, TargetFittedToAVertexBudget)
 {
-    // F0 moves by at most a factor of two, to a value whose level J has 2·0.6·budget faces.
+    // F0 moves down by at most 4^0.75 or up by at most 4^0.25, to a value whose level J has
+    // 2·0.6·budget faces.
+    const double down = std::pow(4.0, 1.0 - smaller_base_bias);
+    const double up = std::pow(4.0, smaller_base_bias);
     for (const std::size_t budget : {1000UL, 35947UL, 100000UL, 1000000UL, 10000000UL})
-        for (const std::size_t target : {200UL, 850UL, 3000UL, 20000UL})
+        for (const std::size_t target : {200UL, 850UL, 3000UL, 7000UL, 20000UL})
         {
             const std::size_t fitted = fit_base_faces_to_budget(target, budget);
             if (static_cast<double>(target) >= 1.2 * static_cast<double>(budget))
@@ -244,8 +247,9 @@ TEST(BaseMesh, TargetFittedToAVertexBudget)
                 EXPECT_EQ(fitted, target);
                 continue;
             }
-            EXPECT_GE(2.0 * static_cast<double>(fitted), static_cast<double>(target));
-            EXPECT_LE(static_cast<double>(fitted), 2.0 * static_cast<double>(target));
+            // Rounded to whole faces: one face either way.
+            EXPECT_GE(down * static_cast<double>(fitted + 1), static_cast<double>(target));
+            EXPECT_LE(static_cast<double>(fitted), up * static_cast<double>(target) + 1.0);
             const double levels =
                 std::log(1.2 * static_cast<double>(budget) / static_cast<double>(fitted)) /
                 std::log(4.0);
@@ -254,6 +258,17 @@ TEST(BaseMesh, TargetFittedToAVertexBudget)
                 << budget << " " << target;
         }
     EXPECT_EQ(fit_base_faces_to_budget(0, 1000), 0U);
+    // Between one level and two (a ratio of 4^1.5 = 8 would round either way), the smaller base
+    // mesh: a target of 1/7 of the faces wanted takes two levels over a quarter of it, where
+    // the nearest level would take one over four times as many faces.
+    const std::size_t budget = 47636;
+    const double wanted = 2.0 * default_budget_fill * static_cast<double>(budget);
+    const auto seventh = static_cast<std::size_t>(wanted / 7.0);
+    EXPECT_NEAR(static_cast<double>(fit_base_faces_to_budget(seventh, budget)), wanted / 16.0, 1.0);
+    // Within a quarter level above an exact fit the target still takes the nearer level.
+    const auto just_above = static_cast<std::size_t>(wanted / std::pow(4.0, 2.2));
+    EXPECT_NEAR(static_cast<double>(fit_base_faces_to_budget(just_above, budget)), wanted / 16.0,
+                1.0);
 }
 
 TEST(BaseMesh, DefaultTargetFollowsTheIntermediateMesh)

@@ -208,9 +208,20 @@ inline constexpr std::size_t max_default_base_faces = 80000;
 /// (fit_base_faces_to_budget()).
 inline constexpr double default_budget_fill = 0.6;
 
-/// \brief Moves a base-face target by at most a factor of two so that some refinement level of
-/// it has about `fill` of a vertex budget: the level J nearest to log₄(2·fill·budget / target),
-/// and F0 = 2·fill·budget / 4^J (a closed mesh of F faces has about F / 2 vertices). With a
+/// How far fit_base_faces_to_budget() leans toward the smaller base mesh, in levels (log₄ of
+/// the base faces): J = ⌈log₄(2·fill·budget / target) − bias⌉, so that the fitted base has
+/// between 4^−(1−bias) and 4^bias times the target's faces (between 0.35 and 1.41 of it) where
+/// the nearest level would take between 0.5 and 2. The two errors do not cost the same: a base
+/// mesh twice as large doubles the marching cubes of the intermediate mesh and its decimation
+/// (the intermediate has intermediate_faces_per_base_face times the base's faces, and the two
+/// are most of a scan's time), where one more refinement level over a smaller base costs a
+/// fraction of that and lands at the same vertex budget.
+inline constexpr double smaller_base_bias = 0.25;
+
+/// \brief Moves a base-face target by at most a factor of 2.83 down or 1.41 up so that some
+/// refinement level of it has about `fill` of a vertex budget: the level J of
+/// smaller_base_bias, and F0 = 2·fill·budget / 4^J (a closed mesh of F faces has about F / 2
+/// vertices). With a
 /// budget on the finest level's vertices (StopRule::Automatic), the deepest level that fits
 /// then has between fill and 4·fill of the budget, whatever the base mesh's own estimate; a
 /// target that alone would exceed the budget is returned as it is.
