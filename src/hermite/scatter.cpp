@@ -285,21 +285,15 @@ Strays find_strays(const KdTree& tree, std::span<const Vec3f> positions, const S
     return out;
 }
 
-std::vector<std::uint32_t> off_surface_samples(std::span<const Vec3f> positions,
-                                               const KnnTable& neighbors)
+namespace {
+
+/// `found` (ascending) without the samples that lie on a plane with the nearest of them: a sheet
+/// (a thin part's far face), not strays.
+void drop_sheets(std::span<const Vec3f> positions, std::vector<std::uint32_t>& found)
 {
-    check_knn_table(neighbors, positions.size(), positions.size(), "off_surface_samples");
-    std::vector<std::uint32_t> found = parallel_collect<std::uint32_t>(
-        positions.size(), 4096,
-        [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& out) {
-            for (std::size_t i = begin; i < end; ++i)
-                if (off_surface(positions, neighbors.neighbors(i), static_cast<std::uint32_t>(i)))
-                    out.push_back(static_cast<std::uint32_t>(i));
-        });
-    // Those that lie on a plane with the nearest of them are a sheet (a thin part's far face).
     constexpr std::size_t fellows = off_surface_sheet_neighbours + 1;
     if (found.size() < fellows)
-        return found;
+        return;
     std::vector<Vec3f> at(found.size());
     for (std::size_t c = 0; c < found.size(); ++c)
         at[c] = positions[found[c]];
@@ -322,6 +316,61 @@ std::vector<std::uint32_t> off_surface_samples(std::span<const Vec3f> positions,
         if (sheet[c] == 0)
             found[kept++] = found[c];
     found.resize(kept);
+}
+
+} // namespace
+
+std::vector<std::uint32_t> off_surface_samples(std::span<const Vec3f> positions,
+                                               const KnnTable& neighbors)
+{
+    check_knn_table(neighbors, positions.size(), positions.size(), "off_surface_samples");
+    std::vector<std::uint32_t> found = parallel_collect<std::uint32_t>(
+        positions.size(), 4096,
+        [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& out) {
+            for (std::size_t i = begin; i < end; ++i)
+                if (off_surface(positions, neighbors.neighbors(i), static_cast<std::uint32_t>(i)))
+                    out.push_back(static_cast<std::uint32_t>(i));
+        });
+    drop_sheets(positions, found);
+    // Strays among strays: a row holding two or three other strays has them off the surface's
+    // plane beside the sample, as its own face at a crease would be. Each round tests again the
+    // samples whose rows hold samples found so far, without those.
+    std::vector<std::uint8_t> off(found.empty() ? 0 : positions.size(), 0);
+    for (std::size_t round = 0; round < off_surface_rounds && !found.empty(); ++round)
+    {
+        for (const std::uint32_t i : found)
+            off[i] = 1;
+        std::vector<std::uint32_t> more = parallel_collect<std::uint32_t>(
+            positions.size(), 4096,
+            [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& out) {
+                std::array<std::uint32_t, off_surface_max_row> rest{};
+                for (std::size_t i = begin; i < end; ++i)
+                {
+                    if (off[i] != 0)
+                        continue;
+                    const std::span<const std::uint32_t> row = neighbors.neighbors(i);
+                    std::size_t count = 0;
+                    bool without = false;
+                    for (const std::uint32_t j : row)
+                    {
+                        if (off[j] != 0)
+                            without = true;
+                        else if (count < rest.size())
+                            rest[count++] = j;
+                    }
+                    if (without && off_surface(positions, std::span(rest).first(count),
+                                               static_cast<std::uint32_t>(i)))
+                        out.push_back(static_cast<std::uint32_t>(i));
+                }
+            });
+        if (more.empty())
+            break;
+        std::fill(off.begin(), off.end(), std::uint8_t{0});
+        std::vector<std::uint32_t> merged(found.size() + more.size());
+        std::merge(found.begin(), found.end(), more.begin(), more.end(), merged.begin());
+        found = std::move(merged);
+        drop_sheets(positions, found);
+    }
     return found;
 }
 

@@ -210,6 +210,33 @@ TEST(OffSurface, StraysNearASurfaceAreFound)
     EXPECT_GE(found.size(), 48U);
 }
 
+TEST(OffSurface, StraysAmongStraysAreFoundInRounds)
+{
+    // A dense grid (spacing 1) and three strays 6 above it on a line, B - A - C, 2 and 5 apart:
+    // every plane sample within about 6.4 of a stray is among its 16 nearest, so A's hold B and
+    // C, both off the plane beside it (as its own face's samples would be at a crease: kept by
+    // the first pass), while B's and C's hold A alone (found). The next round tests A without
+    // them: alone off the plane, found. Strays left in a cluster by the first pass are how a
+    // cube with 5% strays kept pockets 0.2 deep.
+    std::vector<Vec3f> positions;
+    for (int x = 0; x < 60; ++x)
+        for (int y = 0; y < 60; ++y)
+            positions.emplace_back(static_cast<float>(x), static_cast<float>(y), 0.0F);
+    const auto a = static_cast<std::uint32_t>(positions.size());
+    positions.emplace_back(30.3F, 30.2F, 6.0F);
+    positions.emplace_back(28.3F, 30.2F, 6.0F); // B
+    positions.emplace_back(35.3F, 30.2F, 6.0F); // C
+    const std::vector<std::uint32_t> found = off_surface_of(positions);
+    EXPECT_EQ(found, (std::vector<std::uint32_t>{a, a + 1, a + 2}));
+    // A alone with B and C as its own face would be (on one plane with it, 0.5 and 1 apart
+    // beside it, each with the other among its nearest): a face at a crease, kept.
+    positions.resize(a);
+    positions.emplace_back(30.3F, 30.2F, 6.0F);
+    positions.emplace_back(30.8F, 30.2F, 6.0F);
+    positions.emplace_back(31.3F, 30.2F, 6.0F);
+    EXPECT_TRUE(off_surface_of(positions).empty());
+}
+
 TEST(OffSurface, CreasesCornersThinPartsAndNoiseAreNot)
 {
     // Clean shapes with creases and corners (the part, the cone's apex and rim, the blobby's

@@ -110,6 +110,11 @@ inline constexpr double off_surface_beside = 3.0;
 /// of a thin part scanned from one side, sampled more sparsely than its near face.
 inline constexpr std::size_t off_surface_sheet_neighbours = 8;
 inline constexpr double off_surface_sheet = 0.1;
+/// \brief Rounds of off_surface_samples() after the first: each tests again the samples whose
+/// nearest hold samples found so far, with those left out of their nearest (strays among
+/// strays, where two or three others in a row stand off the surface beside the sample as its
+/// own face at a crease would).
+inline constexpr std::size_t off_surface_rounds = 3;
 
 /// \brief The samples that stand off the surface of their nearest (see off_surface_kept and what
 /// follows it): a scanner's stray returns near a surface, where the reach of their nearest is
