@@ -174,8 +174,8 @@ bool off_surface(std::span<const Vec3f> positions, std::span<const std::uint32_t
     if (!(off > off_surface_noise * noise && off > off_surface_spacing * spread))
         return false;
     // Others off the plane too: the sample's own face at a crease (seen at a grazing angle, so
-    // sampled more sparsely than the other face), or other strays. Two or fewer: alone off the
-    // surface, or too few to say. More: a face of its own if it lies on their plane.
+    // sampled more sparsely than the other face), or other strays. Two or fewer: off the
+    // surface. More: a face of its own if it lies on their plane.
     const double beside = std::max(off_surface_beside * noise, 0.25 * spread);
     std::array<std::uint32_t, off_surface_max_row + 1> apart{};
     std::size_t apart_count = 0;
@@ -183,10 +183,8 @@ bool off_surface(std::span<const Vec3f> positions, std::span<const std::uint32_t
         if (std::abs(plane.normal.dot(positions[others[j]].cast<double>() - plane.centroid)) >
             beside)
             apart[apart_count++] = others[j];
-    if (apart_count < off_surface_others)
-        return true;
     if (apart_count < off_surface_face)
-        return false;
+        return true;
     apart[apart_count++] = i;
     const LocalPlane face = fit_plane(positions, std::span(apart).first(apart_count));
     if (face.degenerate)

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <numeric>
 #include <random>
 #include <utility>
@@ -212,28 +213,33 @@ TEST(OffSurface, StraysNearASurfaceAreFound)
 
 TEST(OffSurface, StraysAmongStraysAreFoundInRounds)
 {
-    // A dense grid (spacing 1) and three strays 6 above it on a line, B - A - C, 2 and 5 apart:
-    // every plane sample within about 6.4 of a stray is among its 16 nearest, so A's hold B and
-    // C, both off the plane beside it (as its own face's samples would be at a crease: kept by
-    // the first pass), while B's and C's hold A alone (found). The next round tests A without
-    // them: alone off the plane, found. Strays left in a cluster by the first pass are how a
-    // cube with 5% strays kept pockets 0.2 deep.
+    // A dense grid (spacing 1) and four strays 6 above it: A, and B, C and D 4 from A around it
+    // (6.9 apart). Every plane sample within about 6.4 of a stray is among its 16 nearest, so
+    // A's hold B, C and D, off the plane beside it and on one plane with it (as its own face's
+    // samples would be at a crease: kept by the first pass), while B's, C's and D's hold A alone
+    // (found). The next round tests A without them: alone off the plane, found.
     std::vector<Vec3f> positions;
     for (int x = 0; x < 60; ++x)
         for (int y = 0; y < 60; ++y)
             positions.emplace_back(static_cast<float>(x), static_cast<float>(y), 0.0F);
     const auto a = static_cast<std::uint32_t>(positions.size());
-    positions.emplace_back(30.3F, 30.2F, 6.0F);
-    positions.emplace_back(28.3F, 30.2F, 6.0F); // B
-    positions.emplace_back(35.3F, 30.2F, 6.0F); // C
+    const Vec3f centre(30.3F, 30.2F, 6.0F);
+    positions.push_back(centre);
+    for (int k = 0; k < 3; ++k)
+    {
+        const double angle = 2.0 * std::numbers::pi * k / 3.0;
+        positions.push_back(centre + 4.0F * Vec3f(static_cast<float>(std::cos(angle)),
+                                                  static_cast<float>(std::sin(angle)), 0.0F));
+    }
     const std::vector<std::uint32_t> found = off_surface_of(positions);
-    EXPECT_EQ(found, (std::vector<std::uint32_t>{a, a + 1, a + 2}));
-    // A alone with B and C as its own face would be (on one plane with it, 0.5 and 1 apart
-    // beside it, each with the other among its nearest): a face at a crease, kept.
+    EXPECT_EQ(found, (std::vector<std::uint32_t>{a, a + 1, a + 2, a + 3}));
+    // Five samples 0.7 apart on one plane 6 above the grid: each has the four others off the
+    // plane beside it and on one plane with it, a face of its own: kept.
     positions.resize(a);
-    positions.emplace_back(30.3F, 30.2F, 6.0F);
-    positions.emplace_back(30.8F, 30.2F, 6.0F);
-    positions.emplace_back(31.3F, 30.2F, 6.0F);
+    for (const auto& [dx, dy] :
+         {std::pair{0.0F, 0.0F}, std::pair{0.7F, 0.0F}, std::pair{-0.7F, 0.0F},
+          std::pair{0.0F, 0.7F}, std::pair{0.0F, -0.7F}})
+        positions.push_back(centre + Vec3f(dx, dy, 0.0F));
     EXPECT_TRUE(off_surface_of(positions).empty());
 }
 
