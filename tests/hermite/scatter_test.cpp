@@ -276,15 +276,16 @@ TEST(OffSurface, ASparseFarFaceIsASheet)
         positions.emplace_back(side(random), side(random), 0.1F);
     EXPECT_TRUE(off_surface_of(positions).empty());
     // Strays scattered through the space above it (0.04-0.3, 4-30 spacings of the dense face) do
-    // not lie on a plane: most taken (one with two others among its nearest stays, as a sample of
-    // a face at a crease does). (Strays spread over a wide area within a band much thinner
-    // than their own spacing would: they are kept, as a sparse face is.)
+    // not lie on a plane: all 40 taken here (one with three others of them among its nearest on
+    // one plane with it would stay, as a sample of a face at a crease does). (Strays spread over
+    // a wide area within a band much thinner than their own spacing would: they are kept, as a
+    // sparse face is.)
     std::uniform_real_distribution<float> height(0.04F, 0.3F);
     positions.resize(40000);
     for (int i = 0; i < 40; ++i)
         positions.emplace_back(side(random), side(random), height(random));
     const std::vector<std::uint32_t> found = off_surface_of(positions);
-    EXPECT_GE(found.size(), 30U);
+    EXPECT_GE(found.size(), 38U);
     EXPECT_TRUE(
         std::all_of(found.begin(), found.end(), [](std::uint32_t i) { return i >= 40000; }));
 }
