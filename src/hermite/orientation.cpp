@@ -43,6 +43,14 @@ using detail::WindingSources;
 /// well above 0.3, while open sheets such as terrain or a flat scan score near 0 and keep the
 /// seed's upward orientation.
 constexpr double flux_decision_threshold = 0.1;
+/// A sample's area in the flux (its squared k-th neighbour distance) is at most this many times
+/// the median area: a stray far from the surface has an area hundreds of times a surface
+/// sample's and a normal that says nothing, and a few hundred of them outweighed the surface (a
+/// torus with 1% strays through its box came out inside out, the strays' flux 200 times the
+/// surface's). Uneven sampling within this ratio keeps its areas.
+constexpr double flux_area_cap = 8.0;
+/// The median area is taken over every flux_area_stride-th sample.
+constexpr std::size_t flux_area_stride = 64;
 
 /// Columns of the neighbour table that make the Riemannian graph (OrientationOptions::k).
 std::size_t graph_columns(const OrientationOptions& options, const KnnTable& neighbors)
@@ -907,11 +915,23 @@ void face_components(std::span<const Vec3f> positions, const KnnTable& neighbors
             acc[3] += 1.0;
         },
         [](Eigen::Vector4d& total, const Eigen::Vector4d& part) { total += part; });
+    std::vector<float> sampled;
+    sampled.reserve(n / flux_area_stride + 1);
+    for (std::size_t i = 0; i < n; i += flux_area_stride)
+        sampled.push_back(neighbors.farthest2(i));
+    double largest_area = std::numeric_limits<double>::infinity();
+    if (!sampled.empty())
+    {
+        const auto middle = sampled.begin() + static_cast<std::ptrdiff_t>(sampled.size() / 2);
+        std::nth_element(sampled.begin(), middle, sampled.end());
+        if (std::isfinite(*middle) && *middle > 0.0F)
+            largest_area = flux_area_cap * static_cast<double>(*middle);
+    }
     const std::vector<Eigen::Vector2d> fluxes = reduce_by_component(
         n, component_of, component_count, Eigen::Vector2d::Zero().eval(),
         [&](Eigen::Vector2d& acc, std::size_t i) {
             const Eigen::Vector4d& sum = sums[component_of(i)];
-            const double area = neighbors.farthest2(i);
+            const double area = std::min<double>(neighbors.farthest2(i), largest_area);
             const Vec3d d = positions[i].cast<double>() - sum.head<3>() / sum[3];
             acc[0] += area * normals[i].cast<double>().dot(d);
             acc[1] += area * d.norm();
