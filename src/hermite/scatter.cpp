@@ -330,9 +330,9 @@ std::vector<std::uint32_t> off_surface_samples(std::span<const Vec3f> positions,
                     out.push_back(static_cast<std::uint32_t>(i));
         });
     drop_sheets(positions, found);
-    // Strays among strays: a row holding two or three other strays has them off the surface's
-    // plane beside the sample, as its own face at a crease would be. Each round tests again the
-    // samples whose rows hold samples found so far, without those.
+    // Strays among strays: a row holding three or more other strays on one plane with the sample
+    // has them off the surface's plane beside it, as its own face at a crease would be. Each
+    // round tests again the samples whose rows hold samples found so far, without those.
     std::vector<std::uint8_t> off(found.empty() ? 0 : positions.size(), 0);
     for (std::size_t round = 0; round < off_surface_rounds && !found.empty(); ++round)
     {

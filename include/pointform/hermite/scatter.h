@@ -102,7 +102,8 @@ inline constexpr double off_surface_spacing = 2.0;
 /// on one with it. One or two others off the plane say nothing (three points always lie on a
 /// plane): such a sample is taken as off the surface, a stray beside one or two others, or a
 /// sample of a face seen so sparsely that its own face's samples are one or two of its nearest
-/// (on eleven simulated scans and a cube with strays, taking these too, where two others were
+/// (on eleven simulated scans and a cube with strays, with the samples so found removed before
+/// `reconstruct`, taking these too, where two others were
 /// taken as its own face before, lowered Chamfer on 8: the cube with 5% strays 0.094 -> 0.075% of
 /// the diagonal, Hausdorff 4.1 -> 1.3%, its handle gone; fandisk scan 2 0.913 -> 0.853; raised it
 /// on 3: fandisk scan 1 0.158 -> 0.168).
@@ -116,8 +117,8 @@ inline constexpr std::size_t off_surface_sheet_neighbours = 8;
 inline constexpr double off_surface_sheet = 0.1;
 /// \brief Rounds of off_surface_samples() after the first: each tests again the samples whose
 /// nearest hold samples found so far, with those left out of their nearest (strays among
-/// strays, where two or three others in a row stand off the surface beside the sample as its
-/// own face at a crease would).
+/// strays, where three or more others in a row stand off the surface beside the sample, on one
+/// plane with it, as its own face at a crease would).
 inline constexpr std::size_t off_surface_rounds = 3;
 
 /// \brief The samples that stand off the surface of their nearest (see off_surface_kept and what
