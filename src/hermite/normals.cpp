@@ -35,18 +35,37 @@ struct Moments
 
 Moments moments_of(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices)
 {
+    // The six distinct sums of the outer products (the covariance is symmetric), each taken in
+    // the order of the points: the same sums as p pᵀ in full, at two thirds of the products.
     const Vec3d shift = positions[indices[0]].cast<double>();
-    Vec3d sum = Vec3d::Zero();
-    Mat3d outer = Mat3d::Zero();
+    double sx = 0.0, sy = 0.0, sz = 0.0;
+    double xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0, zz = 0.0;
     for (const auto index : indices)
     {
-        const Vec3d p = positions[index].cast<double>() - shift;
-        sum += p;
-        outer.noalias() += p * p.transpose();
+        const Vec3f& q = positions[index];
+        const double x = static_cast<double>(q.x()) - shift.x();
+        const double y = static_cast<double>(q.y()) - shift.y();
+        const double z = static_cast<double>(q.z()) - shift.z();
+        sx += x;
+        sy += y;
+        sz += z;
+        xx += x * x;
+        xy += x * y;
+        xz += x * z;
+        yy += y * y;
+        yz += y * z;
+        zz += z * z;
     }
     const double count = static_cast<double>(indices.size());
-    const Vec3d mean = sum / count;
-    return {mean + shift, outer / count - mean * mean.transpose()};
+    const Vec3d mean(sx / count, sy / count, sz / count);
+    Mat3d covariance;
+    covariance(0, 0) = xx / count - mean.x() * mean.x();
+    covariance(1, 1) = yy / count - mean.y() * mean.y();
+    covariance(2, 2) = zz / count - mean.z() * mean.z();
+    covariance(0, 1) = covariance(1, 0) = xy / count - mean.x() * mean.y();
+    covariance(0, 2) = covariance(2, 0) = xz / count - mean.x() * mean.z();
+    covariance(1, 2) = covariance(2, 1) = yz / count - mean.y() * mean.z();
+    return {mean + shift, covariance};
 }
 
 /// moments_of() with NeighbourWeights::Local: each point weighted by (1 − d² / far2)³, d its
