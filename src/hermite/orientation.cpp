@@ -1817,6 +1817,18 @@ bool hoppe_trusted(const Vec3f& pa, const Vec3f& na, const Vec3f& pb, const Vec3
                    float reliable, float* reflected = nullptr)
 {
     const float hoppe = na.dot(nb);
+    if (reflected == nullptr)
+    {
+        if (!(std::abs(hoppe) >= reliable))
+            return false;
+        // The reflection rule's agreement is hoppe − 2 (n_a·e)(n_b·e) / |e|²: where the second
+        // term is at most half the first, its sign is Hoppe's whatever the rounding, and the
+        // division is not needed (most edges of a clean cloud lie in both tangent planes).
+        const Vec3f e = pb - pa;
+        const float len2 = e.squaredNorm();
+        if (4.0F * std::abs(na.dot(e) * nb.dot(e)) <= std::abs(hoppe) * len2)
+            return true;
+    }
     const float reflection = agreement_of(pa, na, pb, nb, OrientationRule::Reflection);
     if (reflected != nullptr)
         *reflected = reflection;
