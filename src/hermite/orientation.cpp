@@ -1417,6 +1417,24 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
         if (!progressed.load())
             break;
     }
+    //    A sample that no round reached (every edge of its row jumps between sheets: an outlier
+    //    of the noise off its sheet) kept its own normal, whose side was never set against the
+    //    turned regions: it takes the side that its row's reached samples point to. On 100k
+    //    samples of a cone as wide as high with noise of 0.1% of the diagonal (seed 2), 164
+    //    such samples on its smooth side were left inside out, each a pit in the field.
+    parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            if (stamp[i] != none || !usable(normals[i]))
+                continue;
+            Vec3f sum = Vec3f::Zero();
+            for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                if (j != i && stamp[j] != none)
+                    sum += adopted[j];
+            if (sum.dot(adopted[i]) < 0.0F)
+                adopted[i] = -adopted[i];
+        }
+    });
     normals.swap(adopted);
 }
 
