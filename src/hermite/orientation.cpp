@@ -921,13 +921,9 @@ void face_components(std::span<const Vec3f> positions, const KnnTable& neighbors
     for (std::size_t i = 0; i < n; i += flux_area_stride)
         sampled.push_back(neighbors.farthest2(i));
     double largest_area = std::numeric_limits<double>::infinity();
-    if (!sampled.empty())
-    {
-        const auto middle = sampled.begin() + static_cast<std::ptrdiff_t>(sampled.size() / 2);
-        std::nth_element(sampled.begin(), middle, sampled.end());
-        if (std::isfinite(*middle) && *middle > 0.0F)
-            largest_area = flux_area_cap * static_cast<double>(*middle);
-    }
+    if (const float median = sampled.empty() ? 0.0F : middle_value(sampled);
+        std::isfinite(median) && median > 0.0F)
+        largest_area = flux_area_cap * static_cast<double>(median);
     const std::vector<Eigen::Vector2d> fluxes = reduce_by_component(
         n, component_of, component_count, Eigen::Vector2d::Zero().eval(),
         [&](Eigen::Vector2d& acc, std::size_t i) {

@@ -66,11 +66,6 @@ TEST(SurfelsFromSamples, AStrayPointFarAwayIsLeftOut)
     EXPECT_EQ(surfels_from_samples(clean).isolated, 0U);
 }
 
-// Stray returns near a surface (here 60, 4-8 sample spacings off a sphere: the nearer as near as
-// the reach of a surface sample, so not isolated) are left out, whether the normals are
-// estimated or given, and counted; where they are estimated, the other samples' are made
-// without them: every one within 5° of the sphere's (with the strays among their nearest, the
-// neighbours of a stray tilt by up to tens of degrees).
 TEST(SurfelsFromSamples, StraysThroughTheBoxLeaveTheTorusOutward)
 {
     // `pointform sample torus --strays 0.01` (the bench's strays variant): 1,000 strays through
@@ -97,6 +92,11 @@ TEST(SurfelsFromSamples, StraysThroughTheBoxLeaveTheTorusOutward)
     EXPECT_GT(outward, on - on / 1000) << outward << " of " << on << " face outward";
 }
 
+// Stray returns near a surface (here 60, 4-8 sample spacings off a sphere: the nearer as near as
+// the reach of a surface sample, so not isolated) are left out, whether the normals are
+// estimated or given, and counted; where they are estimated, the other samples' are made
+// without them: every one within 5° of the sphere's (with the strays among their nearest, the
+// neighbours of a stray tilt by up to tens of degrees).
 TEST(SurfelsFromSamples, StraysNearTheSurfaceAreLeftOut)
 {
     PointCloud points = sample_shape(Shape::Sphere, {.count = 20000, .seed = 26});
