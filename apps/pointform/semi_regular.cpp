@@ -102,7 +102,9 @@ void print_refinement(const SemiRegularReport& r)
                                     " regions no sample supports (filled holes and their "
                                     "rims; " +
                                     std::to_string(r.refinement.unsupported.membranes) +
-                                    " as membranes, the rest as thin plates), " +
+                                    " as membranes, the rest as thin plates, " +
+                                    std::to_string(r.refinement.unsupported.creases) +
+                                    " of them out to a crease), " +
                                     std::to_string(r.refinement.unsupported.vertices) +
                                     " vertices; farthest move " +
                                     format_number(r.refinement.unsupported.max_move));

@@ -234,6 +234,7 @@ nlohmann::json report_json(const SemiRegularReport& r, const SemiRegularOptions&
         out["spikes"] = r.refinement.spikes;
         out["unsupported_regions"] = r.refinement.unsupported.regions;
         out["unsupported_membranes"] = r.refinement.unsupported.membranes;
+        out["unsupported_creases"] = r.refinement.unsupported.creases;
         out["unsupported_vertices"] = r.refinement.unsupported.vertices;
         out["unsupported_max_move"] = r.refinement.unsupported.max_move;
     }

@@ -167,10 +167,13 @@ struct RefineOptions
     /// continues the mesh around them (thin-plate fairing, the rest held), or a membrane where
     /// the region's rim is flat and the surface leaves its plane steeply (a face the scanner
     /// never saw, whose creases the mesh rounds; see fill_for_rim() in
-    /// src/polygonize/thin_plate.h), and are relaxed along it with the two rings of held
-    /// vertices around them. Measured on the noisy inputs with holes of
-    /// bench/peers (100k samples) when it came in (with a core of 2.5 and a band of 3 rings
-    /// beyond 1.5 spacings): symmetric Hausdorff to the truth, % of the diagonal, without /
+    /// src/polygonize/thin_plate.h); a thin plate whose rim's normals part into two or three
+    /// nearly flat faces of one kind of crease (a hole over an edge, a plate's rim, a seam) is
+    /// then moved onto where those faces, fitted to the rim and carried across, meet (see
+    /// crease_fill_for_rim() in src/polygonize/crease_fill.h). All are relaxed along their
+    /// surface with the two rings of held vertices around them. Measured on the noisy inputs with
+    /// holes of bench/peers (100k samples) when it came in (with a core of 2.5 and a band of 3
+    /// rings beyond 1.5 spacings): symmetric Hausdorff to the truth, % of the diagonal, without /
     /// with: sphere 0.48 / 0.37, plate 1.22 / 0.75, part 1.35 / 1.17; the shipped bunny scan,
     /// Chamfer to bun_zipper 0.0715 / 0.0651 (0.0490 with today's rule). Done before the
     /// smoothing of denoise_rounds, which smooths the faired vertices across creases.
@@ -200,6 +203,7 @@ struct UnsupportedFairing
 {
     std::size_t regions = 0;   ///< connected regions faired
     std::size_t membranes = 0; ///< of those, the ones faired as a membrane (the rest thin plates)
+    std::size_t creases = 0;   ///< of the thin plates, those moved onto the faces of a crease
     std::size_t vertices = 0;  ///< their vertices
     double max_move = 0.0;     ///< the farthest a vertex moved, world units
 };

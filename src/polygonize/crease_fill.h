@@ -1,0 +1,399 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#pragma once
+
+#include "pointform/core/types.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+namespace pointform::detail {
+
+/// crease_fill_for_rim(): the rim's normals fall into faces when at least this share of them lie
+/// within crease_face_spread of their face's mean normal ...
+constexpr double crease_face_share = 0.75;
+/// ... (30°) ...
+constexpr double crease_face_spread = 0.8660254037844386;
+/// ... every face holds at least this share of the rim's normals (and three of them) ...
+constexpr double crease_least_face_share = 0.05;
+/// ... and the faces' mean normals are at least 40° apart (cos 40°) ...
+constexpr double crease_least_turn = 0.766044443118978;
+/// ... and apart by at least this many times the larger root-mean-square angle of a face's normals
+/// from its mean: a rim on a smooth curved surface (a hole in a sphere) has normals that turn
+/// evenly, and split in two its halves are about twice their own spread apart, while the faces of
+/// a crease are each nearly flat beside it.
+constexpr double crease_turn_over_spread = 3.0;
+/// The pull of a face's curvature terms towards zero, per rim vertex, in the normal equations of
+/// its fit (coordinates in units of the rim's spread): a short arc of rim leaves them loose.
+constexpr double crease_face_stiffness = 1e-3;
+/// A parting into three faces is taken over one into two when it holds at least this share
+/// more of the rim's normals within a face.
+constexpr double crease_third_face_gain = 0.05;
+/// The faces' planes agree on the crease's kind (convex or concave) when the mean of each face's
+/// value at the other faces' rim vertices is beyond this share of the rim's root-mean-square
+/// spread, on the same side for every pair.
+constexpr double crease_kind_margin = 0.05;
+
+/// \brief The faces that meet at a crease across a region that no sample supports (a hole over a
+/// crease, a plate's rim, a cone's acute edge), from the region's rim: the held vertices next to
+/// it, with the held surface's normals there.
+///
+/// Each face is a quadratic height field over its mean plane, fitted to its rim vertices'
+/// heights and slopes (crease_fill_internal::fit_face()) and carried across the region, and the
+/// surface across is where the faces meet: the zero set of max_g f_g at a convex crease (the
+/// solid lies under every face there), of min_g f_g at a concave one. A thin plate, the
+/// smoothest surface that continues the rim, cuts such a crease's corner by about the region's
+/// radius times the turn; the faces meet at it. The slopes make an arc of rim fix a face's
+/// curvature too, so that curved faces (two spheres' seam) keep it across the region where
+/// their planes would sag by about ρ² / 2R (radius ρ, curvature radius R).
+struct CreaseFill
+{
+    /// One face: a height field over the plane through `origin` with normal `axis`,
+    /// h(u, v) = a u² + b uv + c v² + d u + e v + f in units of `scale` (u, v along `tangent`
+    /// and axis × tangent).
+    struct Face
+    {
+        Vec3d origin = Vec3d::Zero();
+        Vec3d axis = Vec3d::UnitZ();
+        Vec3d tangent = Vec3d::UnitX();
+        double scale = 1.0;
+        std::array<double, 6> height{};
+    };
+    std::vector<Face> faces;
+    bool convex = true; ///< the crease's kind: max of the faces' values, else min
+
+    /// Face g's signed height at x: positive outside (along its axis), world units.
+    [[nodiscard]] double face_value(std::size_t g, const Vec3d& x) const
+    {
+        const Face& face = faces[g];
+        const Vec3d d = (x - face.origin) / face.scale;
+        const double u = d.dot(face.tangent);
+        const double v = d.dot(face.axis.cross(face.tangent));
+        const auto& c = face.height;
+        const double h = c[0] * u * u + c[1] * u * v + c[2] * v * v + c[3] * u + c[4] * v + c[5];
+        return (d.dot(face.axis) - h) * face.scale;
+    }
+
+    /// The envelope of the faces at x: its zero set is the surface across the region.
+    [[nodiscard]] double value(const Vec3d& x) const
+    {
+        double out = face_value(0, x);
+        for (std::size_t g = 1; g < faces.size(); ++g)
+            out = convex ? std::max(out, face_value(g, x)) : std::min(out, face_value(g, x));
+        return out;
+    }
+};
+
+namespace crease_fill_internal {
+
+inline double angle_of(double cosine)
+{
+    return std::acos(std::clamp(cosine, -1.0, 1.0));
+}
+
+/// Spherical k-means of unit vectors into `k` groups from farthest-point seeds after unit[first]:
+/// the group of each vector and the groups' unit means; nothing when a group is left empty.
+inline std::optional<std::pair<std::vector<std::uint8_t>, std::vector<Vec3d>>> group_directions(
+    std::span<const Vec3d> unit, std::size_t k, std::size_t first)
+{
+    const std::size_t n = unit.size();
+    std::vector<Vec3d> mean;
+    std::vector<double> nearest(n, 2.0);
+    std::size_t pick = first;
+    while (mean.size() < k)
+    {
+        mean.push_back(unit[pick]);
+        for (std::size_t i = 0; i < n; ++i)
+            nearest[i] = std::min(nearest[i], 1.0 - unit[i].dot(unit[pick]));
+        pick = static_cast<std::size_t>(std::max_element(nearest.begin(), nearest.end()) -
+                                        nearest.begin());
+    }
+    std::vector<std::uint8_t> group(n, 0);
+    for (int round = 0; round < 16; ++round)
+    {
+        bool moved = false;
+        for (std::size_t i = 0; i < n; ++i)
+        {
+            std::uint8_t best = 0;
+            for (std::size_t g = 1; g < k; ++g)
+                if (unit[i].dot(mean[g]) > unit[i].dot(mean[best]))
+                    best = static_cast<std::uint8_t>(g);
+            moved = moved || best != group[i];
+            group[i] = best;
+        }
+        std::vector<Vec3d> sum(k, Vec3d::Zero());
+        for (std::size_t i = 0; i < n; ++i)
+            sum[group[i]] += unit[i];
+        for (std::size_t g = 0; g < k; ++g)
+        {
+            const double length = sum[g].norm();
+            if (!(length > 0.0))
+                return std::nullopt;
+            mean[g] = sum[g] / length;
+        }
+        if (!moved && round > 0)
+            break;
+    }
+    return std::pair{std::move(group), std::move(mean)};
+}
+
+/// The number of unit vectors within crease_face_spread of their group's mean.
+inline std::size_t count_within(std::span<const Vec3d> unit, std::span<const std::uint8_t> group,
+                                std::span<const Vec3d> mean)
+{
+    std::size_t within = 0;
+    for (std::size_t i = 0; i < unit.size(); ++i)
+        within += unit[i].dot(mean[group[i]]) >= crease_face_spread ? 1U : 0U;
+    return within;
+}
+
+/// group_directions() from several first seeds (the direction farthest from the mean, the two
+/// ends of the directions' widest spread, and three spread over the list), the grouping that
+/// holds the most directions within crease_face_spread of their group's mean (the first of
+/// equals): one start can settle on a few outlying normals against all the rest.
+inline std::optional<std::pair<std::vector<std::uint8_t>, std::vector<Vec3d>>> best_grouping(
+    std::span<const Vec3d> unit, std::size_t k)
+{
+    const std::size_t n = unit.size();
+    Vec3d all = Vec3d::Zero();
+    for (const Vec3d& u : unit)
+        all += u;
+    const Vec3d centre = all / static_cast<double>(n);
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    for (const Vec3d& u : unit)
+        scatter += (u - centre) * (u - centre).transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+    const Vec3d widest = eigen.eigenvectors().col(2);
+    std::array<std::size_t, 6> firsts{0, 0, 0, 0, n / 3, 2 * n / 3};
+    for (std::size_t i = 1; i < n; ++i)
+    {
+        if (unit[i].dot(all) < unit[firsts[0]].dot(all))
+            firsts[0] = i;
+        if (unit[i].dot(widest) < unit[firsts[1]].dot(widest))
+            firsts[1] = i;
+        if (unit[i].dot(widest) > unit[firsts[2]].dot(widest))
+            firsts[2] = i;
+    }
+    std::optional<std::pair<std::vector<std::uint8_t>, std::vector<Vec3d>>> best;
+    std::size_t best_within = 0;
+    for (const std::size_t first : firsts)
+    {
+        auto grouped = group_directions(unit, k, first);
+        if (!grouped)
+            continue;
+        const std::size_t within = count_within(unit, grouped->first, grouped->second);
+        if (!best || within > best_within)
+        {
+            best = std::move(grouped);
+            best_within = within;
+        }
+    }
+    return best;
+}
+
+/// Least-squares height field of one face (CreaseFill::Face) through its rim vertices `at` with
+/// their unit `normals`: each vertex's height and, where the face is not steep there, its two
+/// slopes, so that an arc of a rim fixes the face's curvature across the region too. The
+/// curvature terms are pulled slightly towards zero (a short arc leaves them loose).
+inline std::optional<CreaseFill::Face> fit_face(std::span<const Vec3d> at,
+                                                std::span<const Vec3d> normals, const Vec3d& axis,
+                                                double scale)
+{
+    CreaseFill::Face face;
+    face.axis = axis;
+    face.scale = scale;
+    for (const Vec3d& p : at)
+        face.origin += p;
+    face.origin /= static_cast<double>(at.size());
+    face.tangent =
+        (std::abs(axis.x()) < 0.9 ? Vec3d::UnitX() : Vec3d::UnitY()).cross(axis).normalized();
+    const Vec3d bitangent = axis.cross(face.tangent);
+    Eigen::Matrix<double, 6, 6> normal_matrix = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> right = Eigen::Matrix<double, 6, 1>::Zero();
+    const auto add = [&](const Eigen::Matrix<double, 6, 1>& row, double value) {
+        normal_matrix += row * row.transpose();
+        right += row * value;
+    };
+    for (std::size_t j = 0; j < at.size(); ++j)
+    {
+        const Vec3d d = (at[j] - face.origin) / scale;
+        const double u = d.dot(face.tangent);
+        const double v = d.dot(bitangent);
+        add((Eigen::Matrix<double, 6, 1>() << u * u, u * v, v * v, u, v, 1.0).finished(),
+            d.dot(axis));
+        const double up = normals[j].dot(axis);
+        if (up < crease_face_spread)
+            continue;
+        // ∂h/∂u = −n_u / n_h and ∂h/∂v = −n_v / n_h.
+        add((Eigen::Matrix<double, 6, 1>() << 2.0 * u, v, 0.0, 1.0, 0.0, 0.0).finished(),
+            -normals[j].dot(face.tangent) / up);
+        add((Eigen::Matrix<double, 6, 1>() << 0.0, u, 2.0 * v, 0.0, 1.0, 0.0).finished(),
+            -normals[j].dot(bitangent) / up);
+    }
+    for (int c = 0; c < 3; ++c)
+        normal_matrix(c, c) += crease_face_stiffness * static_cast<double>(at.size());
+    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(normal_matrix);
+    if (solver.info() != Eigen::Success)
+        return std::nullopt;
+    const Eigen::Matrix<double, 6, 1> x = solver.solve(right);
+    if (!x.allFinite())
+        return std::nullopt;
+    for (int c = 0; c < 6; ++c)
+        face.height[static_cast<std::size_t>(c)] = x(c);
+    return face;
+}
+
+} // namespace crease_fill_internal
+
+/// \brief The crease fill of a region from its rim (see CreaseFill), or nothing when the rim's
+/// normals do not part into two or three nearly flat faces that meet at one kind of crease (a
+/// smooth rim, whose region the thin plate fills). `rim` and `rim_normals` as fill_for_rim()'s.
+[[nodiscard]] inline std::optional<CreaseFill> crease_fill_for_rim(
+    std::span<const Vec3d> rim, std::span<const Vec3d> rim_normals)
+{
+    using crease_fill_internal::angle_of;
+    if (rim.size() < 8 || rim_normals.size() != rim.size())
+        return std::nullopt;
+    std::vector<Vec3d> at;
+    std::vector<Vec3d> unit;
+    for (std::size_t i = 0; i < rim.size(); ++i)
+    {
+        const double length = rim_normals[i].norm();
+        if (length > 0.0 && std::isfinite(length) && rim[i].allFinite())
+        {
+            at.push_back(rim[i]);
+            unit.push_back(rim_normals[i] / length);
+        }
+    }
+    const std::size_t n = unit.size();
+    if (n < 8)
+        return std::nullopt;
+    // The rim parted into k faces, for k = 2 and 3: k = 3 where both do and it holds clearly
+    // more of the normals within a face (a plate's rim: its two faces and the side between).
+    struct Parting
+    {
+        std::vector<std::uint8_t> group;
+        std::vector<Vec3d> mean;
+        std::size_t within = 0;
+    };
+    // The fill of a parting: each face fitted to its own rim vertices, and the crease's kind.
+    const auto fill_of = [&](const Parting& chosen) -> std::optional<CreaseFill> {
+        const std::size_t k = chosen.mean.size();
+        CreaseFill fill;
+        Vec3d centre = Vec3d::Zero();
+        for (const Vec3d& p : at)
+            centre += p;
+        centre /= static_cast<double>(n);
+        double spread_squared = 0.0;
+        for (const Vec3d& p : at)
+            spread_squared += (p - centre).squaredNorm();
+        const double rim_spread = std::sqrt(spread_squared / static_cast<double>(n));
+        if (!(rim_spread > 0.0))
+            return std::nullopt;
+        // Each face from its own rim vertices: those outside every face's spread (the crease's own,
+        // whose normals are a blend of the faces') are left out.
+        std::vector<std::vector<Vec3d>> face_at(k);
+        std::vector<std::vector<Vec3d>> face_normals(k);
+        for (std::size_t i = 0; i < n; ++i)
+            if (unit[i].dot(chosen.mean[chosen.group[i]]) >= crease_face_spread)
+            {
+                face_at[chosen.group[i]].push_back(at[i]);
+                face_normals[chosen.group[i]].push_back(unit[i]);
+            }
+        for (std::size_t g = 0; g < k; ++g)
+        {
+            std::optional<CreaseFill::Face> face = crease_fill_internal::fit_face(
+                face_at[g], face_normals[g], chosen.mean[g], rim_spread);
+            if (!face)
+                return std::nullopt;
+            fill.faces.push_back(*face);
+        }
+        // The crease's kind from every pair of faces: each face's value at the other's vertices.
+        int convex = 0;
+        int concave = 0;
+        for (std::size_t a = 0; a < k; ++a)
+            for (std::size_t b = 0; b < k; ++b)
+            {
+                if (a == b)
+                    continue;
+                double sum = 0.0;
+                for (const Vec3d& p : face_at[b])
+                    sum += fill.face_value(a, p);
+                const double mean_value = sum / static_cast<double>(face_at[b].size());
+                convex += mean_value < -crease_kind_margin * rim_spread ? 1 : 0;
+                concave += mean_value > crease_kind_margin * rim_spread ? 1 : 0;
+            }
+        const auto pairs = static_cast<int>(k * (k - 1));
+        if (convex != pairs && concave != pairs)
+            return std::nullopt;
+        fill.convex = convex == pairs;
+        return fill;
+    };
+    std::optional<CreaseFill> chosen;
+    std::size_t chosen_within = 0;
+    for (std::size_t k = 2; k <= 3; ++k)
+    {
+        auto grouped = crease_fill_internal::best_grouping(unit, k);
+        if (!grouped)
+            continue;
+        Parting parting{std::move(grouped->first), std::move(grouped->second), 0};
+        const auto& group = parting.group;
+        const auto& mean = parting.mean;
+        // A face's spread over its own normals: the crease's blended ones (outside every
+        // face's crease_face_spread) left out.
+        std::vector<std::size_t> size(k, 0);
+        std::vector<std::size_t> own(k, 0);
+        std::vector<double> squared(k, 0.0);
+        for (std::size_t i = 0; i < n; ++i)
+        {
+            const double cosine = unit[i].dot(mean[group[i]]);
+            ++size[group[i]];
+            if (cosine >= crease_face_spread)
+            {
+                ++own[group[i]];
+                squared[group[i]] += angle_of(cosine) * angle_of(cosine);
+            }
+        }
+        for (std::size_t g = 0; g < k; ++g)
+            parting.within += own[g];
+        bool ok = static_cast<double>(parting.within) >= crease_face_share * static_cast<double>(n);
+        double spread = 0.0;
+        for (std::size_t g = 0; g < k; ++g)
+        {
+            ok = ok && own[g] >= 3 &&
+                 static_cast<double>(size[g]) >= crease_least_face_share * static_cast<double>(n);
+            if (own[g] > 0)
+                spread = std::max(spread, std::sqrt(squared[g] / static_cast<double>(own[g])));
+        }
+        for (std::size_t a = 0; a < k; ++a)
+            for (std::size_t b = a + 1; b < k; ++b)
+            {
+                const double cosine = mean[a].dot(mean[b]);
+                ok = ok && cosine <= crease_least_turn &&
+                     angle_of(cosine) >= crease_turn_over_spread * spread;
+            }
+        if (!ok)
+            continue;
+        std::optional<CreaseFill> fill = fill_of(parting);
+        if (fill && (!chosen || static_cast<double>(parting.within) >=
+                                    static_cast<double>(chosen_within) +
+                                        crease_third_face_gain * static_cast<double>(n)))
+        {
+            chosen = std::move(fill);
+            chosen_within = parting.within;
+        }
+    }
+    return chosen;
+}
+
+} // namespace pointform::detail
