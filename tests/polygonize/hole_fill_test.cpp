@@ -645,36 +645,37 @@ Rim edge_rim(bool concave)
     return rim;
 }
 
-TEST(CreaseFill, TheFacesOfAConvexEdgeMeetAtIt)
+TEST(CreaseFill, TheFacesOfAnEdgeMeetAtIt)
 {
-    const Rim rim = edge_rim(false);
-    const std::optional<detail::CreaseFill> fill = detail::crease_fill_for_rim(rim.at, rim.normals);
-    ASSERT_TRUE(fill.has_value());
-    EXPECT_EQ(fill->faces.size(), 2U);
-    EXPECT_TRUE(fill->convex);
-    // On the edge across the hole, both faces: zero. A thin plate would cut the corner.
-    for (double y = -0.9; y <= 0.9; y += 0.1)
-        EXPECT_NEAR(fill->value({0.0, y, 0.0}), 0.0, 1e-6) << y;
-    // On either face inside the hole, zero; inside the box below, the nearer face's distance;
-    // outside, positive.
-    EXPECT_NEAR(fill->value({-0.5, 0.2, 0.0}), 0.0, 1e-6);
-    EXPECT_NEAR(fill->value({0.0, 0.2, -0.5}), 0.0, 1e-6);
-    EXPECT_NEAR(fill->value({-0.2, 0.0, -0.3}), -0.2, 1e-6);
-    EXPECT_GT(fill->value({0.1, 0.0, 0.05}), 0.0);
-}
-
-TEST(CreaseFill, TheFacesOfAValleyMeetAtItsFloor)
-{
-    const Rim rim = edge_rim(true);
-    const std::optional<detail::CreaseFill> fill = detail::crease_fill_for_rim(rim.at, rim.normals);
-    ASSERT_TRUE(fill.has_value());
-    EXPECT_EQ(fill->faces.size(), 2U);
-    EXPECT_FALSE(fill->convex);
-    for (double y = -0.9; y <= 0.9; y += 0.1)
-        EXPECT_NEAR(fill->value({0.0, y, 0.0}), 0.0, 1e-6) << y;
-    // In the air over the valley: outside, by the nearer face's distance.
-    EXPECT_NEAR(fill->value({-0.3, 0.0, 0.2}), 0.2, 1e-6);
-    EXPECT_LT(fill->value({0.1, 0.0, -0.1}), 0.0);
+    for (const bool concave : {false, true})
+    {
+        const Rim rim = edge_rim(concave);
+        const std::optional<detail::CreaseFill> fill =
+            detail::crease_fill_for_rim(rim.at, rim.normals);
+        ASSERT_TRUE(fill.has_value()) << concave;
+        EXPECT_EQ(fill->faces.size(), 2U);
+        EXPECT_EQ(fill->convex, !concave);
+        // On the edge across the hole, both faces: zero. A thin plate would cut the corner.
+        for (double y = -0.9; y <= 0.9; y += 0.1)
+            EXPECT_NEAR(fill->value({0.0, y, 0.0}), 0.0, 1e-6) << y;
+        // On the face z = 0 inside the hole, zero.
+        EXPECT_NEAR(fill->value({-0.5, 0.2, 0.0}), 0.0, 1e-6);
+        if (!concave)
+        {
+            // On the wall, zero; inside the box below the edge, the nearer face's distance;
+            // outside, positive.
+            EXPECT_NEAR(fill->value({0.0, 0.2, -0.5}), 0.0, 1e-6);
+            EXPECT_NEAR(fill->value({-0.2, 0.0, -0.3}), -0.2, 1e-6);
+            EXPECT_GT(fill->value({0.1, 0.0, 0.05}), 0.0);
+        }
+        else
+        {
+            // In the air over the valley: outside, by the nearer face's distance; under its
+            // floor, inside.
+            EXPECT_NEAR(fill->value({-0.3, 0.0, 0.2}), 0.2, 1e-6);
+            EXPECT_LT(fill->value({0.1, 0.0, -0.1}), 0.0);
+        }
+    }
 }
 
 TEST(CreaseFill, CurvedFacesKeepTheirCurvatureAcrossTheHole)
