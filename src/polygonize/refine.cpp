@@ -1233,6 +1233,15 @@ std::size_t onto_crease_faces(std::span<Vec3d> x, std::span<const Vec3d> normal,
     const std::size_t count = region.members.size();
     if (count == 0 || region.fill.faces.empty())
         return 0;
+    Vec3d centre = Vec3d::Zero();
+    for (const Vec3d& r : region.rim)
+        centre += r;
+    centre /= static_cast<double>(std::max<std::size_t>(region.rim.size(), 1));
+    double rim_spread = 0.0;
+    for (const Vec3d& r : region.rim)
+        rim_spread += (r - centre).squaredNorm();
+    rim_spread =
+        std::sqrt(rim_spread / static_cast<double>(std::max<std::size_t>(region.rim.size(), 1)));
     std::vector<Vec3d> moved(count);
     parallel_blocks(count, 64, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
@@ -1247,7 +1256,7 @@ std::size_t onto_crease_faces(std::span<Vec3d> x, std::span<const Vec3d> normal,
             double reach = std::numeric_limits<double>::infinity();
             for (const Vec3d& r : region.rim)
                 reach = std::min(reach, (r - start).squaredNorm());
-            reach = std::sqrt(reach);
+            reach = std::max(std::sqrt(reach), rim_spread);
             const auto value = [&](double t) {
                 return region.fill.value(start + t * along);
             };
@@ -1296,9 +1305,14 @@ std::size_t onto_crease_faces(std::span<Vec3d> x, std::span<const Vec3d> normal,
 }
 
 /// Moves the faired regions' vertices along the faired surface's normals onto the zero set of
-/// their crease fills (detail::CreaseFill), each at most as far as its region's nearest rim
-/// vertex (the nearest zero crossing found by steps of a sixteenth of that, then bisected): the
-/// thin plate rounds the crease off, the faces meet at it. Returns how many regions moved.
+/// their crease fills (detail::CreaseFill), each at most as far as the farther of its nearest rim
+/// vertex and the rim's root-mean-square spread about its centroid (the nearest zero crossing
+/// found by steps of a sixteenth of that, then bisected): the thin plate rounds the crease off,
+/// the faces meet at it. Bounded by the nearest rim vertex alone, the middle of a hole over a
+/// plate's edge (0.05 thick, the hole 0.22 wide) could not reach the side wall, 0.065 out and
+/// its top and bottom rims 0.04-0.05 away: the 1M noisy plate's rim holes 1.83 / 1.67 / 1.54 /
+/// 0.67% of the diagonal from the truth, with the spread 0.60 / 0.99 / 0.48 / 0.48. Returns how
+/// many regions moved.
 std::size_t onto_crease_faces(std::span<Vec3d> x, std::span<const Triangle> faces,
                               std::span<const CreasedRegion> regions)
 {
