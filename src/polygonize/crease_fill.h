@@ -84,6 +84,23 @@ struct CreaseFill
         return (d.dot(face.axis) - h) * face.scale;
     }
 
+    /// The face whose value is the envelope's at x (the first of equals).
+    [[nodiscard]] std::size_t active_face(const Vec3d& x) const
+    {
+        std::size_t active = 0;
+        double best = face_value(0, x);
+        for (std::size_t g = 1; g < faces.size(); ++g)
+        {
+            const double v = face_value(g, x);
+            if (convex ? v > best : v < best)
+            {
+                best = v;
+                active = g;
+            }
+        }
+        return active;
+    }
+
     /// The envelope of the faces at x: its zero set is the surface across the region.
     [[nodiscard]] double value(const Vec3d& x) const
     {

@@ -1222,6 +1222,16 @@ struct CreasedRegion
 /// the holes over the noisy 100k cone's rim reach 8.8 to 12.1.
 constexpr double crease_fill_depth = 5.0;
 
+/// onto_crease_faces() moves a vertex farther than its nearest rim vertex only when the face it
+/// meets there faces the move within 60°, or when it lands on the crease (the other faces' value
+/// there within this share of the move): on the 1M noisy plate of bench/peers, vertices in a
+/// hole over the plate's edge (its rim parted into the top and bottom faces alone) slid 0.05
+/// out past the edge along their normals to meet the bottom face (Hausdorff distance 1.82% of
+/// the diagonal), while over the acute rim of a cone the faces meet at 67° from the thin
+/// plate's normal there.
+constexpr double crease_far_move_alignment = 0.5;
+constexpr double crease_far_move_gap = 0.25;
+
 /// Steps of onto_crease_faces()'s search for the faces' envelope along a vertex's normal, each way.
 constexpr int crease_search_steps = 16;
 
@@ -1253,10 +1263,11 @@ std::size_t onto_crease_faces(std::span<Vec3d> x, std::span<const Vec3d> normal,
             if (!(length > 0.0) || !std::isfinite(length))
                 continue;
             const Vec3d along = n / length;
-            double reach = std::numeric_limits<double>::infinity();
+            double near = std::numeric_limits<double>::infinity();
             for (const Vec3d& r : region.rim)
-                reach = std::min(reach, (r - start).squaredNorm());
-            reach = std::max(std::sqrt(reach), rim_spread);
+                near = std::min(near, (r - start).squaredNorm());
+            near = std::sqrt(near);
+            const double reach = std::max(near, rim_spread);
             const auto value = [&](double t) {
                 return region.fill.value(start + t * along);
             };
@@ -1292,7 +1303,34 @@ std::size_t onto_crease_faces(std::span<Vec3d> x, std::span<const Vec3d> normal,
                 else
                     outer = middle;
             }
-            moved[i] = start + 0.5 * (inner + outer) * along;
+            const double t = 0.5 * (inner + outer);
+            // Past the nearest rim vertex only towards the face met, or onto the crease itself
+            // (the other faces there within a quarter of the move of it): a vertex whose
+            // normal runs along a face (the middle of a hole over a plate's edge, between its
+            // top and bottom faces) would slide out to where that face is met far off.
+            if (std::abs(t) > near)
+            {
+                const Vec3d end_point = start + t * along;
+                const std::size_t met = region.fill.active_face(end_point);
+                double runner_up = 0.0;
+                bool first = true;
+                for (std::size_t g = 0; g < region.fill.faces.size(); ++g)
+                {
+                    if (g == met)
+                        continue;
+                    const double v = region.fill.face_value(g, end_point);
+                    runner_up = first                ? v
+                                : region.fill.convex ? std::max(runner_up, v)
+                                                     : std::min(runner_up, v);
+                    first = false;
+                }
+                const bool facing =
+                    std::abs(region.fill.faces[met].axis.dot(along)) >= crease_far_move_alignment;
+                const bool on_crease = std::abs(runner_up) <= crease_far_move_gap * std::abs(t);
+                if (!facing && !on_crease)
+                    continue;
+            }
+            moved[i] = start + t * along;
         }
     });
     std::size_t changed = 0;
