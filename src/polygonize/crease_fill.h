@@ -84,6 +84,22 @@ struct CreaseFill
         return (d.dot(face.axis) - h) * face.scale;
     }
 
+    /// The envelope of the faces but `skipped` at x (of every face when `skipped` is none).
+    [[nodiscard]] double envelope(const Vec3d& x, std::size_t skipped) const
+    {
+        double out = 0.0;
+        bool first = true;
+        for (std::size_t g = 0; g < faces.size(); ++g)
+        {
+            if (g == skipped)
+                continue;
+            const double v = face_value(g, x);
+            out = first ? v : convex ? std::max(out, v) : std::min(out, v);
+            first = false;
+        }
+        return out;
+    }
+
     /// The face whose value is the envelope's at x (the first of equals).
     [[nodiscard]] std::size_t active_face(const Vec3d& x) const
     {
@@ -102,13 +118,7 @@ struct CreaseFill
     }
 
     /// The envelope of the faces at x: its zero set is the surface across the region.
-    [[nodiscard]] double value(const Vec3d& x) const
-    {
-        double out = face_value(0, x);
-        for (std::size_t g = 1; g < faces.size(); ++g)
-            out = convex ? std::max(out, face_value(g, x)) : std::min(out, face_value(g, x));
-        return out;
-    }
+    [[nodiscard]] double value(const Vec3d& x) const { return envelope(x, faces.size()); }
 };
 
 namespace crease_fill_internal {
@@ -116,6 +126,21 @@ namespace crease_fill_internal {
 inline double angle_of(double cosine)
 {
     return std::acos(std::clamp(cosine, -1.0, 1.0));
+}
+
+/// The root-mean-square distance of points from their centroid (0 for none).
+inline double rms_spread(std::span<const Vec3d> points)
+{
+    if (points.empty())
+        return 0.0;
+    Vec3d centre = Vec3d::Zero();
+    for (const Vec3d& p : points)
+        centre += p;
+    centre /= static_cast<double>(points.size());
+    double squared = 0.0;
+    for (const Vec3d& p : points)
+        squared += (p - centre).squaredNorm();
+    return std::sqrt(squared / static_cast<double>(points.size()));
 }
 
 /// Spherical k-means of unit vectors into `k` groups from farthest-point seeds after unit[first]:
@@ -303,20 +328,13 @@ inline std::optional<CreaseFill::Face> fit_face(std::span<const Vec3d> at,
         std::vector<Vec3d> mean;
         std::size_t within = 0;
     };
+    const double rim_spread = crease_fill_internal::rms_spread(at);
+    if (!(rim_spread > 0.0))
+        return std::nullopt;
     // The fill of a parting: each face fitted to its own rim vertices, and the crease's kind.
     const auto fill_of = [&](const Parting& chosen) -> std::optional<CreaseFill> {
         const std::size_t k = chosen.mean.size();
         CreaseFill fill;
-        Vec3d centre = Vec3d::Zero();
-        for (const Vec3d& p : at)
-            centre += p;
-        centre /= static_cast<double>(n);
-        double spread_squared = 0.0;
-        for (const Vec3d& p : at)
-            spread_squared += (p - centre).squaredNorm();
-        const double rim_spread = std::sqrt(spread_squared / static_cast<double>(n));
-        if (!(rim_spread > 0.0))
-            return std::nullopt;
         // Each face from its own rim vertices: those outside every face's spread (the crease's own,
         // whose normals are a blend of the faces') are left out.
         std::vector<std::vector<Vec3d>> face_at(k);

@@ -1243,15 +1243,7 @@ std::size_t onto_crease_faces(std::span<Vec3d> x, std::span<const Vec3d> normal,
     const std::size_t count = region.members.size();
     if (count == 0 || region.fill.faces.empty())
         return 0;
-    Vec3d centre = Vec3d::Zero();
-    for (const Vec3d& r : region.rim)
-        centre += r;
-    centre /= static_cast<double>(std::max<std::size_t>(region.rim.size(), 1));
-    double rim_spread = 0.0;
-    for (const Vec3d& r : region.rim)
-        rim_spread += (r - centre).squaredNorm();
-    rim_spread =
-        std::sqrt(rim_spread / static_cast<double>(std::max<std::size_t>(region.rim.size(), 1)));
+    const double rim_spread = detail::crease_fill_internal::rms_spread(region.rim);
     std::vector<Vec3d> moved(count);
     parallel_blocks(count, 64, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
@@ -1312,18 +1304,7 @@ std::size_t onto_crease_faces(std::span<Vec3d> x, std::span<const Vec3d> normal,
             {
                 const Vec3d end_point = start + t * along;
                 const std::size_t met = region.fill.active_face(end_point);
-                double runner_up = 0.0;
-                bool first = true;
-                for (std::size_t g = 0; g < region.fill.faces.size(); ++g)
-                {
-                    if (g == met)
-                        continue;
-                    const double v = region.fill.face_value(g, end_point);
-                    runner_up = first                ? v
-                                : region.fill.convex ? std::max(runner_up, v)
-                                                     : std::min(runner_up, v);
-                    first = false;
-                }
+                const double runner_up = region.fill.envelope(end_point, met);
                 const bool facing =
                     std::abs(region.fill.faces[met].axis.dot(along)) >= crease_far_move_alignment;
                 const bool on_crease = std::abs(runner_up) <= crease_far_move_gap * std::abs(t);
