@@ -267,6 +267,11 @@ void add_refine_options(CLI::App& cmd, SemiRegularCommandOptions& options)
                  "Keep the finest level as projected where no sample supports it (filled holes "
                  "and their rims) instead of fairing it to the smoothest surface that continues "
                  "the mesh around it");
+    cmd.add_flag("!--no-face-fit", options.semi_regular.fit_faces,
+                 "Keep the finest level's vertices on the field (the paper's interpolating "
+                 "level) instead of fitting its flat faces to the field in the least-squares "
+                 "sense (which takes out their sag inside curved parts; not done where the "
+                 "level was smoothed for noise)");
     cmd.add_flag("--ascii", options.ascii, "Write ascii PLY instead of binary");
     cmd.add_flag("--json", options.json, "Print the report as JSON");
 }

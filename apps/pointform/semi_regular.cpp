@@ -93,6 +93,17 @@ void print_refinement(const SemiRegularReport& r)
                                       " rounds of Taubin smoothing of the finest level (its "
                                       "details were noise); farthest move " +
                                       format_number(r.refinement.denoise_max_move));
+        if (r.refinement.face_fit_vertices > 0)
+            print_row("face fit", std::to_string(r.refinement.face_fit_vertices) +
+                                      " vertices moved along their normals so that the faces "
+                                      "fit the field in the least-squares sense; median move " +
+                                      format_number(r.refinement.face_fit_median_move) +
+                                      ", farthest " +
+                                      format_number(r.refinement.face_fit_max_move));
+        else if (r.refinement.face_fit_median_move > 0.0)
+            print_row("face fit", "none: the median move " +
+                                      format_number(r.refinement.face_fit_median_move) +
+                                      " is below a quarter of the field residual (noise)");
         if (r.refinement.spikes > 0)
             print_row("spikes", std::to_string(r.refinement.spikes) +
                                     " vertices that stood off their neighbours' surface alone, "

@@ -283,7 +283,7 @@ void bind_polygonize(py::module_& m)
            const std::optional<std::filesystem::path>& base_mesh, const py::object& base_triangles,
            long long k, double radius_scale, const std::string& predictor, int relax_iterations,
            const std::string& relaxation, double fill_holes, double rim_reach,
-           long long denoise_rounds, bool hole_fairing, double max_handle) {
+           long long denoise_rounds, bool hole_fairing, double max_handle, bool face_fit) {
             ReconstructOptions options;
             options.fill_holes = fill_holes; // checked by the base mesh
             options.max_handle = max_handle; // checked by reconstruct()
@@ -292,6 +292,7 @@ void bind_polygonize(py::module_& m)
                 semi_regular_options(levels, base_faces, stop_rule, predictor, relax_iterations,
                                      relaxation, denoise_rounds);
             options.semi_regular.fair_unsupported = hole_fairing;
+            options.semi_regular.fit_faces = face_fit;
             options.fit = parse_plane_fit(fit);
             if (resolution != 0 && resolution < 2)
                 throw InvalidInput("resolution must be at least 2 (or 0 = automatic), got " +
@@ -349,12 +350,12 @@ void bind_polygonize(py::module_& m)
         py::arg("rim_reach") = ReconstructOptions{}.rim_reach,
         py::arg("denoise_rounds") = static_cast<long long>(RefineOptions{}.denoise_rounds),
         py::arg("hole_fairing") = RefineOptions{}.fair_unsupported,
-        py::arg("max_handle") = default_max_handle,
+        py::arg("max_handle") = default_max_handle, py::arg("face_fit") = RefineOptions{}.fit_faces,
         "reconstruct(cloud, *, levels=None, base_faces=None, stop_rule='auto', fit='quadric', "
         "resolution=0, cell=0.0, min_component_samples=None, base_mesh=None, base_triangles=None, "
         "k=16, "
         "radius_scale=1.5, predictor=..., relax_iterations=..., relaxation=..., fill_holes=0.05, "
-        "rim_reach=0.25, denoise_rounds=10, hole_fairing=True, max_handle=6.0) "
+        "rim_reach=0.25, denoise_rounds=10, hole_fairing=True, max_handle=6.0, face_fit=True) "
         "-> Hierarchy\n\n"
         "Points to a semi-regular multiresolution mesh (paper §5), as `pointform reconstruct` "
         "does, with the same defaults and the same result: surfels (pointform.surfels() with "
@@ -371,7 +372,9 @@ void bind_polygonize(py::module_& m)
         "`levels` (0-8), or until stop_rule says so ('auto' or 'paper'); a level where 'auto' "
         "stops on noise is smoothed by denoise_rounds rounds of Taubin's smoothing (0 = none), "
         "and with 'auto' the regions no sample supports (filled holes and their rims) are "
-        "faired unless hole_fairing=False (`--no-hole-fairing`). "
+        "faired unless hole_fairing=False (`--no-hole-fairing`); a finest level not smoothed has "
+        "its faces fitted to the field in the least-squares sense unless face_fit=False "
+        "(`--no-face-fit`). "
         "Raises InvalidInput "
         "for bad points or options, or work that would not fit in memory.");
 

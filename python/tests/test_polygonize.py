@@ -284,6 +284,34 @@ def test_holes_are_faired_as_the_cli_does(tmp_path):
         assert mine.read_bytes() == out.read_bytes()
 
 
+def test_faces_are_fitted_as_the_cli_does(tmp_path):
+    # A clean sphere's finest level has its faces fitted to the field (face_fit,
+    # `--no-face-fit`): the same bytes and report as the CLI either way; fitted, its own vertices
+    # lie outside the sphere (the faces' sag taken out), the coarser levels' on it.
+    points = tmp_path / "clean.ply"
+    run_cli("sample", "sphere", "-n", 20000, "--seed", 3, "-o", points)
+    cloud = pointform.read_points(points)
+    moved = {}
+    for fit in (True, False):
+        hierarchy = pointform.reconstruct(cloud, face_fit=fit)
+        out = tmp_path / f"cli{fit}.pfh"
+        cli_report = run_cli("reconstruct", points, "-o", tmp_path / "cli.ply", "--save-hierarchy",
+                             out, "--json", *([] if fit else ["--no-face-fit"]),
+                             json_output=True)
+        for key in ("face_fit_vertices", "face_fit_max_move", "face_fit_median_move"):
+            assert cli_report[key] == hierarchy.report[key]
+        assert (hierarchy.report["face_fit_vertices"] > 0) == fit
+        mine = tmp_path / f"py{fit}.pfh"
+        hierarchy.save(mine)
+        assert mine.read_bytes() == out.read_bytes()
+        finest = np.linalg.norm(hierarchy.level_mesh(-1).world(), axis=1)
+        coarser = len(hierarchy.level_mesh(-2).world())
+        moved[fit] = (np.mean(finest[coarser:]), finest[:coarser], hierarchy.report)
+    outwards = moved[True][0] - moved[False][0]
+    assert outwards > 0.5 * moved[True][2]["face_fit_median_move"]
+    np.testing.assert_array_equal(moved[True][1], moved[False][1])
+
+
 def test_noisy_levels_are_denoised_as_the_cli_does(tmp_path):
     # A noisy sphere stops on noise and is smoothed (denoise_rounds, `--denoise`): the same
     # bytes and report as the CLI either way, and closer to the sphere when smoothed.

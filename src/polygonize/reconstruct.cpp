@@ -69,6 +69,7 @@ RefineOptions refine_options_of(const SemiRegularOptions& options, const Progres
     refine_options.relaxation = options.relaxation;
     refine_options.denoise_rounds = options.denoise_rounds;
     refine_options.fair_unsupported = options.fair_unsupported;
+    refine_options.fit_faces = options.fit_faces;
     refine_options.stop_rule = options.stop_rule;
     refine_options.sample_tree = options.sample_tree;
     refine_options.progress = progress;

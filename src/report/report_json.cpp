@@ -231,6 +231,9 @@ nlohmann::json report_json(const SemiRegularReport& r, const SemiRegularOptions&
         out["detail_threshold"] = r.refinement.detail_threshold;
         out["denoise_rounds"] = r.refinement.denoise_rounds;
         out["denoise_max_move"] = r.refinement.denoise_max_move;
+        out["face_fit_vertices"] = r.refinement.face_fit_vertices;
+        out["face_fit_max_move"] = r.refinement.face_fit_max_move;
+        out["face_fit_median_move"] = r.refinement.face_fit_median_move;
         out["spikes"] = r.refinement.spikes;
         out["unsupported_regions"] = r.refinement.unsupported.regions;
         out["unsupported_membranes"] = r.refinement.unsupported.membranes;

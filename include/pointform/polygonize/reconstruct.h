@@ -56,6 +56,8 @@ struct SemiRegularOptions
     std::size_t denoise_rounds = RefineOptions{}.denoise_rounds;
     /// Fair the regions no sample supports (RefineOptions::fair_unsupported).
     bool fair_unsupported = RefineOptions{}.fair_unsupported;
+    /// Fit the finest level's faces to the field's zero set (RefineOptions::fit_faces).
+    bool fit_faces = RefineOptions{}.fit_faces;
     /// Holes of the automatic base mesh filled (BaseMeshOptions::fill_holes); 0 = none.
     double fill_holes = 0.0;
     /// Long chords of the automatic base mesh split (BaseMeshOptions::chord_split_share).
