@@ -263,6 +263,21 @@ def test_fill_holes_is_the_mc_clis(tmp_path):
         pointform.fill_holes(mesh, max_share=1.0)
 
 
+def reconstructed_as_the_cli(tmp_path, points, cloud, options, flags, keys):
+    """pointform.reconstruct(cloud, **options), checked against `pointform reconstruct points
+    *flags`: the same report entries `keys` and the same hierarchy file bytes."""
+    hierarchy = pointform.reconstruct(cloud, **options)
+    out = tmp_path / "cli.pfh"
+    cli_report = run_cli("reconstruct", points, "-o", tmp_path / "cli.ply", "--save-hierarchy",
+                         out, "--json", *flags, json_output=True)
+    for key in keys:
+        assert cli_report[key] == hierarchy.report[key]
+    mine = tmp_path / "py.pfh"
+    hierarchy.save(mine)
+    assert mine.read_bytes() == out.read_bytes()
+    return hierarchy
+
+
 def test_holes_are_faired_as_the_cli_does(tmp_path):
     # A noisy sphere with holes: the regions no sample supports are faired (hole_fairing,
     # `--no-hole-fairing`), the same bytes and report as the CLI either way.
@@ -271,17 +286,11 @@ def test_holes_are_faired_as_the_cli_does(tmp_path):
             0.04, "--seed", 4, "-o", points)
     cloud = pointform.read_points(points)
     for fairing in (True, False):
-        hierarchy = pointform.reconstruct(cloud, hole_fairing=fairing)
-        out = tmp_path / f"cli{fairing}.pfh"
-        cli_report = run_cli("reconstruct", points, "-o", tmp_path / "cli.ply", "--save-hierarchy",
-                             out, "--json", *([] if fairing else ["--no-hole-fairing"]),
-                             json_output=True)
-        for key in ("unsupported_regions", "unsupported_vertices"):
-            assert cli_report[key] == hierarchy.report[key]
+        hierarchy = reconstructed_as_the_cli(
+            tmp_path, points, cloud, {"hole_fairing": fairing},
+            [] if fairing else ["--no-hole-fairing"],
+            ("unsupported_regions", "unsupported_vertices"))
         assert (hierarchy.report["unsupported_regions"] > 0) == fairing
-        mine = tmp_path / f"py{fairing}.pfh"
-        hierarchy.save(mine)
-        assert mine.read_bytes() == out.read_bytes()
 
 
 def test_faces_are_fitted_as_the_cli_does(tmp_path):
@@ -293,17 +302,10 @@ def test_faces_are_fitted_as_the_cli_does(tmp_path):
     cloud = pointform.read_points(points)
     moved = {}
     for fit in (True, False):
-        hierarchy = pointform.reconstruct(cloud, face_fit=fit)
-        out = tmp_path / f"cli{fit}.pfh"
-        cli_report = run_cli("reconstruct", points, "-o", tmp_path / "cli.ply", "--save-hierarchy",
-                             out, "--json", *([] if fit else ["--no-face-fit"]),
-                             json_output=True)
-        for key in ("face_fit_vertices", "face_fit_max_move", "face_fit_median_move"):
-            assert cli_report[key] == hierarchy.report[key]
+        hierarchy = reconstructed_as_the_cli(
+            tmp_path, points, cloud, {"face_fit": fit}, [] if fit else ["--no-face-fit"],
+            ("face_fit_vertices", "face_fit_max_move", "face_fit_median_move"))
         assert (hierarchy.report["face_fit_vertices"] > 0) == fit
-        mine = tmp_path / f"py{fit}.pfh"
-        hierarchy.save(mine)
-        assert mine.read_bytes() == out.read_bytes()
         finest = np.linalg.norm(hierarchy.level_mesh(-1).world(), axis=1)
         coarser = len(hierarchy.level_mesh(-2).world())
         moved[fit] = (np.mean(finest[coarser:]), finest[:coarser], hierarchy.report)
