@@ -270,8 +270,8 @@ void add_refine_options(CLI::App& cmd, SemiRegularCommandOptions& options)
     cmd.add_flag("!--no-face-fit", options.semi_regular.fit_faces,
                  "Keep the finest level's vertices on the field (the paper's interpolating "
                  "level) instead of fitting its flat faces to the field in the least-squares "
-                 "sense (which takes out their sag inside curved parts; not done where the "
-                 "level was smoothed for noise)");
+                 "sense (which takes out their sag inside curved parts; with the automatic "
+                 "stop only, and not where the level was smoothed for noise)");
     cmd.add_flag("--ascii", options.ascii, "Write ascii PLY instead of binary");
     cmd.add_flag("--json", options.json, "Print the report as JSON");
 }

@@ -372,8 +372,9 @@ void bind_polygonize(py::module_& m)
         "`levels` (0-8), or until stop_rule says so ('auto' or 'paper'); a level where 'auto' "
         "stops on noise is smoothed by denoise_rounds rounds of Taubin's smoothing (0 = none), "
         "and with 'auto' the regions no sample supports (filled holes and their rims) are "
-        "faired unless hole_fairing=False (`--no-hole-fairing`); a finest level not smoothed has "
-        "its faces fitted to the field in the least-squares sense unless face_fit=False "
+        "faired unless hole_fairing=False (`--no-hole-fairing`); with 'auto' a finest level not "
+        "smoothed has its faces fitted to the field in the least-squares sense unless "
+        "face_fit=False "
         "(`--no-face-fit`). "
         "Raises InvalidInput "
         "for bad points or options, or work that would not fit in memory.");

@@ -1177,10 +1177,11 @@ constexpr double fit_reach = 0.25;
 /// fit_faces() moves no vertex when the median move is below this share of the field's residual
 /// at the samples (the noise the field leaves): then the moves follow the field's unevenness
 /// between the vertices more than the faces' sag. Median move over residual, measured: a clean
-/// 100k sphere 2,100, the shipped bunny scan 0.67 (Chamfer to bun_zipper 0.0507 -> 0.0472% of
+/// 100k sphere 2,100, the shipped bunny scan 0.67 (Chamfer to bun_zipper 0.0507 -> 0.0478% of
 /// the diagonal with the fit), simulated scans of data/meshes/ 0.034-0.048 (fandisk, teapot and
-/// spot, seed 1: Chamfer 0.1552 / 0.2012 / 0.1074 -> 0.1561 / 0.2020 / 0.1079 with it, and
-/// with the moves averaged over one or two rings no better than without the fit).
+/// spot, seed 1: Chamfer 0.1552 / 0.2012 / 0.1074 -> 0.1561 / 0.2020 / 0.1079 with a fit of
+/// every vertex of the level, and with its moves averaged over one or two rings no better than
+/// without the fit).
 constexpr double fit_least_move = 0.25;
 
 /// The finest level's flat faces fitted to the field's zero set in the least-squares sense
