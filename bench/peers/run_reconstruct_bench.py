@@ -138,6 +138,9 @@ def main(argv=None) -> int:
                          "clean only, against the Stanford reconstruction bun_zipper), and "
                          "fandisk, spot or teapot (simulated scans of data/meshes/, against the mesh: "
                          "--scan-seeds; --size and --variants do not apply)")
+    ap.add_argument("--sample-seed", type=int, default=1,
+                    help="seed of `pointform sample` for the analytic shapes' raw points (a held-out "
+                         "draw of the same shapes; the truth's samples keep their own seed)")
     ap.add_argument("--scan-seeds", default="1,2,3",
                     help="seeds of virtual_scan.py for each scanned mesh, comma-separated")
     ap.add_argument("--variants", default="clean,noisy+holes")
@@ -192,7 +195,7 @@ def main(argv=None) -> int:
                     write_points(raw, scan(str(SCANNED_MESHES[shape]), int(variant.split()[1])))
                 else:
                     run_measured([args.pointform, "sample", *sample_args(shape), "-n",
-                                  str(args.size), "-o",
+                                  str(args.size), "--seed", str(args.sample_seed), "-o",
                                   work / "with_normals.ply", *VARIANTS[variant]], env, 600,
                                  work / "sample")
                     # Raw points: no tool may see the true normals.

@@ -1367,6 +1367,29 @@ struct CreasedRegion
 /// the holes over the noisy 100k cone's rim reach 8.8 to 12.1.
 constexpr double crease_fill_depth = 5.0;
 
+/// A crease fill whose faces include two facing nearly opposite ways (their normals more than
+/// about 150 degrees apart) spans a thin wall: its region is a wall's rim, not one crease's
+/// corner. Where the wall is thinner than the field's fits reach, the field rounds its rim
+/// off into a cap standing several spacings beyond the samples (a clean 100k plate 0.02 thick,
+/// about five spacings: regions 5-8 spacings deep), and the rim's strips on the wall's side,
+/// as narrow as the wall is thick, fit faces that bend or never meet: the crease fill moved
+/// such caps up to 0.066 out past the plate's side (3.3 thicknesses; Hausdorff distance 2.33%
+/// of the diagonal against 0.60% as faired). The thin plate's fairing takes such a cap back to
+/// within about 3-4 spacings of the samples, while a hole through a wall's rim stays as deep as
+/// it is wide: so such a fill is kept only when its faired region is still crease_fill_depth
+/// deep. A cone's acute rim (normals 135 degrees apart) is not a wall.
+constexpr double wall_faces_cosine = -0.866;
+
+/// Whether two of a crease fill's faces face nearly opposite ways (wall_faces_cosine).
+bool spans_a_wall(const detail::CreaseFill& fill)
+{
+    for (std::size_t a = 0; a < fill.faces.size(); ++a)
+        for (std::size_t b = a + 1; b < fill.faces.size(); ++b)
+            if (fill.faces[a].axis.dot(fill.faces[b].axis) < wall_faces_cosine)
+                return true;
+    return false;
+}
+
 /// onto_crease_faces() moves a vertex farther than its nearest rim vertex only when the face it
 /// meets there faces the move within 60°, or when it lands on the crease (the other faces' value
 /// there within this share of the move): on the 1M noisy plate of bench/peers, vertices in a
@@ -1532,6 +1555,26 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
     // Distance to the nearest sample in local spacings. Level by level: a base vertex searches
     // the whole tree, and a later one starts from the nearest sample of its parent edge's first
     // end (an edge of the level below away), whose distance bounds its search.
+    // The distance from `at` to its nearest sample (searched from sample `start` when there is
+    // one) in local spacings; the sample into `nearest` (none when there is no sample).
+    const auto depth_at = [&](const Vec3d& at, std::uint32_t start, std::uint32_t& nearest) {
+        float squared = 0.0F;
+        const Vec3f query = (at + shift).cast<float>();
+        const PointId found =
+            start == none ? tree.nearest(query, &squared)
+                          : tree.nearest_within_factor(query, 1.0F, PointId{start}, &squared);
+        nearest = found.is_valid() ? found.value : none;
+        if (!found.is_valid())
+            return 0.0;
+        double local = spacing;
+        if (radius_scale > 0.0)
+        {
+            const double r = radius_scale * static_cast<double>(samples.radii[found.value]);
+            if (r > 0.0 && std::isfinite(r))
+                local = r;
+        }
+        return std::sqrt(static_cast<double>(squared)) / local;
+    };
     std::vector<float> excess(n, 0.0F);
     std::vector<std::uint32_t> nearest_sample(n, none);
     const std::size_t base = mesh.vertex_count(0);
@@ -1543,24 +1586,8 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
         parallel_blocks(last - first, vertex_block, [&](std::size_t begin, std::size_t end) {
             for (std::size_t v = first + begin; v < first + end; ++v)
             {
-                float squared = 0.0F;
-                const Vec3f query = (x[v] + shift).cast<float>();
                 const std::uint32_t start = v < base ? none : nearest_sample[parents[v - base].a];
-                const PointId nearest = start == none ? tree.nearest(query, &squared)
-                                                      : tree.nearest_within_factor(
-                                                            query, 1.0F, PointId{start}, &squared);
-                if (!nearest.is_valid())
-                    continue;
-                nearest_sample[v] = nearest.value;
-                double local = spacing;
-                if (radius_scale > 0.0)
-                {
-                    const double r =
-                        radius_scale * static_cast<double>(samples.radii[nearest.value]);
-                    if (r > 0.0 && std::isfinite(r))
-                        local = r;
-                }
-                excess[v] = static_cast<float>(std::sqrt(static_cast<double>(squared)) / local);
+                excess[v] = static_cast<float>(depth_at(x[v], start, nearest_sample[v]));
             }
         });
     }
@@ -1703,6 +1730,16 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
             deepest = std::max(deepest, excess[v]);
         return static_cast<double>(deepest);
     };
+    // The same depth of a region's faired positions (`at`, in its members' order).
+    const auto faired_depth = [&](std::span<const std::uint32_t> region_vertices,
+                                  std::span<const Vec3d> at) {
+        double deepest = 0.0;
+        std::uint32_t nearest = none;
+        for (std::size_t i = 0; i < at.size(); ++i)
+            deepest =
+                std::max(deepest, depth_at(at[i], nearest_sample[region_vertices[i]], nearest));
+        return deepest;
+    };
     for (std::size_t seed = 0; seed < n; ++seed)
     {
         if (free[seed] == 0 || region[seed] != unset)
@@ -1739,11 +1776,16 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
         ++out.regions;
         if (fill == detail::Fairing::membrane)
             ++out.membranes;
-        else if (std::optional<detail::CreaseFill> crease =
-                     hole_depth(members) >= crease_fill_depth
-                         ? detail::crease_fill_for_rim(rim_at, rim_normals)
-                         : std::nullopt)
-            creased.push_back({members, rim_at, std::move(*crease)});
+        else if (hole_depth(members) >= crease_fill_depth)
+        {
+            std::optional<detail::CreaseFill> crease =
+                detail::crease_fill_for_rim(rim_at, rim_normals);
+            if (crease && spans_a_wall(*crease) &&
+                faired_depth(members, *solution) < crease_fill_depth)
+                crease.reset();
+            if (crease)
+                creased.push_back({members, rim_at, std::move(*crease)});
+        }
         for (std::size_t i = 0; i < members.size(); ++i)
         {
             flat_fill[members[i]] = fill == detail::Fairing::membrane ? 1 : 0;
