@@ -24,34 +24,51 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
-import open3d as o3d
 
 
-def surface_samples(mesh, count: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    """`count` area-uniform samples of an Open3D triangle mesh's faces, from `rng` (Open3D's
-    sampler has its own generator), with their faces' unit normals."""
-    mesh.compute_triangle_normals()
-    vertices = np.asarray(mesh.vertices)
-    faces = np.asarray(mesh.triangles)
+def triangle_samples(vertices: np.ndarray, faces: np.ndarray, count: int,
+                     rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """`count` area-uniform samples of the triangles `faces` (indices into `vertices`), from
+    `rng`, with their triangles' unit normals."""
+    vertices = np.asarray(vertices, dtype=np.float64)
+    faces = np.asarray(faces)
     a, b, c = vertices[faces[:, 0]], vertices[faces[:, 1]], vertices[faces[:, 2]]
-    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+    cross = np.cross(b - a, c - a)
+    length = np.linalg.norm(cross, axis=1)
+    area = 0.5 * length
     face = rng.choice(len(faces), size=count, p=area / area.sum())
     u, v = rng.uniform(size=(2, len(face)))
     flip = u + v > 1
     u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
     points = a[face] + u[:, None] * (b[face] - a[face]) + v[:, None] * (c[face] - a[face])
-    return points, np.asarray(mesh.triangle_normals)[face]
+    normals = cross[face] / np.where(length[face] > 0, length[face], 1.0)[:, None]
+    return points, normals
+
+
+def surface_samples(mesh, count: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """triangle_samples() of an Open3D triangle mesh (Open3D's sampler has its own generator)."""
+    return triangle_samples(np.asarray(mesh.vertices), np.asarray(mesh.triangles), count, rng)
 
 
 def scan(mesh_path: str, seed: int, views: int = 6, resolution: int = 260,
          noise: float = 0.001) -> np.ndarray:
-    rng = np.random.default_rng(seed)
+    """scan_triangles() of a mesh file (read with Open3D)."""
+    import open3d as o3d
+
     mesh = o3d.io.read_triangle_mesh(mesh_path)
-    vertices = np.asarray(mesh.vertices)
+    return scan_triangles(np.asarray(mesh.vertices), np.asarray(mesh.triangles), seed, views,
+                          resolution, noise)
+
+
+def scan_triangles(vertices: np.ndarray, faces: np.ndarray, seed: int, views: int = 6,
+                   resolution: int = 260, noise: float = 0.001) -> np.ndarray:
+    """The simulated scan of a triangle mesh (the module's docstring): numpy only."""
+    rng = np.random.default_rng(seed)
+    vertices = np.asarray(vertices, dtype=np.float64)
     low, high = vertices.min(0), vertices.max(0)
     centre = (low + high) / 2
     diag = float(np.linalg.norm(high - low))
-    points, normals = surface_samples(mesh, 3_000_000, rng)
+    points, normals = triangle_samples(vertices, faces, 3_000_000, rng)
     parts = []
     for _ in range(views):
         direction = rng.normal(size=3)
