@@ -7,8 +7,9 @@ paper's Fig. 4 claim), Open3D's Poisson at depth 9 and, with --bpa, ball pivotin
 Every tool starts from the same raw points (an analytic shape sampled by `pointform sample`,
 clean or with 0.2% noise and holes; the shipped bunny scan; or simulated multi-view range scans
 of a mesh of data/meshes/ (fandisk, a CAD part; spot, a smooth cow; teapot, with a thin spout
-and a handle) by virtual_scan.py: occlusion, grazing dropout, range noise, holes and strays,
-measured against the mesh) and estimates its own normals: pointform inside its
+and a handle) or of a machined part written in the modeling language (bracket, flange, finblock:
+run_surface_bench.CAD_PARTS) by virtual_scan.py: occlusion, grazing dropout, range noise, holes
+and strays, measured against the mesh) and estimates its own normals: pointform inside its
 commands, Open3D with estimate_normals + orient_normals_consistent_tangent_plane (k = 16), so
 times are end to end. Per tool: wall time, peak memory (/usr/bin/time), vertices, accuracy
 against the true analytic surface (symmetric Hausdorff and Chamfer in % of the diagonal,
@@ -37,8 +38,8 @@ import open3d as o3d
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from run_normals_bench import run_measured  # noqa: E402
 from plyio import write_ply  # noqa: E402
-from run_surface_bench import (BUNNY_MESH, SCANNED_MESHES, VARIANTS, evaluate_isolated,  # noqa: E402
-                               load_points, sample_args)
+from run_surface_bench import (BUNNY_MESH, SCANNED_MESHES, VARIANTS, ensure_cad_part,  # noqa: E402
+                               evaluate_isolated, load_points, sample_args)
 from virtual_scan import scan, surface_samples  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
@@ -137,7 +138,8 @@ def main(argv=None) -> int:
                          "thick), bunny (the shipped scan, "
                          "clean only, against the Stanford reconstruction bun_zipper), and "
                          "fandisk, spot or teapot (simulated scans of data/meshes/, against the mesh: "
-                         "--scan-seeds; --size and --variants do not apply)")
+                         "--scan-seeds; --size and --variants do not apply) and bracket, flange or "
+                         "finblock (machined parts built by `pointform model`, scanned the same way)")
     ap.add_argument("--sample-seed", type=int, default=1,
                     help="seed of `pointform sample` for the analytic shapes' raw points (a held-out "
                          "draw of the same shapes; the truth's samples keep their own seed)")
@@ -175,6 +177,7 @@ def main(argv=None) -> int:
                 # The truth is the Stanford reconstruction; the samples are its own vertices.
                 write_points(truth_path, load_points(BUNNY_MESH))
             elif shape in SCANNED_MESHES:
+                ensure_cad_part(shape, args.pointform)
                 # The truth's points (for recall): area-uniform samples of the mesh.
                 truth_mesh = o3d.io.read_triangle_mesh(str(SCANNED_MESHES[shape]))
                 write_points(truth_path,

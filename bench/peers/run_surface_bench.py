@@ -23,6 +23,7 @@ from __future__ import annotations
 import argparse
 import faulthandler
 import functools
+import hashlib
 import multiprocessing
 import json
 import math
@@ -117,6 +118,41 @@ def sample_args(shape: str) -> list[str]:
 SCANNED_MESHES = {"fandisk": HERE.parent.parent / "data" / "meshes" / "fandisk.obj",
                   "spot": HERE.parent.parent / "data" / "meshes" / "spot.obj",
                   "teapot": HERE.parent.parent / "data" / "meshes" / "teapot.obj"}
+
+# Machined parts written in the modeling language (`pointform model`, marching cubes of 400
+# cells along the longest side), scanned like the meshes above: large flat faces seen head-on
+# by some cameras and at a slant by the rest, bores and bolt holes, a thin fin. A bracket (a
+# plate with an upright, a bore through the plate, a slot through the upright), a flange (a disc
+# with a boss, a bore through both and four bolt holes) and a block with a fin 0.06 thick and a
+# round boss.
+CAD_PARTS = {
+    "bracket": "difference(union(box([-1,-0.6,-0.2],[1,0.6,0.2]), box([-1,-0.6,0.2],[-0.6,0.6,1.0])), "
+               "union(cylinder([0.5,0,-0.5],[0.5,0,0.5],0.22), box([-1.2,-0.15,0.45],[-0.4,0.15,0.8])))",
+    "flange": "difference(union(cylinder([0,0,-0.2],[0,0,0.2],1.0), "
+              "cylinder([0,0,0.1],[0,0,0.9],0.45)), "
+              "union(cylinder([0,0,-0.5],[0,0,1.2],0.25), cylinder([0.72,0,-0.5],[0.72,0,0.5],0.09), "
+              "cylinder([-0.72,0,-0.5],[-0.72,0,0.5],0.09), cylinder([0,0.72,-0.5],[0,0.72,0.5],0.09), "
+              "cylinder([0,-0.72,-0.5],[0,-0.72,0.5],0.09)))",
+    "finblock": "union(box([-1,-0.5,-0.3],[1,0.5,0.3]), box([-0.03,-0.5,0.25],[0.03,0.5,0.9]), "
+                "cylinder([0.6,0,0.25],[0.6,0,0.7],0.2))",
+}
+CAD_CACHE = Path(tempfile.gettempdir()) / "pointform-bench-cad"
+for _name, _expression in CAD_PARTS.items():
+    # Named by the expression, so that an edited part is built again.
+    SCANNED_MESHES[_name] = CAD_CACHE / f"{_name}-{hashlib.sha256(_expression.encode()).hexdigest()[:12]}.ply"
+
+
+def ensure_cad_part(shape: str, pointform) -> None:
+    """Builds the mesh of a CAD part (CAD_PARTS) with `pointform model` unless it is there."""
+    if shape not in CAD_PARTS or SCANNED_MESHES[shape].exists():
+        return
+    CAD_CACHE.mkdir(parents=True, exist_ok=True)
+    partial = SCANNED_MESHES[shape].with_suffix(".partial.ply")
+    status = run_measured([pointform, "model", CAD_PARTS[shape], "-o", partial, "--resolution",
+                           "400", "--json"], os.environ.copy(), 600, CAD_CACHE / shape)[0]
+    if status != "ok":
+        raise RuntimeError(f"pointform model of {shape} failed ({status})")
+    partial.replace(SCANNED_MESHES[shape])
 
 
 @functools.lru_cache(maxsize=None)
