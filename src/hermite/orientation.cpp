@@ -1133,11 +1133,11 @@ std::vector<std::uint8_t> crease_band(std::span<const Vec3f> positions, const Kn
 /// block with a thin fin) three of fifteen turned a region from an energy of 0.019-0.041, each
 /// one wrongly (the flange's bore, 2.8% of its samples then inside out, 0.03% without the turn;
 /// the fin block 8.9% -> 1.1%); every turn of the noisy cones starts at 0.18-0.19. On a cloud
-/// where no region
-/// turns nothing changes: on 90 simulated scans of fandisk, spot and the teapot not one sample did,
-/// nor on the LiDAR terrain of data/. (Taking the planes on every noisy cloud halved the normals
-/// more than 30° off on the bench's noisy blobby and part, but its plate, whose rims are narrower
-/// than the band, came out with 4x the vertices and twice the Hausdorff distance.)
+/// where no region turns nothing changes: on 90 simulated scans of fandisk, spot and the teapot
+/// not one sample did, nor on the LiDAR terrain of data/. (Taking the planes on every noisy cloud
+/// halved the normals more than 30° off on the bench's noisy blobby and part, but its plate,
+/// whose rims are narrower than the band, came out with 4x the vertices and twice the Hausdorff
+/// distance.)
 ///
 /// Sums run over every stride-th sample in index order (spatially sorted) and each query's sum is
 /// serial, so the result does not depend on the thread count.
