@@ -6,6 +6,7 @@
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
 #include "pointform/hermite/crease_fit.h"
+#include "pointform/hermite/normals.h"
 #include "pointform/hermite/scatter.h"
 #include "pointform/spatial/feature_grid.h"
 #include "pointform/spatial/kd_tree.h"
@@ -22,7 +23,9 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <numbers>
 #include <optional>
@@ -266,10 +269,13 @@ void set_quadric(PackedSurfel& out, const std::array<float, 6>& quadric)
 /// holes): a sample left inside a hole by the noise fitted a quadric whose zero set flared
 /// 0.035 off the tube (2.4 times 0.5% of the diagonal); with the rule the torus's F@0.5% went
 /// from 0.9992 to 1.0000 and its Hausdorff from 1.45% to 0.51% of the diagonal.
-/// `narrow_out` (if given) receives the narrow fit for pool_narrow_fits().
-void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
-                       std::span<const std::uint32_t> neighbors, std::size_t i, PlaneFit fit,
-                       std::size_t narrow_k, bool on_rim, PackedSurfel& out, NarrowFit* narrow_out)
+/// `narrow_out` (if given) receives the narrow fit for pool_narrow_fits(). Returns the kept
+/// quadric's noise relative to its neighbourhood: the residual's σ̂ (RSS / (count − 6) of the fit
+/// to all) over the distance to the farthest neighbour; 0 where no quadric was fitted.
+double fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
+                         std::span<const std::uint32_t> neighbors, std::size_t i, PlaneFit fit,
+                         std::size_t narrow_k, bool on_rim, PackedSurfel& out,
+                         NarrowFit* narrow_out)
 {
     const Vec3d s = positions[i].cast<double>();
     const Vec3d n = out.normal.cast<double>();
@@ -278,7 +284,7 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
     out.a = out.b = out.c = out.d = out.e = out.f = 0.0F;
     if (fit == PlaneFit::Raw)
     {
-        return;
+        return 0.0;
     }
     double mean_height = 0.0;
     for (const std::uint32_t j : neighbors)
@@ -289,7 +295,7 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
     out.a = static_cast<float>(mean_height);
     if (fit != PlaneFit::Quadric)
     {
-        return;
+        return 0.0;
     }
     // The quadric's neighbourhood is wide enough to reach across a thin wall: samples facing
     // more than 60° away belong to another sheet and are left out.
@@ -305,7 +311,7 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
     }
     if (used < 10 || !(scale2 > 0.0))
     {
-        return; // too few to fit six coefficients: keep the centroid plane
+        return 0.0; // too few to fit six coefficients: keep the centroid plane
     }
     // Least squares in coordinates scaled to the neighbourhood, for a well-conditioned system.
     // The normal equations are accumulated nearest first, and kept at the narrow scale too, with
@@ -398,7 +404,7 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
         // them (plausible_fit()), which the field would extrapolate into the hole: keep the
         // centroid plane. (Inside the surface the wide fit stands: on a clean crease it rises
         // steeply and is still the best fit.)
-        return;
+        return 0.0;
     }
     Vec6 coef = wide->first;
     if (small && small->count < count)
@@ -436,7 +442,28 @@ void fit_local_surface(std::span<const Vec3f> positions, std::span<const Vec3f> 
         }
     }
     set_quadric(out, unscaled_quadric(coef, std::sqrt(scale2)));
+    // The wide fit's σ̂ in the scaled coordinates, where the farthest neighbour lies at 1.
+    const double rss = std::max(0.0, sums.heights2 - wide->first.dot(sums.rhs));
+    return count > 6 ? std::sqrt(rss / static_cast<double>(count - 6)) : 0.0;
 }
+
+/// A sample's quadric in a noisy cloud is fitted again at coarser scales while its fit's noise
+/// (the residual's σ̂) is above this fraction of the distance to its farthest neighbour. A ball
+/// of radius R centred at height z in Gaussian noise σ across a sheet holds samples whose mean
+/// height is about 2 z σ² / (R² − σ² − z²): the fit follows its own sample by 2 σ² / R² of its
+/// offset, the blend of such fits follows the samples, and the field's zero set frays into the
+/// noise. At 0.2 (R = 5 σ) it follows by 8%. The noisy inputs of bench/peers at 100k samples
+/// score about 0.1 and keep their fits; at 1M (spacings a third as long, noise the same) 0.3.
+/// Where noise merges the two faces of a thin plate into one slab of samples (the 1M noisy plate
+/// 0.02 thick: faces 3.4 deviations apart), the slab is what a fit sees, and a ball narrower than
+/// the slab fits the samples' own heights: its surface was a sponge (Euler characteristic
+/// -12,661).
+constexpr double coarse_fit_noise = 0.2;
+
+/// The coarser scales of a refit: the fit's count of neighbours among every 4th sample (in
+/// Morton order), every 16th, every 64th: twice, 4 and 8 times the reach.
+constexpr std::size_t coarse_fit_stride = 4;
+constexpr std::size_t coarse_fit_levels = 3;
 
 /// The k nearest of each query (grid slots and squared distances, nearest first, k per query
 /// from query i · k on): the grid's batch search, and the kd-tree for the queries too far from
@@ -456,6 +483,138 @@ void knn_of_batch(const PointGrid& grid, const KdTree& tree, std::span<const Vec
         tree.knn(queries[q], k, neighbors, std::span(dist2.data() + q * k, k));
         for (std::uint32_t& neighbor : neighbors)
             neighbor = grid.slot_of(neighbor);
+    }
+}
+
+/// Every stride-th sample of a cloud in Morton order (a subsample spread as the cloud is), in
+/// the order of a point grid of its own (cells of `cell`) for batch searches.
+struct CoarseSamples
+{
+    std::unique_ptr<KdTree> tree;
+    std::unique_ptr<PointGrid> grid;
+    std::vector<Vec3f> positions;        ///< by grid slot
+    std::vector<Vec3f> normals;          ///< by grid slot
+    std::vector<std::uint32_t> original; ///< by grid slot: the index in the cloud
+    std::vector<Vec3f> tree_positions;   ///< the kd-tree's points
+};
+
+/// The coarse subsamples of `positions` and `normals` (samples in Morton order), finest first,
+/// none with fewer than `k` samples; `cell` is the full cloud's fit grid cell, which each level
+/// doubles (its spacing doubles).
+std::vector<CoarseSamples> coarse_samples(std::span<const Vec3f> positions,
+                                          std::span<const Vec3f> normals, std::size_t k, float cell)
+{
+    std::vector<CoarseSamples> levels;
+    std::size_t stride = 1;
+    for (std::size_t level = 0; level < coarse_fit_levels; ++level)
+    {
+        stride *= coarse_fit_stride;
+        cell *= 2.0F;
+        if (positions.size() / stride < k)
+            break;
+        std::vector<Vec3f> subsample;
+        std::vector<std::uint32_t> index;
+        for (std::size_t i = 0; i < positions.size(); i += stride)
+        {
+            subsample.push_back(positions[i]);
+            index.push_back(static_cast<std::uint32_t>(i));
+        }
+        CoarseSamples c;
+        c.tree = std::make_unique<KdTree>(subsample);
+        c.grid = std::make_unique<PointGrid>(subsample, cell, *c.tree);
+        c.positions.resize(c.grid->slot_count(), Vec3f::Zero());
+        c.normals.resize(c.grid->slot_count(), Vec3f::Zero());
+        c.original.resize(c.grid->slot_count(), PointGrid::padding_slot);
+        for (std::uint32_t slot = 0; slot < c.grid->slot_count(); ++slot)
+        {
+            const std::uint32_t j = c.grid->original_index(slot);
+            if (j == PointGrid::padding_slot)
+                continue;
+            c.positions[slot] = subsample[j];
+            c.normals[slot] = normals[index[j]];
+            c.original[slot] = index[j];
+        }
+        // The kd-tree answers from the subsample's own array: keep it alive with the level.
+        c.tree_positions = std::move(subsample);
+        levels.push_back(std::move(c));
+    }
+    return levels;
+}
+
+/// Refits, in a noisy cloud, the local surfaces whose fit's noise (fit_local_surface(), in
+/// `noise` by sample, samples in Morton order) is above coarse_fit_noise: over the sample's own
+/// k nearest among coarser subsamples (`levels`; each doubles the reach), from the level whose
+/// reach would bring the noise to the limit were it a single sheet's, and up while it is not.
+/// In the sample's own frame. `surfel(i)` is sample i's surface as the field keeps it.
+void refit_coarser(std::span<const CoarseSamples> levels, std::span<const Vec3f> positions,
+                   std::span<float> noise, std::span<const std::uint8_t> on_rim, std::size_t k,
+                   const std::function<PackedSurfel&(std::uint32_t)>& surfel)
+{
+    // The level each sample starts from (levels.size(): none), by sample.
+    std::vector<std::uint8_t> start(positions.size(), static_cast<std::uint8_t>(levels.size()));
+    std::vector<std::uint32_t> pending = parallel_collect<std::uint32_t>(
+        positions.size(), 4096,
+        [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& out) {
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                double ratio = static_cast<double>(noise[i]) / coarse_fit_noise;
+                if (!(ratio > 1.0))
+                    continue;
+                std::size_t level = 0;
+                for (; ratio > 2.0 && level + 1 < levels.size(); ratio *= 0.5)
+                    ++level;
+                start[i] = static_cast<std::uint8_t>(level);
+                out.push_back(static_cast<std::uint32_t>(i));
+            }
+        });
+    for (std::size_t level = 0; level < levels.size() && !pending.empty(); ++level)
+    {
+        const CoarseSamples& c = levels[level];
+        parallel_blocks(pending.size(), 256, [&](std::size_t begin, std::size_t end) {
+            std::vector<Vec3f> queries;
+            std::vector<std::uint32_t> asked;
+            for (std::size_t p = begin; p < end; ++p)
+                if (start[pending[p]] <= level)
+                {
+                    asked.push_back(pending[p]);
+                    queries.push_back(positions[pending[p]]);
+                }
+            std::vector<std::uint32_t> slots;
+            std::vector<float> dist2;
+            knn_of_batch(*c.grid, *c.tree, queries, k, slots, dist2);
+            std::vector<Vec3f> local_positions;
+            std::vector<Vec3f> local_normals;
+            std::vector<std::uint32_t> order;
+            for (std::size_t q = 0; q < asked.size(); ++q)
+            {
+                const std::uint32_t i = asked[q];
+                PackedSurfel& out = surfel(i);
+                local_positions.assign(1, positions[i]);
+                local_normals.assign(1, out.normal);
+                for (std::size_t j = 0; j < k && local_positions.size() < k; ++j)
+                {
+                    const std::uint32_t slot = slots[q * k + j];
+                    if (c.original[slot] == i)
+                        continue;
+                    local_positions.push_back(c.positions[slot]);
+                    local_normals.push_back(c.normals[slot]);
+                }
+                order.resize(local_positions.size());
+                for (std::size_t o = 0; o < order.size(); ++o)
+                    order[o] = static_cast<std::uint32_t>(o);
+                PackedSurfel trial = out;
+                const double trial_noise =
+                    fit_local_surface(local_positions, local_normals, order, 0, PlaneFit::Quadric,
+                                      0, on_rim[i] != 0, trial, nullptr);
+                // No quadric at this scale: the finer one stays.
+                noise[i] = trial_noise > 0.0 ? static_cast<float>(trial_noise) : 0.0F;
+                if (trial_noise > 0.0)
+                    out = trial;
+            }
+        });
+        std::erase_if(pending, [&](std::uint32_t i) {
+            return start[i] <= level && !(static_cast<double>(noise[i]) > coarse_fit_noise);
+        });
     }
 }
 
@@ -928,6 +1087,7 @@ struct PointField::Impl
     Aabb local_box;  ///< box, relative to the cloud's origin
     Aabb sample_box; ///< the samples' bounding box, relative to the origin
     double median_radius = 0.0;
+    bool noisy = false;
     double max_radius = 0.0;
     double area = 0.0;
     /// Farther from every sample than this, the point grid's knn_nearby() finds nothing: it
@@ -1231,6 +1391,12 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
     };
     m.grid = std::make_unique<PointGrid>(m.surfels.positions, grid_cell(query_reach), m.tree);
 
+    // Noisy clouds: each fit's noise, for the refits over coarser subsamples.
+    m.noisy = !clean;
+    const bool refit = options.fit == PlaneFit::Quadric && !clean && options.noise_scale;
+    std::vector<float> fit_noise(refit ? n : 0, 0.0F);
+    std::vector<std::uint8_t> fit_on_rim(refit ? n : 0, 0);
+
     // Each sample's local surface from its k nearest. The samples are taken in the order of
     // the fits' grid (neighbouring samples after each other, which its batch queries answer
     // fastest), and the fits read positions and normals in that order too (a sample's
@@ -1316,9 +1482,15 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
                     ? neighbourhood_offset(fit_positions, neighbors, samples[q], packed)
                     : NeighbourhoodOffset{};
             NarrowFit narrow;
-            fit_local_surface(fit_positions, fit_normals, neighbors, samples[q], options.fit,
-                              options.quadric_narrow_k, offset.centroid.norm() >= rim_full, packed,
-                              narrow_tests.empty() ? nullptr : &narrow);
+            const bool on_rim = offset.centroid.norm() >= rim_full;
+            const double noise = fit_local_surface(
+                fit_positions, fit_normals, neighbors, samples[q], options.fit,
+                options.quadric_narrow_k, on_rim, packed, narrow_tests.empty() ? nullptr : &narrow);
+            if (!fit_noise.empty())
+            {
+                fit_noise[i] = static_cast<float>(noise);
+                fit_on_rim[i] = on_rim ? 1 : 0;
+            }
             if (!narrow_tests.empty())
             {
                 narrow_tests[samples[q]] = narrow.test;
@@ -1342,6 +1514,14 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
             options.quadric_narrow_k, [&](const NarrowCandidate& fit) {
                 set_quadric(m.packed[m.grid->slot_of(fit_grid.original_index(fit.slot))], fit.coef);
             });
+    }
+    if (refit)
+    {
+        const std::vector<CoarseSamples> coarse =
+            coarse_samples(m.surfels.positions, m.surfels.normals, k, fit_grid.cell_size());
+        refit_coarser(
+            coarse, m.surfels.positions, fit_noise, fit_on_rim, k,
+            [&](std::uint32_t i) -> PackedSurfel& { return m.packed[m.grid->slot_of(i)]; });
     }
     m.area = 0.0;
     for (const double area : block_area)
@@ -1931,6 +2111,11 @@ const PointFieldOptions& PointField::options() const
 double PointField::median_radius() const
 {
     return impl_->median_radius;
+}
+
+bool PointField::noisy() const
+{
+    return impl_->noisy;
 }
 
 double PointField::estimated_area() const

@@ -14,7 +14,9 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <optional>
+#include <string>
 
 namespace pointform {
 namespace {
@@ -287,6 +289,70 @@ double intermediate_face_limit(const PointField& field, double cell,
                     intermediate_faces_per_base_face * static_cast<double>(target));
 }
 
+/// A sponge (reconstruct()): marching cubes made a mesh of at least this many handles, and one
+/// handle for every sponge_vertices_per_handle vertices or fewer. The noisy 1M thin plate of
+/// bench/peers (faces 3.4 noise deviations apart) made genus 7,355 in 150,038 vertices (one
+/// per 20); the noisy inputs of bench/peers at 100k and 1M and the simulated scans at most 11.
+constexpr std::size_t sponge_least_genus = 64;
+constexpr std::size_t sponge_vertices_per_handle = 500;
+
+/// Handles of a mesh, summed over its components (2 C − χ − B = 2 g).
+std::size_t genus_of(const MeshTopology& topology)
+{
+    const auto twice = static_cast<std::int64_t>(2 * topology.components) -
+                       topology.euler_characteristic -
+                       static_cast<std::int64_t>(topology.boundary_loops);
+    return twice > 0 ? static_cast<std::size_t>(twice / 2) : 0;
+}
+
+/// reconstruct()'s intermediate mesh: marching cubes of `field` over the cells that
+/// choose_cell_size() and intermediate_grid() give, its debris removed; its figures into
+/// `report`.
+TriMesh intermediate_mesh_of(const PointField& field, const Aabb& bounds,
+                             const ReconstructOptions& options, ReconstructReport& report,
+                             StageClock& clock, const std::string& stage_suffix = {})
+{
+    const PointCloud& samples = field.surfels();
+    IntermediateGrid intermediate{
+        .cell = choose_cell_size(field, bounds, options.resolution, options.cell)};
+    if (options.resolution <= 0 && !(options.cell > 0.0))
+        intermediate =
+            intermediate_grid(field, intermediate.cell,
+                              intermediate_face_limit(field, intermediate.cell,
+                                                      options.semi_regular, samples.size()));
+    const double cell = intermediate.cell;
+    report.cell = cell;
+    report.coarsening = intermediate.coarsening;
+    report.stray_samples = field.stray_samples().size();
+    const CellGrid grid = grid_over(field.bounds(), cell);
+    check_marching_cubes_memory(field, cell);
+    // The intermediate mesh's vertex normals are not used (the base mesh is made from its
+    // positions): not asked for, which saves a field evaluation a vertex.
+    MarchingCubesResult mc =
+        marching_cubes(field, grid,
+                       {.vertex_normals = false,
+                        .min_defined_corners = intermediate.min_defined_corners,
+                        .progress = options.progress});
+    clock.lap("marching cubes" + stage_suffix);
+    if (mc.mesh.face_count() == 0)
+        throw Error(
+            "marching cubes made no triangles: the field has no defined zero crossing at "
+            "this cell size (try a smaller --cell or a larger --radius-scale)");
+    report.intermediate_faces = mc.mesh.face_count();
+    report.intermediate_vertices = mc.mesh.vertex_count();
+    report.degenerate_triangles = mc.stats.degenerate_triangles;
+    report.degenerate_kept = mc.stats.degenerate_kept;
+    report.undefined_triangles = mc.stats.undefined_triangles;
+    report.cell_vertices = mc.stats.cell_vertices;
+    report.debris = remove_unsupported_components(
+        mc.mesh, samples,
+        options.min_component_samples ? *options.min_component_samples
+                                      : default_min_component_samples(samples.size()),
+        &field.tree());
+    clock.lap("debris" + stage_suffix);
+    return std::move(mc.mesh);
+}
+
 ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& options)
 {
     check_semi_regular_options(options.semi_regular);
@@ -306,74 +372,59 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
     std::optional<PointCloud> given;
     if (!options.base_mesh.empty())
         given = surfels;
-    const PointField field(std::move(surfels),
-                           {.fit = options.fit, .rim_reach = options.rim_reach});
+    auto field = std::make_unique<const PointField>(
+        std::move(surfels), PointFieldOptions{.fit = options.fit, .rim_reach = options.rim_reach});
     clock.lap("field");
-    const PointCloud& samples = field.surfels();
 
     if (!options.base_mesh.empty() || !options.picked_vertices.empty())
     {
         // M0 picked over the samples (§5.1, Fig. 6).
+        const PointCloud& samples = field->surfels();
         report.picked = options.base_mesh.empty()
-                            ? snap_picked_base_mesh(options.picked_vertices, samples, field)
-                            : read_picked_base_mesh(options.base_mesh, *given, field);
+                            ? snap_picked_base_mesh(options.picked_vertices, samples, *field)
+                            : read_picked_base_mesh(options.base_mesh, *given, *field);
         given.reset();
         report.picked_angles = angle_quality(report.picked->mesh);
         const double base_seconds = clock.lap("base mesh (picked)");
         SemiRegularOptions semi_regular = options.semi_regular;
-        semi_regular.sample_tree = &field.tree();
-        report.semi_regular = refine_semi_regular(report.picked->mesh, field, &samples,
+        semi_regular.sample_tree = &field->tree();
+        report.semi_regular = refine_semi_regular(report.picked->mesh, *field, &samples,
                                                   semi_regular, options.progress);
         report.semi_regular.base_seconds = base_seconds;
     }
     else
     {
-        // M0: the simplified marching-cubes mesh (Fig. 5).
-        IntermediateGrid intermediate{
-            .cell = choose_cell_size(field, bounds, options.resolution, options.cell)};
-        if (options.resolution <= 0 && !(options.cell > 0.0))
-            intermediate =
-                intermediate_grid(field, intermediate.cell,
-                                  intermediate_face_limit(field, intermediate.cell,
-                                                          options.semi_regular, samples.size()));
-        const double cell = intermediate.cell;
-        report.cell = cell;
-        report.coarsening = intermediate.coarsening;
-        report.stray_samples = field.stray_samples().size();
-        const CellGrid grid = grid_over(field.bounds(), cell);
-        check_marching_cubes_memory(field, cell);
-        // The intermediate mesh's vertex normals are not used (the base mesh is made from its
-        // positions): not asked for, which saves a field evaluation a vertex.
-        MarchingCubesResult mc =
-            marching_cubes(field, grid,
-                           {.vertex_normals = false,
-                            .min_defined_corners = intermediate.min_defined_corners,
-                            .progress = options.progress});
-        clock.lap("marching cubes");
-        if (mc.mesh.face_count() == 0)
-            throw Error(
-                "marching cubes made no triangles: the field has no defined zero crossing at "
-                "this cell size (try a smaller --cell or a larger --radius-scale)");
-        report.intermediate_faces = mc.mesh.face_count();
-        report.intermediate_vertices = mc.mesh.vertex_count();
-        report.degenerate_triangles = mc.stats.degenerate_triangles;
-        report.degenerate_kept = mc.stats.degenerate_kept;
-        report.undefined_triangles = mc.stats.undefined_triangles;
-        report.cell_vertices = mc.stats.cell_vertices;
-        report.debris = remove_unsupported_components(
-            mc.mesh, samples,
-            options.min_component_samples ? *options.min_component_samples
-                                          : default_min_component_samples(samples.size()),
-            &field.tree());
-        clock.lap("debris");
-        report.handles = cut_short_handles(mc.mesh, options.max_handle * field.median_radius());
+        // M0: the simplified marching-cubes mesh (Fig. 5), its debris removed.
+        TriMesh intermediate_mesh = intermediate_mesh_of(*field, bounds, options, report, clock);
+        // A sponge: the fits follow the noise (PointFieldOptions::noise_scale). The field again,
+        // its fits at the scale of the noise, and its mesh.
+        if (field->noisy() && field->options().fit == PlaneFit::Quadric)
+        {
+            const MeshTopology topology = analyze_topology(intermediate_mesh);
+            const std::size_t genus = genus_of(topology);
+            if (genus >= sponge_least_genus &&
+                genus * sponge_vertices_per_handle >= topology.vertices)
+            {
+                report.sponge_genus = genus;
+                PointFieldOptions refit = field->options();
+                refit.noise_scale = true;
+                PointCloud samples = field->surfels();
+                field.reset();
+                field = std::make_unique<const PointField>(std::move(samples), refit);
+                clock.lap("field (noise scale)");
+                intermediate_mesh =
+                    intermediate_mesh_of(*field, bounds, options, report, clock, " (noise scale)");
+            }
+        }
+        report.handles =
+            cut_short_handles(intermediate_mesh, options.max_handle * field->median_radius());
         clock.lap("handles");
         SemiRegularOptions semi_regular = options.semi_regular;
         semi_regular.fill_holes = options.fill_holes;
-        semi_regular.sample_tree = &field.tree();
+        semi_regular.sample_tree = &field->tree();
         report.semi_regular =
-            semi_regular_mesh(mc.mesh, field, &samples, semi_regular, default_base_share,
-                              options.progress, intermediate.coarsening);
+            semi_regular_mesh(intermediate_mesh, *field, &field->surfels(), semi_regular,
+                              default_base_share, options.progress, report.coarsening);
     }
     report.stage_seconds.insert(report.stage_seconds.end(),
                                 report.semi_regular.stage_seconds.begin(),

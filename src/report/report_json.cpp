@@ -272,6 +272,8 @@ nlohmann::json report_json(const ReconstructReport& report, const ReconstructOpt
                          {"scattered_components", report.debris.scattered_components},
                          {"stray_samples", report.stray_samples}};
         out["handles"] = report_json(report.handles);
+        out["field_noise_scale"] = {{"refitted", report.sponge_genus > 0},
+                                    {"sponge_genus", report.sponge_genus}};
     }
     else if (report.picked)
     {

@@ -18,7 +18,9 @@
 #include <limits>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <random>
+#include <vector>
 
 namespace pointform {
 namespace {
@@ -1043,6 +1045,78 @@ TEST(PointField, RejectsSurfelsItCannotUse)
     EXPECT_THROW(PointField(cloud, {.fit = PlaneFit::Blend, .blend_k = 1}), InvalidInput);
     EXPECT_THROW((void)parse_plane_fit("smooth"), InvalidInput);
     EXPECT_EQ(parse_plane_fit("centroid"), PlaneFit::Centroid);
+}
+
+/// Raw points of a plate 0.06 thick under noise of 0.0063 of the diagonal (0.018, 2 sampling
+/// steps at 100k samples): its faces 3.4 noise deviations apart merge into one slab of samples
+/// as thick as a fit's neighbourhood, and their normals into one sheet.
+PointCloud noisy_slab_surfels()
+{
+    const PointCloud drawn = sample_shape(
+        Shape::Plate, {.count = 100000, .seed = 2, .noise = 0.0063, .thickness = 0.06});
+    PointCloud raw;
+    raw.origin = drawn.origin;
+    raw.positions = drawn.positions;
+    return surfels_from_samples(raw).surfels;
+}
+
+/// The share of vertical lines through the slab's inside (400 of them) whose field, where it is
+/// defined, changes sign exactly once.
+double share_crossed_once(const PointField& field, const Vec3d& origin)
+{
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> across(-0.8, 0.8);
+    constexpr int lines = 400;
+    constexpr int steps = 161;
+    int once = 0;
+    std::vector<Vec3d> points(steps);
+    std::vector<FieldSample> values(steps);
+    for (int line = 0; line < lines; ++line)
+    {
+        const double x = across(rng);
+        const double y = across(rng);
+        for (int z = 0; z < steps; ++z)
+            points[z] = Vec3d(x, y, -0.08 + 0.16 * z / (steps - 1)) - origin;
+        field.evaluate(points, values);
+        int changes = 0;
+        std::optional<bool> last;
+        for (const FieldSample& f : values)
+        {
+            if (!f.defined)
+                continue;
+            if (last && *last != (f.value > 0.0))
+                ++changes;
+            last = f.value > 0.0;
+        }
+        once += changes == 1 ? 1 : 0;
+    }
+    return static_cast<double>(once) / lines;
+}
+
+TEST(PointField, NoiseScaleFitsMakeOneSheetOfANoisySlab)
+{
+    // Fits over the 48 nearest (a ball about as wide as the slab is thick) follow their own
+    // samples, and the blend of them is about zero through the whole slab: a sponge. Fitted
+    // again over coarser subsamples until their noise is a fifth of their reach, they all find
+    // the slab's middle.
+    const PointCloud surfels = noisy_slab_surfels();
+    const PointField fine(surfels, {});
+    ASSERT_TRUE(fine.noisy());
+    const PointField scaled(surfels, {.noise_scale = true});
+    const double fine_once = share_crossed_once(fine, surfels.origin);
+    const double scaled_once = share_crossed_once(scaled, surfels.origin);
+    RecordProperty("fine_once", std::to_string(fine_once));
+    RecordProperty("scaled_once", std::to_string(scaled_once));
+    EXPECT_LT(fine_once, 0.8); // the input shows what the option is for
+    EXPECT_GT(scaled_once, 0.95);
+    // A clean cloud keeps its fits: the same field.
+    const PointCloud sphere =
+        surfels_from_samples(sample_shape(Shape::Sphere, {.count = 20000})).surfels;
+    const PointField plain(sphere, {});
+    const PointField asked(sphere, {.noise_scale = true});
+    ASSERT_FALSE(plain.noisy());
+    for (const Vec3d& p : {Vec3d(0.0, 0.0, 0.99), Vec3d(0.3, -0.5, 0.8), Vec3d(-1.01, 0.0, 0.0)})
+        EXPECT_EQ(plain.evaluate(p).value, asked.evaluate(p).value);
 }
 
 } // namespace

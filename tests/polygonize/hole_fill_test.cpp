@@ -823,6 +823,48 @@ TEST(HoleFill, AThinWallsRimIsNotTakenForACrease)
     }
 }
 
+TEST(Reconstruct, ANoisySpongeIsMadeAgainAtTheNoisesScale)
+{
+    // A plate 0.06 thick under noise of 0.0063 of the diagonal (2 sampling steps at 100k): its
+    // faces merge into one slab, its normals into one sheet, and the field's fits, narrower than
+    // the slab, made a sponge (genus 1,031, 71 handles left after the cuts, 10 s). Found a
+    // sponge, the field is made again with its fits at the noise's scale: one sheet between
+    // the faces.
+    PointCloud raw;
+    {
+        const PointCloud drawn = sample_shape(
+            Shape::Plate, {.count = 100000, .seed = 1, .noise = 0.0063, .thickness = 0.06});
+        raw.origin = drawn.origin;
+        raw.positions = drawn.positions;
+    }
+    const ReconstructReport report = reconstruct(surfels_from_samples(raw).surfels, {});
+    EXPECT_GE(report.sponge_genus, 64U);
+    const MultiresMesh& mesh = report.semi_regular.hierarchy;
+    const TriMesh finest = mesh.level_mesh(mesh.finest_level());
+    const MeshTopology topology = analyze_topology(finest);
+    EXPECT_EQ(topology.components, 1U);
+    EXPECT_EQ(2 * static_cast<std::int64_t>(topology.components) - topology.euler_characteristic -
+                  static_cast<std::int64_t>(topology.boundary_loops),
+              0); // genus 0
+    // Inside the rim (where the side's samples turn the sheet), within the slab of samples
+    // (faces at ±0.03, noise 0.018).
+    double farthest = 0.0;
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+    {
+        const Vec3d p = mesh.origin() + mesh.positions()[v];
+        if (std::max(std::abs(p.x()), std::abs(p.y())) < 0.9)
+            farthest = std::max(farthest, std::abs(p.z()));
+    }
+    RecordProperty("farthest_z", std::to_string(farthest));
+    EXPECT_LT(farthest, 0.03);
+    // A noisy sphere's mesh is no sponge: its field stays as it was.
+    const PointCloud sphere = sample_shape(Shape::Sphere, {.count = 50000, .noise = 0.002});
+    PointCloud sphere_raw;
+    sphere_raw.origin = sphere.origin;
+    sphere_raw.positions = sphere.positions;
+    EXPECT_EQ(reconstruct(surfels_from_samples(sphere_raw).surfels, {}).sponge_genus, 0U);
+}
+
 TEST(HoleFill, OutOfRangeIsRefused)
 {
     const PointCloud samples = sample_shape(Shape::Sphere, {.count = 3000, .seed = 4});

@@ -91,6 +91,18 @@ struct PointFieldOptions
     /// was raised to span. Crease samples are not rims (the other face's neighbours balance
     /// the centroid). In (0, 1]; 1 = the whole radius, as elsewhere (the paper's field).
     double rim_reach = 0.25;
+    /// Quadric, in a noisy cloud (PointField::noisy()): the fit scale from the local noise.
+    /// Where a sample's fit leaves residuals above a fifth of the distance to its farthest
+    /// neighbour, it is fitted again over its quadric_k nearest among every 4th sample (in
+    /// Morton order), then every 16th and 64th (twice, 4 and 8 times the reach), until they are
+    /// not. A fit whose ball is not wide against the noise follows its own sample (by about
+    /// 2 σ² / R² of its offset), and where the noise band is as thick as the ball (dense noisy
+    /// samples; the two faces of a thin plate merged by noise into one slab) the blend of such
+    /// fits is about zero through the whole band and its zero set a sponge. Off by default:
+    /// at concave creases the wider fits round the surface more (the noisy 1M blobby of
+    /// bench/peers: the field at the truth 0.0020 -> 0.0040 off near its creases, 0.0016 ->
+    /// 0.0015 elsewhere); reconstruct() turns it on where the field's surface comes out a sponge.
+    bool noise_scale = false;
     /// Answer deep-inside queries from the far grid (see PointField): constant time, within
     /// 2√3 h of the distance. False: the nearly nearest kd-tree search, as outside (within 1%),
     /// slower deep inside a closed scan; for callers that take inside values as distances
@@ -177,6 +189,10 @@ public:
     [[nodiscard]] const PointFieldOptions& options() const;
     /// \brief Median influence radius over the samples.
     [[nodiscard]] double median_radius() const;
+    /// \brief Whether the field's noise test found the samples noisy (the median flatness of
+    /// their fit neighbourhoods above that of clean samples): crease fits then look for their
+    /// other face's samples only among outliers, and PointFieldOptions::noise_scale applies.
+    [[nodiscard]] bool noisy() const;
     /// \brief The area of the sampled surface, estimated from the sampling density (each sample
     /// stands for π d² / k, d its distance to the k-th of its `centroid_k` neighbours).
     [[nodiscard]] double estimated_area() const;

@@ -245,6 +245,10 @@ struct ReconstructReport
     std::size_t stray_samples = 0;
     /// The short handles cut from the intermediate mesh (ReconstructOptions::max_handle).
     HandleCutReport handles;
+    /// The handles of the first intermediate mesh where it was a sponge, whereupon the field was
+    /// made again with PointFieldOptions::noise_scale (and the figures above are its mesh's);
+    /// 0 where it was not.
+    std::size_t sponge_genus = 0;
     /// The picked base mesh, when ReconstructOptions::base_mesh or picked_vertices was given, and
     /// its angles.
     std::optional<PickedBaseMesh> picked;
