@@ -9,6 +9,7 @@
 #include "pointform/metrics/hausdorff.h"
 #include "pointform/polygonize/base_mesh.h"
 #include "pointform/polygonize/components.h"
+#include "pointform/polygonize/handles.h"
 #include "pointform/polygonize/marching_cubes.h"
 #include "pointform/polygonize/reconstruct.h"
 #include "pointform/report/report_json.h"
@@ -23,6 +24,9 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <string>
+#include <tuple>
+#include <utility>
 
 namespace pointform::cli {
 namespace {
@@ -51,28 +55,46 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
     SurfelsFromSamples input = load_surfels(options.input, options.surfels, progress.callback());
     timings.lap(input.estimated_normals ? "read + surfels" : "read");
 
-    const PointField field(input.surfels, {.fit = options.fit, .rim_reach = options.rim_reach});
+    auto field = std::make_unique<const PointField>(
+        input.surfels, PointFieldOptions{.fit = options.fit, .rim_reach = options.rim_reach});
     timings.lap("field");
-    const Aabb box = field.bounds();
     const double cell =
-        choose_cell_size(field, input.surfels.bounds(), options.resolution, options.cell);
-    const CellGrid grid = grid_over(box, cell);
-    check_marching_cubes_memory(field, cell);
-    MarchingCubesResult result = marching_cubes(field, grid, {.progress = progress.callback()});
-    timings.lap("marching cubes");
-    if (result.mesh.face_count() == 0)
+        choose_cell_size(*field, input.surfels.bounds(), options.resolution, options.cell);
+    // Marching cubes of the field, its debris removed.
+    const auto polygonize = [&](const PointField& f, const std::string& suffix) {
+        const CellGrid grid = grid_over(f.bounds(), cell);
+        check_marching_cubes_memory(f, cell);
+        MarchingCubesResult made = marching_cubes(f, grid, {.progress = progress.callback()});
+        timings.lap("marching cubes" + suffix);
+        if (made.mesh.face_count() == 0)
+        {
+            throw Error(
+                "marching cubes made no triangles: the field has no defined zero crossing "
+                "at this cell size (try a smaller --cell or a larger --radius-scale)");
+        }
+        const ComponentFilterReport removed = remove_unsupported_components(
+            made.mesh, input.surfels,
+            options.min_component_samples ? *options.min_component_samples
+                                          : default_min_component_samples(input.surfels.size()));
+        timings.lap("debris" + suffix);
+        return std::pair{std::move(made), removed};
+    };
+    auto [result, debris] = polygonize(*field, "");
+    // A sponge: the field again with its fits at the noise's scale, as reconstruct makes it.
+    std::size_t sponge = 0;
+    if (field->noisy() && options.fit == PlaneFit::Quadric)
+        sponge = sponge_genus(result.mesh);
+    if (sponge > 0)
     {
-        throw Error(
-            "marching cubes made no triangles: the field has no defined zero crossing "
-            "at this cell size (try a smaller --cell or a larger --radius-scale)");
+        PointFieldOptions refit = field->options();
+        refit.noise_scale = true;
+        field.reset();
+        field = std::make_unique<const PointField>(input.surfels, refit);
+        timings.lap("field (noise scale)");
+        std::tie(result, debris) = polygonize(*field, " (noise scale)");
     }
-    const ComponentFilterReport debris = remove_unsupported_components(
-        result.mesh, input.surfels,
-        options.min_component_samples ? *options.min_component_samples
-                                      : default_min_component_samples(input.surfels.size()));
-    timings.lap("debris");
     const HandleCutReport handles =
-        cut_short_handles(result.mesh, options.max_handle * field.median_radius());
+        cut_short_handles(result.mesh, options.max_handle * field->median_radius());
     timings.lap("handles");
     const HoleFillStats holes = fill_mesh_holes(result.mesh, options.fill_holes);
     timings.lap("fill holes");
@@ -100,10 +122,11 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
         out["min_component_samples"] = debris.min_samples;
         out["components_removed"] = debris.removed_components;
         out["components_scattered"] = debris.scattered_components;
-        out["stray_samples"] = field.stray_samples().size();
+        out["stray_samples"] = field->stray_samples().size();
         out["faces_removed"] = debris.removed_faces;
         out["max_handle"] = options.max_handle;
         out["handles"] = report_json(handles);
+        out["field_noise_scale"] = {{"refitted", sponge > 0}, {"sponge_genus", sponge}};
         out["fill_holes"] = options.fill_holes;
         out["holes_filled"] = holes.holes_filled;
         out["hole_vertices"] = holes.hole_vertices;
@@ -148,9 +171,9 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
                                                    std::to_string(debris.scattered_components) + ")"
                                              : std::string()) +
             ")" +
-            (field.stray_samples().empty()
+            (field->stray_samples().empty()
                  ? std::string()
-                 : "; " + std::to_string(field.stray_samples().size()) +
+                 : "; " + std::to_string(field->stray_samples().size()) +
                        " stray samples, not where marching cubes starts"));
     print_row("handles", describe_handle_cuts(handles, options.max_handle));
     print_row("holes filled", holes.skipped_not_manifold

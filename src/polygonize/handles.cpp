@@ -717,4 +717,21 @@ HandleCutReport cut_short_handles(TriMesh& mesh, double max_length)
     }
 }
 
+std::size_t sponge_genus(const TriMesh& mesh)
+{
+    // A sponge: at least this many handles, and one for every sponge_vertices_per_handle
+    // vertices or fewer.
+    constexpr std::size_t sponge_least_genus = 64;
+    constexpr std::size_t sponge_vertices_per_handle = 500;
+    const MeshTopology topology = analyze_topology(mesh);
+    // 2 C − χ − B = 2 g, summed over the components.
+    const std::int64_t twice = static_cast<std::int64_t>(2 * topology.components) -
+                               topology.euler_characteristic -
+                               static_cast<std::int64_t>(topology.boundary_loops);
+    const std::size_t genus = twice > 0 ? static_cast<std::size_t>(twice / 2) : 0;
+    return genus >= sponge_least_genus && genus * sponge_vertices_per_handle >= topology.vertices
+               ? genus
+               : 0;
+}
+
 } // namespace pointform

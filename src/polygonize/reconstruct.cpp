@@ -289,22 +289,6 @@ double intermediate_face_limit(const PointField& field, double cell,
                     intermediate_faces_per_base_face * static_cast<double>(target));
 }
 
-/// A sponge (reconstruct()): marching cubes made a mesh of at least this many handles, and one
-/// handle for every sponge_vertices_per_handle vertices or fewer. The noisy 1M thin plate of
-/// bench/peers (faces 3.4 noise deviations apart) made genus 7,355 in 150,038 vertices (one
-/// per 20); the noisy inputs of bench/peers at 100k and 1M and the simulated scans at most 11.
-constexpr std::size_t sponge_least_genus = 64;
-constexpr std::size_t sponge_vertices_per_handle = 500;
-
-/// Handles of a mesh, summed over its components (2 C − χ − B = 2 g).
-std::size_t genus_of(const MeshTopology& topology)
-{
-    const auto twice = static_cast<std::int64_t>(2 * topology.components) -
-                       topology.euler_characteristic -
-                       static_cast<std::int64_t>(topology.boundary_loops);
-    return twice > 0 ? static_cast<std::size_t>(twice / 2) : 0;
-}
-
 /// reconstruct()'s intermediate mesh: marching cubes of `field` over the cells that
 /// choose_cell_size() and intermediate_grid() give, its debris removed; its figures into
 /// `report`.
@@ -400,10 +384,7 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
         // its fits at the scale of the noise, and its mesh.
         if (field->noisy() && field->options().fit == PlaneFit::Quadric)
         {
-            const MeshTopology topology = analyze_topology(intermediate_mesh);
-            const std::size_t genus = genus_of(topology);
-            if (genus >= sponge_least_genus &&
-                genus * sponge_vertices_per_handle >= topology.vertices)
+            if (const std::size_t genus = sponge_genus(intermediate_mesh); genus > 0)
             {
                 report.sponge_genus = genus;
                 PointFieldOptions refit = field->options();

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <numbers>
 #include <string>
@@ -201,6 +202,38 @@ TEST(McCli, DebrisOfStraySamplesIsRemoved)
     const TriMesh mesh = read_mesh(dir / "out.ply");
     for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
         ASSERT_NEAR(mesh.vertices.world(v).norm(), 1.0, 0.02) << v;
+}
+
+TEST(McCli, ASpongeIsMadeAgainAtTheNoisesScale)
+{
+    // A plate 0.06 thick under noise of 0.0063 of the diagonal (2 sampling steps at 100k): its
+    // faces merge into one slab and its field's fits, narrower than the slab, make a sponge. As
+    // reconstruct does, mc makes the field again with its fits at the noise's scale (one sheet);
+    // a noisy sphere's field stays as it was.
+    test::TempDir dir;
+    ASSERT_EQ(
+        run("sample plate --thickness 0.06 --noise 0.0063 -n 100000 -o " + quoted(dir / "slab.ply"))
+            .exit_code,
+        0);
+    const auto r = run("mc " + quoted(dir / "slab.ply") + " -o " + quoted(dir / "slab_mc.ply") +
+                       " --reestimate --json");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const auto report = nlohmann::json::parse(r.out);
+    EXPECT_TRUE(report["field_noise_scale"]["refitted"].get<bool>());
+    EXPECT_GE(report["field_noise_scale"]["sponge_genus"].get<std::size_t>(), 64U);
+    const MeshTopology topo = analyze_topology(read_mesh(dir / "slab_mc.ply"));
+    // Handles left: at most a few (the sponge had over a thousand).
+    const std::int64_t twice_genus = 2 * static_cast<std::int64_t>(topo.components) -
+                                     topo.euler_characteristic -
+                                     static_cast<std::int64_t>(topo.boundary_loops);
+    EXPECT_LE(twice_genus, 4);
+
+    ASSERT_EQ(
+        run("sample sphere --noise 0.002 -n 30000 -o " + quoted(dir / "sphere.ply")).exit_code, 0);
+    const auto sphere = run("mc " + quoted(dir / "sphere.ply") + " -o " +
+                            quoted(dir / "sphere_mc.ply") + " --reestimate --json");
+    ASSERT_EQ(sphere.exit_code, 0) << sphere.out;
+    EXPECT_FALSE(nlohmann::json::parse(sphere.out)["field_noise_scale"]["refitted"].get<bool>());
 }
 
 TEST(McCli, BadOptionsAndInputsFailCleanly)
