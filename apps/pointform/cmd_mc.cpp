@@ -82,12 +82,15 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
     auto [result, debris] = polygonize(*field, "");
     // A sponge: the field again with its fits at the noise's scale, as reconstruct makes it.
     std::size_t sponge = 0;
+    std::size_t sponge_cells = 0;
     if (field->noisy() && options.fit == PlaneFit::Quadric)
         sponge = sponge_genus(result.mesh);
     if (sponge > 0)
     {
         PointFieldOptions refit = field->options();
         refit.noise_scale = true;
+        refit.noise_scale_region = spongy_cells(result.mesh, field->median_radius());
+        sponge_cells = refit.noise_scale_region.cells.size();
         field.reset();
         field = std::make_unique<const PointField>(input.surfels, refit);
         timings.lap("field (noise scale)");
@@ -126,7 +129,8 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
         out["faces_removed"] = debris.removed_faces;
         out["max_handle"] = options.max_handle;
         out["handles"] = report_json(handles);
-        out["field_noise_scale"] = {{"refitted", sponge > 0}, {"sponge_genus", sponge}};
+        out["field_noise_scale"] = {
+            {"refitted", sponge > 0}, {"sponge_genus", sponge}, {"cells", sponge_cells}};
         out["fill_holes"] = options.fill_holes;
         out["holes_filled"] = holes.holes_filled;
         out["hole_vertices"] = holes.hole_vertices;

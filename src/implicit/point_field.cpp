@@ -1486,7 +1486,10 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
             const double noise = fit_local_surface(
                 fit_positions, fit_normals, neighbors, samples[q], options.fit,
                 options.quadric_narrow_k, on_rim, packed, narrow_tests.empty() ? nullptr : &narrow);
-            if (!fit_noise.empty())
+            if (!fit_noise.empty() &&
+                (options.noise_scale_region.cells.empty() ||
+                 options.noise_scale_region.contains(m.surfels.origin +
+                                                     m.surfels.positions[i].cast<double>())))
             {
                 fit_noise[i] = static_cast<float>(noise);
                 fit_on_rim[i] = on_rim ? 1 : 0;
@@ -2111,6 +2114,21 @@ const PointFieldOptions& PointField::options() const
 double PointField::median_radius() const
 {
     return impl_->median_radius;
+}
+
+bool NoiseScaleRegion::contains(const Vec3d& p) const
+{
+    if (cells.empty() || !(size > 0.0))
+        return false;
+    std::array<std::int32_t, 3> cell{};
+    for (int a = 0; a < 3; ++a)
+    {
+        const double c = std::floor(p[a] / size);
+        if (!(std::abs(c) < 2e9))
+            return false;
+        cell[a] = static_cast<std::int32_t>(c);
+    }
+    return std::binary_search(cells.begin(), cells.end(), cell);
 }
 
 bool PointField::noisy() const

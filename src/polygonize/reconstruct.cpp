@@ -389,6 +389,8 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
                 report.sponge_genus = genus;
                 PointFieldOptions refit = field->options();
                 refit.noise_scale = true;
+                refit.noise_scale_region = spongy_cells(intermediate_mesh, field->median_radius());
+                report.sponge_cells = refit.noise_scale_region.cells.size();
                 PointCloud samples = field->surfels();
                 field.reset();
                 field = std::make_unique<const PointField>(std::move(samples), refit);

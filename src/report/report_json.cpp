@@ -273,7 +273,8 @@ nlohmann::json report_json(const ReconstructReport& report, const ReconstructOpt
                          {"stray_samples", report.stray_samples}};
         out["handles"] = report_json(report.handles);
         out["field_noise_scale"] = {{"refitted", report.sponge_genus > 0},
-                                    {"sponge_genus", report.sponge_genus}};
+                                    {"sponge_genus", report.sponge_genus},
+                                    {"cells", report.sponge_cells}};
     }
     else if (report.picked)
     {

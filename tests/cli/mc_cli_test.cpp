@@ -221,6 +221,7 @@ TEST(McCli, ASpongeIsMadeAgainAtTheNoisesScale)
     const auto report = nlohmann::json::parse(r.out);
     EXPECT_TRUE(report["field_noise_scale"]["refitted"].get<bool>());
     EXPECT_GE(report["field_noise_scale"]["sponge_genus"].get<std::size_t>(), 64U);
+    EXPECT_GT(report["field_noise_scale"]["cells"].get<std::size_t>(), 0U);
     const MeshTopology topo = analyze_topology(read_mesh(dir / "slab_mc.ply"));
     // Handles left: at most a few (the sponge had over a thousand).
     const std::int64_t twice_genus = 2 * static_cast<std::int64_t>(topo.components) -

@@ -1060,11 +1060,13 @@ PointCloud noisy_slab_surfels()
     return surfels_from_samples(raw).surfels;
 }
 
-/// The share of vertical lines through the slab's inside (400 of them) whose field, where it is
-/// defined, changes sign exactly once.
-double share_crossed_once(const PointField& field, const Vec3d& origin)
+/// The share of vertical lines through the slab's inside (400 of them, x in [x0, x1], |y| under
+/// 0.8) whose field, where it is defined, changes sign exactly once.
+double share_crossed_once(const PointField& field, const Vec3d& origin, double x0 = -0.8,
+                          double x1 = 0.8)
 {
     std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> along(x0, x1);
     std::uniform_real_distribution<double> across(-0.8, 0.8);
     constexpr int lines = 400;
     constexpr int steps = 161;
@@ -1073,7 +1075,7 @@ double share_crossed_once(const PointField& field, const Vec3d& origin)
     std::vector<FieldSample> values(steps);
     for (int line = 0; line < lines; ++line)
     {
-        const double x = across(rng);
+        const double x = along(rng);
         const double y = across(rng);
         for (int z = 0; z < steps; ++z)
             points[z] = Vec3d(x, y, -0.08 + 0.16 * z / (steps - 1)) - origin;
@@ -1109,6 +1111,19 @@ TEST(PointField, NoiseScaleFitsMakeOneSheetOfANoisySlab)
     RecordProperty("scaled_once", std::to_string(scaled_once));
     EXPECT_LT(fine_once, 0.8); // the input shows what the option is for
     EXPECT_GT(scaled_once, 0.95);
+    // Only where asked: fits made again in the cells of x < 0 (cells of 0.1), not beyond.
+    NoiseScaleRegion half{.size = 0.1};
+    for (std::int32_t x = -12; x < 0; ++x)
+        for (std::int32_t y = -12; y < 12; ++y)
+            for (std::int32_t z = -2; z < 2; ++z)
+                half.cells.push_back({x, y, z});
+    std::sort(half.cells.begin(), half.cells.end());
+    const PointField halved(surfels, {.noise_scale = true, .noise_scale_region = half});
+    EXPECT_GT(share_crossed_once(halved, surfels.origin, -0.8, -0.1), 0.95);
+    EXPECT_LT(share_crossed_once(halved, surfels.origin, 0.1, 0.8), 0.8);
+    EXPECT_TRUE(half.contains(Vec3d(-0.05, 0.5, 0.01)));
+    EXPECT_FALSE(half.contains(Vec3d(0.05, 0.5, 0.01)));
+    EXPECT_FALSE(NoiseScaleRegion{}.contains(Vec3d::Zero()));
     // A clean cloud keeps its fits: the same field.
     const PointCloud sphere =
         surfels_from_samples(sample_shape(Shape::Sphere, {.count = 20000})).surfels;

@@ -106,6 +106,27 @@ std::size_t genus(const TriMesh& mesh)
                                     2);
 }
 
+TEST(Handles, ARealHandleIsNoSponge)
+{
+    // A torus's inner side curves negatively (-4π in all, spread round its inner circle), a
+    // sphere's positively: no cell of 8 radii adds up to two handles. Cells of 0.5 here.
+    TriMesh torus;
+    add_torus(torus, Vec3d::Zero(), 1.0, 0.1, 120, 24);
+    EXPECT_TRUE(spongy_cells(torus, 0.5 / 8.0).cells.empty());
+    EXPECT_EQ(sponge_genus(torus), 0U);
+    TriMesh sphere;
+    add_revolution(
+        sphere, Vec3d::Zero(), [](double t) { return std::sin(pi * t); },
+        [](double t) { return -std::cos(pi * t); }, 40, 60, false);
+    EXPECT_TRUE(spongy_cells(sphere, 0.5 / 8.0).cells.empty());
+    // Many tori in one cell, each a piece of its own: each adds up to 0 (a handle's -4π counts
+    // only where it is attached to a surface), and they are not a sponge either.
+    TriMesh many;
+    for (int i = 0; i < 80; ++i)
+        add_torus(many, Vec3d(0.01 * i, 0.0, 0.0), 0.05, 0.01, 24, 12);
+    EXPECT_TRUE(spongy_cells(many, 1.0).cells.empty());
+}
+
 TEST(Handles, TheShortestLoopOfATorusIsItsTubesMeridian)
 {
     TriMesh torus;

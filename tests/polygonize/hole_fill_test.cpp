@@ -839,6 +839,7 @@ TEST(Reconstruct, ANoisySpongeIsMadeAgainAtTheNoisesScale)
     }
     const ReconstructReport report = reconstruct(surfels_from_samples(raw).surfels, {});
     EXPECT_GE(report.sponge_genus, 64U);
+    EXPECT_GT(report.sponge_cells, 0U);
     const MultiresMesh& mesh = report.semi_regular.hierarchy;
     const TriMesh finest = mesh.level_mesh(mesh.finest_level());
     const MeshTopology topology = analyze_topology(finest);

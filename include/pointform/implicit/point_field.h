@@ -7,11 +7,13 @@
 #include "pointform/implicit/field.h"
 #include "pointform/spatial/kd_tree.h"
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <span>
 #include <string_view>
+#include <vector>
 
 namespace pointform {
 
@@ -39,6 +41,16 @@ enum class PlaneFit
 /// \brief Parses "raw", "centroid", "blend" or "quadric". \throw InvalidInput otherwise
 [[nodiscard]] PlaneFit parse_plane_fit(std::string_view text);
 [[nodiscard]] std::string_view to_string(PlaneFit fit);
+
+/// \brief Cells of a uniform grid anchored at the world origin (cell c spans size·c to
+/// size·(c + 1)): where PointFieldOptions::noise_scale applies.
+struct NoiseScaleRegion
+{
+    double size = 0.0;
+    std::vector<std::array<std::int32_t, 3>> cells; ///< ascending
+    /// \brief Whether world point `p` lies in one of the cells (false when there are none).
+    [[nodiscard]] bool contains(const Vec3d& p) const;
+};
 
 struct PointFieldOptions
 {
@@ -103,6 +115,8 @@ struct PointFieldOptions
     /// bench/peers: the field at the truth 0.0020 -> 0.0040 off near its creases, 0.0016 ->
     /// 0.0015 elsewhere); reconstruct() turns it on where the field's surface comes out a sponge.
     bool noise_scale = false;
+    /// Where noise_scale applies, by the samples' positions; empty cells = everywhere.
+    NoiseScaleRegion noise_scale_region;
     /// Answer deep-inside queries from the far grid (see PointField): constant time, within
     /// 2√3 h of the distance. False: the nearly nearest kd-tree search, as outside (within 1%),
     /// slower deep inside a closed scan; for callers that take inside values as distances

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "pointform/geometry/tri_mesh.h"
+#include "pointform/implicit/point_field.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -67,5 +68,13 @@ HandleCutReport cut_short_handles(TriMesh& mesh, double max_length);
 /// 1M and the simulated scans made at most 16. A surface with many real handles (a grille, a
 /// perforated sheet) has several hundred vertices a handle, and is not taken for one.
 [[nodiscard]] std::size_t sponge_genus(const TriMesh& mesh);
+
+/// \brief Where a sponge's handles are: the cells of a grid of 8 influence radii (`radius`; world
+/// coordinates) whose
+/// vertices' angle defects (2π less the angles round an interior vertex; discrete Gauss-Bonnet:
+/// they add up to 2π χ) add up to -8π or less, two handles' worth, and the cells round them
+/// (one cell each way). A smooth sheet's cell adds up to about its integral of Gaussian
+/// curvature, a small part of 4π for cells of a few influence radii.
+[[nodiscard]] NoiseScaleRegion spongy_cells(const TriMesh& mesh, double radius);
 
 } // namespace pointform

@@ -249,6 +249,9 @@ struct ReconstructReport
     /// made again with PointFieldOptions::noise_scale (and the figures above are its mesh's);
     /// 0 where it was not.
     std::size_t sponge_genus = 0;
+    /// The cells of spongy_cells() (its handles and the cells round them) that the field's fits
+    /// were made again in; 0: everywhere, or no sponge.
+    std::size_t sponge_cells = 0;
     /// The picked base mesh, when ReconstructOptions::base_mesh or picked_vertices was given, and
     /// its angles.
     std::optional<PickedBaseMesh> picked;
