@@ -104,6 +104,7 @@ class Field:
         far_grid: bool = True,
         rim_reach: float = 0.25,
         crease_fit: bool = True,
+        noise_scale: bool = False,
     ) -> None: ...
     @overload
     def evaluate(

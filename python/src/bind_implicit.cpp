@@ -65,10 +65,11 @@ void bind_implicit(py::module_& m)
         "pointform.scene() makes one from the modeling language. Immutable and safe to "
         "evaluate from many threads.")
         .def(py::init([](const std::shared_ptr<Cloud>& surfels, const std::string& fit,
-                         bool far_grid, double rim_reach, bool crease_fit) {
+                         bool far_grid, double rim_reach, bool crease_fit, bool noise_scale) {
                  PointFieldOptions options{.fit = parse_plane_fit(fit),
                                            .crease_fit = crease_fit,
                                            .rim_reach = rim_reach,
+                                           .noise_scale = noise_scale,
                                            .far_grid = far_grid};
                  std::shared_ptr<const PointField> field;
                  {
@@ -82,7 +83,9 @@ void bind_implicit(py::module_& m)
              py::arg("surfels"), py::kw_only(), py::arg("fit") = "quadric",
              py::arg("far_grid") = true, py::arg("rim_reach") = PointFieldOptions{}.rim_reach,
              py::arg("crease_fit") = PointFieldOptions{}.crease_fit,
-             "Field(surfels, *, fit='quadric', far_grid=True, rim_reach=0.25, crease_fit=True)\n\n"
+             py::arg("noise_scale") = PointFieldOptions{}.noise_scale,
+             "Field(surfels, *, fit='quadric', far_grid=True, rim_reach=0.25, crease_fit=True, "
+             "noise_scale=False)\n\n"
              "The signed point field of surfels with normals and radii (pointform.surfels()). "
              "fit: the local surfaces, 'quadric' (default), 'blend', 'centroid' or 'raw' (the "
              "paper's tangent planes). far_grid=False answers deep-inside queries by search "
@@ -94,7 +97,10 @@ void bind_implicit(py::module_& m)
              "crease of a clean cloud, the union of its face and the other face's plane), so "
              "that faces meet there instead of being rounded off or running past it; False = "
              "the principal "
-             "normal's quadric everywhere. Raises InvalidInput for a cloud without normals or "
+             "normal's quadric everywhere. noise_scale (quadric only, noisy clouds): each "
+             "sample's quadric fitted again over coarser subsamples until its residuals are a "
+             "fifth of its reach (pointform.reconstruct turns it on where its surface comes out a "
+             "sponge). Raises InvalidInput for a cloud without normals or "
              "radii, or non-finite or non-positive ones, or rim_reach out of range.")
         .def("evaluate", &evaluate, py::arg("points"), py::kw_only(), py::arg("defined") = false,
              "evaluate(points, *, defined=False) -> (values, gradients[, defined])\n\n"

@@ -141,3 +141,38 @@ def test_scene_fields_are_exact():
         pointform.scene("sphere([0, 0, 0], 1")
     with pytest.raises(pointform.InvalidInput, match="did you mean 'sphere'"):
         pointform.scene("spher([0, 0, 0], 1)")
+
+
+def noisy_slab(n=100000, thickness=0.06, noise=0.018, seed=3):
+    """Raw points of a 2 x 2 plate `thickness` thick (its top and bottom faces only) under
+    Gaussian noise of `noise` (2 sampling steps at 100k): the faces, 3.3 deviations apart, merge
+    into one slab of samples."""
+    rng = np.random.default_rng(seed)
+    xy = rng.uniform(-1.0, 1.0, (n, 2))
+    z = np.where(rng.random(n) < 0.5, 0.5, -0.5) * thickness
+    return np.column_stack([xy, z]) + rng.normal(0.0, noise, (n, 3))
+
+
+def test_noise_scale_fits_make_one_sheet_of_a_noisy_slab():
+    surfels, _ = pointform.surfels(pointform.PointCloud(noisy_slab()))
+    rng = np.random.default_rng(5)
+    xy = rng.uniform(-0.8, 0.8, (200, 2))
+    z = np.linspace(-0.08, 0.08, 161)
+    lines = np.concatenate([np.column_stack([np.full(z.size, x), np.full(z.size, y), z])
+                            for x, y in xy])
+
+    def crossed_once(field):
+        values, _, defined = field.evaluate(lines, defined=True)
+        once = 0
+        for v, d in zip(values.reshape(len(xy), z.size), defined.reshape(len(xy), z.size)):
+            signs = np.sign(v[d])
+            once += int(np.count_nonzero(signs[1:] != signs[:-1]) == 1)
+        return once / len(xy)
+
+    assert crossed_once(pointform.Field(surfels)) < 0.8  # fits narrower than the slab
+    assert crossed_once(pointform.Field(surfels, noise_scale=True)) > 0.95
+    # reconstruct finds the sponge and makes the field again, as the CLI does.
+    report = pointform.reconstruct(pointform.PointCloud(noisy_slab())).report
+    assert report["field_noise_scale"]["refitted"]
+    assert report["field_noise_scale"]["sponge_genus"] >= 64
+    assert report["base_mesh"]["euler_characteristic"] == 1  # one sheet, one rim
