@@ -1134,5 +1134,30 @@ TEST(PointField, NoiseScaleFitsMakeOneSheetOfANoisySlab)
         EXPECT_EQ(plain.evaluate(p).value, asked.evaluate(p).value);
 }
 
+TEST(PointField, NoiseScaleFitsAreTheSameForAnyThreadCount)
+{
+    // The refits run in blocks of the samples still too noisy, level by level: the same field
+    // bit for bit at 1, 2 and 3 threads.
+    const PointCloud surfels = noisy_slab_surfels();
+    std::vector<Vec3d> points;
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> across(-0.9, 0.9);
+    std::uniform_real_distribution<double> up(-0.06, 0.06);
+    for (int i = 0; i < 2000; ++i)
+        points.push_back(Vec3d(across(rng), across(rng), up(rng)) - surfels.origin);
+    const auto runs = test::at_thread_counts([&] {
+        const PointField field(surfels, {.noise_scale = true});
+        std::vector<FieldSample> out(points.size());
+        field.evaluate(points, out);
+        return out;
+    });
+    for (std::size_t i = 0; i < points.size(); ++i)
+        for (std::size_t r = 1; r < runs.size(); ++r)
+        {
+            ASSERT_EQ(runs[r][i].value, runs[0][i].value) << i;
+            ASSERT_EQ(runs[r][i].defined, runs[0][i].defined) << i;
+        }
+}
+
 } // namespace
 } // namespace pointform
