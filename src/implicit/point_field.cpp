@@ -490,12 +490,12 @@ void knn_of_batch(const PointGrid& grid, const KdTree& tree, std::span<const Vec
 /// the order of a point grid of its own (cells of `cell`) for batch searches.
 struct CoarseSamples
 {
+    std::vector<Vec3f> tree_positions; ///< the kd-tree's points (it refers to them: declared first)
     std::unique_ptr<KdTree> tree;
     std::unique_ptr<PointGrid> grid;
     std::vector<Vec3f> positions;        ///< by grid slot
     std::vector<Vec3f> normals;          ///< by grid slot
     std::vector<std::uint32_t> original; ///< by grid slot: the index in the cloud
-    std::vector<Vec3f> tree_positions;   ///< the kd-tree's points
 };
 
 /// The coarse subsamples of `positions` and `normals` (samples in Morton order), finest first,
@@ -520,8 +520,9 @@ std::vector<CoarseSamples> coarse_samples(std::span<const Vec3f> positions,
             index.push_back(static_cast<std::uint32_t>(i));
         }
         CoarseSamples c;
-        c.tree = std::make_unique<KdTree>(subsample);
-        c.grid = std::make_unique<PointGrid>(subsample, cell, *c.tree);
+        c.tree_positions = std::move(subsample);
+        c.tree = std::make_unique<KdTree>(c.tree_positions);
+        c.grid = std::make_unique<PointGrid>(c.tree_positions, cell, *c.tree);
         c.positions.resize(c.grid->slot_count(), Vec3f::Zero());
         c.normals.resize(c.grid->slot_count(), Vec3f::Zero());
         c.original.resize(c.grid->slot_count(), PointGrid::padding_slot);
@@ -530,13 +531,11 @@ std::vector<CoarseSamples> coarse_samples(std::span<const Vec3f> positions,
             const std::uint32_t j = c.grid->original_index(slot);
             if (j == PointGrid::padding_slot)
                 continue;
-            c.positions[slot] = subsample[j];
+            c.positions[slot] = c.tree_positions[j];
             c.normals[slot] = normals[index[j]];
             c.original[slot] = index[j];
         }
-        // The kd-tree answers from the subsample's own array: keep it alive with the level.
-        c.tree_positions = std::move(subsample);
-        levels.push_back(std::move(c));
+        levels.push_back(std::move(c)); // the vectors' buffers move with them
     }
     return levels;
 }
