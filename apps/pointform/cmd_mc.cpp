@@ -83,16 +83,12 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
     // A sponge: the field again with its fits at the noise's scale, as reconstruct makes it.
     std::size_t sponge = 0;
     std::size_t sponge_cells = 0;
-    if (field->noisy() && options.fit == PlaneFit::Quadric)
-        sponge = sponge_genus(result.mesh);
-    if (sponge > 0)
+    if (const std::optional<SpongeRefit> refit = sponge_refit(*field, result.mesh))
     {
-        PointFieldOptions refit = field->options();
-        refit.noise_scale = true;
-        refit.noise_scale_region = spongy_cells(result.mesh, field->median_radius());
-        sponge_cells = refit.noise_scale_region.cells.size();
+        sponge = refit->genus;
+        sponge_cells = refit->options.noise_scale_region.cells.size();
         field.reset();
-        field = std::make_unique<const PointField>(input.surfels, refit);
+        field = std::make_unique<const PointField>(input.surfels, refit->options);
         timings.lap("field (noise scale)");
         std::tie(result, debris) = polygonize(*field, " (noise scale)");
     }

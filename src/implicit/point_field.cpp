@@ -2115,19 +2115,27 @@ double PointField::median_radius() const
     return impl_->median_radius;
 }
 
-bool NoiseScaleRegion::contains(const Vec3d& p) const
+std::optional<std::array<std::int32_t, 3>> NoiseScaleRegion::cell_of(const Vec3d& p) const
 {
-    if (cells.empty() || !(size > 0.0))
-        return false;
+    if (!(size > 0.0))
+        return std::nullopt;
     std::array<std::int32_t, 3> cell{};
     for (int a = 0; a < 3; ++a)
     {
         const double c = std::floor(p[a] / size);
         if (!(std::abs(c) < 2e9))
-            return false;
+            return std::nullopt;
         cell[a] = static_cast<std::int32_t>(c);
     }
-    return std::binary_search(cells.begin(), cells.end(), cell);
+    return cell;
+}
+
+bool NoiseScaleRegion::contains(const Vec3d& p) const
+{
+    if (cells.empty())
+        return false;
+    const auto cell = cell_of(p);
+    return cell && std::binary_search(cells.begin(), cells.end(), *cell);
 }
 
 bool PointField::noisy() const

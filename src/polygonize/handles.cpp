@@ -15,6 +15,7 @@
 #include <limits>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <queue>
 #include <span>
 #include <utility>
@@ -748,28 +749,7 @@ NoiseScaleRegion spongy_cells(const TriMesh& mesh, double radius)
         return region;
     const std::size_t n = mesh.vertex_count();
     // Boundary vertices (an edge of one triangle) have no angle defect of their own.
-    std::vector<std::uint8_t> boundary(n, 0);
-    {
-        std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
-        edges.reserve(3 * mesh.face_count());
-        for (const Triangle& t : mesh.triangles)
-            for (int c = 0; c < 3; ++c)
-            {
-                const std::uint32_t a = t[c];
-                const std::uint32_t b = t[(c + 1) % 3];
-                edges.emplace_back(std::min(a, b), std::max(a, b));
-            }
-        std::sort(edges.begin(), edges.end());
-        for (std::size_t e = 0; e < edges.size();)
-        {
-            std::size_t same = e + 1;
-            while (same < edges.size() && edges[same] == edges[e])
-                ++same;
-            if (same - e == 1)
-                boundary[edges[e].first] = boundary[edges[e].second] = 1;
-            e = same;
-        }
-    }
+    const std::vector<char> boundary = edge_graph(mesh).on_boundary;
     std::vector<double> defect(n, 2.0 * std::numbers::pi);
     const auto& positions = mesh.vertices.positions;
     for (const Triangle& t : mesh.triangles)
@@ -789,17 +769,8 @@ NoiseScaleRegion spongy_cells(const TriMesh& mesh, double radius)
     {
         if (boundary[v] != 0)
             continue;
-        const Vec3d p = mesh.vertices.origin + positions[v].cast<double>();
-        std::array<std::int32_t, 3> key{};
-        bool inside = true;
-        for (int a = 0; a < 3; ++a)
-        {
-            const double c = std::floor(p[a] / cell);
-            inside = inside && std::abs(c) < 2e9;
-            key[a] = inside ? static_cast<std::int32_t>(c) : 0;
-        }
-        if (inside)
-            sums.emplace_back(key, defect[v]);
+        if (const auto key = region.cell_of(mesh.vertices.origin + positions[v].cast<double>()))
+            sums.emplace_back(*key, defect[v]);
     }
     std::sort(sums.begin(), sums.end(),
               [](const auto& a, const auto& b) { return a.first < b.first; });
@@ -821,6 +792,19 @@ NoiseScaleRegion spongy_cells(const TriMesh& mesh, double radius)
     std::sort(region.cells.begin(), region.cells.end());
     region.cells.erase(std::unique(region.cells.begin(), region.cells.end()), region.cells.end());
     return region;
+}
+
+std::optional<SpongeRefit> sponge_refit(const PointField& field, const TriMesh& mesh)
+{
+    if (!field.noisy() || field.options().fit != PlaneFit::Quadric)
+        return std::nullopt;
+    const std::size_t genus = sponge_genus(mesh);
+    if (genus == 0)
+        return std::nullopt;
+    SpongeRefit refit{.genus = genus, .options = field.options()};
+    refit.options.noise_scale = true;
+    refit.options.noise_scale_region = spongy_cells(mesh, field.median_radius());
+    return refit;
 }
 
 } // namespace pointform

@@ -382,22 +382,16 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
         TriMesh intermediate_mesh = intermediate_mesh_of(*field, bounds, options, report, clock);
         // A sponge: the fits follow the noise (PointFieldOptions::noise_scale). The field again,
         // its fits at the scale of the noise, and its mesh.
-        if (field->noisy() && field->options().fit == PlaneFit::Quadric)
+        if (const std::optional<SpongeRefit> refit = sponge_refit(*field, intermediate_mesh))
         {
-            if (const std::size_t genus = sponge_genus(intermediate_mesh); genus > 0)
-            {
-                report.sponge_genus = genus;
-                PointFieldOptions refit = field->options();
-                refit.noise_scale = true;
-                refit.noise_scale_region = spongy_cells(intermediate_mesh, field->median_radius());
-                report.sponge_cells = refit.noise_scale_region.cells.size();
-                PointCloud samples = field->surfels();
-                field.reset();
-                field = std::make_unique<const PointField>(std::move(samples), refit);
-                clock.lap("field (noise scale)");
-                intermediate_mesh =
-                    intermediate_mesh_of(*field, bounds, options, report, clock, " (noise scale)");
-            }
+            report.sponge_genus = refit->genus;
+            report.sponge_cells = refit->options.noise_scale_region.cells.size();
+            PointCloud samples = field->surfels();
+            field.reset();
+            field = std::make_unique<const PointField>(std::move(samples), refit->options);
+            clock.lap("field (noise scale)");
+            intermediate_mesh =
+                intermediate_mesh_of(*field, bounds, options, report, clock, " (noise scale)");
         }
         report.handles =
             cut_short_handles(intermediate_mesh, options.max_handle * field->median_radius());

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -48,6 +49,9 @@ struct NoiseScaleRegion
 {
     double size = 0.0;
     std::vector<std::array<std::int32_t, 3>> cells; ///< ascending
+    /// \brief The cell of world point `p`; nullopt where the size is not positive or the cell's
+    /// index is beyond 32 bits.
+    [[nodiscard]] std::optional<std::array<std::int32_t, 3>> cell_of(const Vec3d& p) const;
     /// \brief Whether world point `p` lies in one of the cells (false when there are none).
     [[nodiscard]] bool contains(const Vec3d& p) const;
 };

@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace pointform {
@@ -76,5 +77,17 @@ HandleCutReport cut_short_handles(TriMesh& mesh, double max_length);
 /// (one cell each way). A smooth sheet's cell adds up to about its integral of Gaussian
 /// curvature, a small part of 4π for cells of a few influence radii.
 [[nodiscard]] NoiseScaleRegion spongy_cells(const TriMesh& mesh, double radius);
+
+/// \brief A field to make again (SpongeRefit::options) where marching cubes of `field` made
+/// `mesh` a sponge (SpongeRefit::genus, sponge_genus()): `field`'s options with
+/// PointFieldOptions::noise_scale on in the spongy_cells() of `mesh`. Nullopt where `field` is
+/// not a noisy cloud's quadric field or `mesh` is no sponge. What reconstruct() and `pointform
+/// mc` do with their marching-cubes mesh.
+struct SpongeRefit
+{
+    std::size_t genus = 0;
+    PointFieldOptions options;
+};
+[[nodiscard]] std::optional<SpongeRefit> sponge_refit(const PointField& field, const TriMesh& mesh);
 
 } // namespace pointform
