@@ -94,6 +94,10 @@ struct CreaseFill
     };
     std::vector<Face> faces;
     bool convex = true; ///< the crease's kind: max of the faces' values, else min
+    /// The faces were fitted as curved faces to a kinked rim (crease_kinked_rim): the faired
+    /// surface across may lie on either side of them (a thin plate across a seam of two balls
+    /// cuts the convex way along the seam and the concave way across it).
+    bool curved = false;
 
     /// Face g's signed height at x: positive outside (along its axis), world units.
     [[nodiscard]] double face_value(std::size_t g, const Vec3d& x) const
@@ -560,6 +564,8 @@ inline double one_face_residual(std::span<const Vec3d> at, std::span<const Vec3d
         else if (kinked)
         {
             fill = regroup(parting);
+            if (fill)
+                fill->curved = true;
             if (fill &&
                 (!holds(
                      parting,

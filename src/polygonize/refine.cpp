@@ -1435,11 +1435,16 @@ std::size_t onto_crease_faces(std::span<Vec3d> x, std::span<const Vec3d> normal,
             if (!(at_start != 0.0) || !std::isfinite(at_start) || !(reach > 0.0))
                 continue;
             // Only across the corner the thin plate cuts: out to a convex crease from inside
-            // its faces, in to a concave one from outside them. The nearest sign change that
-            // way.
-            const double sign = region.fill.convex ? 1.0 : -1.0;
+            // its faces, in to a concave one from outside them; either way onto curved faces
+            // (CreaseFill::curved), which a thin plate can also cut the other way. The nearest
+            // sign change that way.
+            double sign = region.fill.convex ? 1.0 : -1.0;
             if ((at_start > 0.0) == region.fill.convex)
-                continue;
+            {
+                if (!region.fill.curved)
+                    continue;
+                sign = -sign;
+            }
             double inner = 0.0;
             double outer = 0.0;
             for (int step = 1; step <= crease_search_steps; ++step)
