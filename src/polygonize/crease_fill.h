@@ -99,13 +99,28 @@ struct CreaseFill
     /// cuts the convex way along the seam and the concave way across it).
     bool curved = false;
 
+    /// Where x lies over face g's plane: d = (x - origin) / scale and its coordinates u, v
+    /// along the tangent and the bitangent (axis × tangent).
+    struct Local
+    {
+        Vec3d d;
+        Vec3d bitangent;
+        double u;
+        double v;
+    };
+    [[nodiscard]] Local local(std::size_t g, const Vec3d& x) const
+    {
+        const Face& face = faces[g];
+        const Vec3d d = (x - face.origin) / face.scale;
+        const Vec3d bitangent = face.axis.cross(face.tangent);
+        return {d, bitangent, d.dot(face.tangent), d.dot(bitangent)};
+    }
+
     /// Face g's signed height at x: positive outside (along its axis), world units.
     [[nodiscard]] double face_value(std::size_t g, const Vec3d& x) const
     {
         const Face& face = faces[g];
-        const Vec3d d = (x - face.origin) / face.scale;
-        const double u = d.dot(face.tangent);
-        const double v = d.dot(face.axis.cross(face.tangent));
+        const auto [d, bitangent, u, v] = local(g, x);
         const auto& c = face.height;
         const double h = c[0] * u * u + c[1] * u * v + c[2] * v * v + c[3] * u + c[4] * v + c[5];
         return (d.dot(face.axis) - h) * face.scale;
@@ -115,10 +130,7 @@ struct CreaseFill
     [[nodiscard]] Vec3d face_normal(std::size_t g, const Vec3d& x) const
     {
         const Face& face = faces[g];
-        const Vec3d bitangent = face.axis.cross(face.tangent);
-        const Vec3d d = (x - face.origin) / face.scale;
-        const double u = d.dot(face.tangent);
-        const double v = d.dot(bitangent);
+        const auto [d, bitangent, u, v] = local(g, x);
         const auto& c = face.height;
         const double du = 2.0 * c[0] * u + c[1] * v + c[3];
         const double dv = c[1] * u + 2.0 * c[2] * v + c[4];
@@ -184,6 +196,25 @@ inline double rms_spread(std::span<const Vec3d> points)
     return std::sqrt(squared / static_cast<double>(points.size()));
 }
 
+/// The unit mean of each of the `k` groups of unit vectors (`group[i]`: unit[i]'s), or nothing
+/// when a group's sum is zero (empty, or its vectors cancel).
+inline std::optional<std::vector<Vec3d>> group_means(std::span<const Vec3d> unit,
+                                                     std::span<const std::uint8_t> group,
+                                                     std::size_t k)
+{
+    std::vector<Vec3d> sum(k, Vec3d::Zero());
+    for (std::size_t i = 0; i < unit.size(); ++i)
+        sum[group[i]] += unit[i];
+    for (Vec3d& s : sum)
+    {
+        const double length = s.norm();
+        if (!(length > 0.0))
+            return std::nullopt;
+        s /= length;
+    }
+    return sum;
+}
+
 /// Spherical k-means of unit vectors into `k` groups from farthest-point seeds after unit[first]:
 /// the group of each vector and the groups' unit means; nothing when a group is left empty.
 inline std::optional<std::pair<std::vector<std::uint8_t>, std::vector<Vec3d>>> group_directions(
@@ -214,16 +245,10 @@ inline std::optional<std::pair<std::vector<std::uint8_t>, std::vector<Vec3d>>> g
             moved = moved || best != group[i];
             group[i] = best;
         }
-        std::vector<Vec3d> sum(k, Vec3d::Zero());
-        for (std::size_t i = 0; i < n; ++i)
-            sum[group[i]] += unit[i];
-        for (std::size_t g = 0; g < k; ++g)
-        {
-            const double length = sum[g].norm();
-            if (!(length > 0.0))
-                return std::nullopt;
-            mean[g] = sum[g] / length;
-        }
+        std::optional<std::vector<Vec3d>> means = group_means(unit, group, k);
+        if (!means)
+            return std::nullopt;
+        mean = std::move(*means);
         if (!moved && round > 0)
             break;
     }
@@ -513,11 +538,14 @@ inline double one_face_residual(std::span<const Vec3d> at, std::span<const Vec3d
             bool moved = false;
             for (std::size_t i = 0; i < n; ++i)
             {
-                std::uint8_t best = parting.group[i];
-                double least = crease_fill_internal::crease_regroup_cost(*fill, best, at[i],
+                const std::uint8_t current = parting.group[i];
+                std::uint8_t best = current;
+                double least = crease_fill_internal::crease_regroup_cost(*fill, current, at[i],
                                                                          unit[i], rim_spread);
                 for (std::size_t g = 0; g < k; ++g)
                 {
+                    if (g == current)
+                        continue;
                     const double cost = crease_fill_internal::crease_regroup_cost(
                         *fill, g, at[i], unit[i], rim_spread);
                     if (cost < least)
@@ -531,16 +559,11 @@ inline double one_face_residual(std::span<const Vec3d> at, std::span<const Vec3d
             }
             if (!moved)
                 return fill;
-            std::vector<Vec3d> sum(k, Vec3d::Zero());
-            for (std::size_t i = 0; i < n; ++i)
-                sum[parting.group[i]] += unit[i];
-            for (std::size_t g = 0; g < k; ++g)
-            {
-                const double length = sum[g].norm();
-                if (!(length > 0.0))
-                    return std::nullopt;
-                parting.mean[g] = sum[g] / length;
-            }
+            std::optional<std::vector<Vec3d>> means =
+                crease_fill_internal::group_means(unit, parting.group, k);
+            if (!means)
+                return std::nullopt;
+            parting.mean = std::move(*means);
         }
         return fill;
     };

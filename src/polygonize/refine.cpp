@@ -1438,13 +1438,9 @@ std::size_t onto_crease_faces(std::span<Vec3d> x, std::span<const Vec3d> normal,
             // its faces, in to a concave one from outside them; either way onto curved faces
             // (CreaseFill::curved), which a thin plate can also cut the other way. The nearest
             // sign change that way.
-            double sign = region.fill.convex ? 1.0 : -1.0;
-            if ((at_start > 0.0) == region.fill.convex)
-            {
-                if (!region.fill.curved)
-                    continue;
-                sign = -sign;
-            }
+            if ((at_start > 0.0) == region.fill.convex && !region.fill.curved)
+                continue;
+            const double sign = at_start > 0.0 ? -1.0 : 1.0;
             double inner = 0.0;
             double outer = 0.0;
             for (int step = 1; step <= crease_search_steps; ++step)
