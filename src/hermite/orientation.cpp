@@ -962,9 +962,9 @@ constexpr float supporting_cos2 = 0.75F;
 constexpr std::size_t min_support = 6;
 
 /// Oriented guide normals checked by a vote of their neighbours on the same sheet
-/// (Guide::jumps()), each weighted by its guide's confidence: a sample that too few neighbours
-/// support (min_support) takes the principal axis of their normals (a sign-free vote, so the
-/// side with more weight wins, rather than an average across a crease), and every sample turns
+/// (Guide::jumps_in_rows()), each weighted by its guide's confidence: a sample that too few
+/// neighbours support (min_support) takes the principal axis of their normals (a sign-free vote, so
+/// the side with more weight wins, rather than an average across a crease), and every sample turns
 /// to the side the weighted normals point to, so a lone sample oriented against its neighbours
 /// follows them. On a noisy plate whose faces are 9 noise deviations apart (1M samples, noise
 /// twice the sampling step, bench/peers' noisy+holes plate at 1M) the guides of samples whose
@@ -991,7 +991,8 @@ void vote_normals(std::span<const Vec3f> positions, const KnnTable& neighbors, c
             std::size_t support = 0;
             for (const std::uint32_t j : neighbors.neighbors(i))
             {
-                if (!usable(normals[j]) || (j != a && guide.jumps(positions, neighbors, a, j)))
+                if (!usable(normals[j]) ||
+                    (j != a && guide.jumps_in_rows(positions, neighbors, a, j)))
                     continue;
                 const float along = normals[j].dot(normals[i]);
                 support += j != a && along * along > supporting_cos2 ? 1U : 0U;
