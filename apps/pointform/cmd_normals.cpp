@@ -100,6 +100,8 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
         out["components"] = orientation.components;
         out["flipped"] = orientation.flipped;
         out["crease_refits"] = result.crease_refits;
+        out["thin_parts"] = orientation.thin_parts;
+        out["thin_part_turned"] = orientation.thin_part_turned;
         out["degenerate"] = result.degenerate;
         out["inherited"] = orientation.inherited;
         out["unoriented"] = orientation.unoriented.size();
@@ -125,6 +127,11 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
                   std::to_string(result.crease_refits) +
                       (result.crease_refits == 0 ? " (none at a crease, or a noisy cloud)"
                                                  : " (normals refitted to their own face)"));
+    if (orientation.thin_parts > 0)
+        print_row("thin parts", std::to_string(orientation.thin_parts) +
+                                    " (faces apart by less than the noise; " +
+                                    std::to_string(orientation.thin_part_turned) +
+                                    " normals turned away from the other face)");
     print_row("degenerate (inherited)", std::to_string(result.degenerate));
     print_row("unoriented", std::to_string(orientation.unoriented.size()));
     print_row("isolated", std::to_string(result.isolated.size()) +

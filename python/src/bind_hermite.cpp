@@ -48,7 +48,8 @@ void bind_hermite(py::module_& m)
         "sharp_creases, the estimated normals of a clean cloud at its creases are refitted to "
         "each sample's own face (`pointform normals --sharp-creases`). Returns the "
         "surfels (same origin) and a report: estimated_normals, estimated_radii, components, "
-        "flipped, crease_refits, degenerate, unoriented, isolated, off_surface, copies. What "
+        "flipped, crease_refits, thin_parts, thin_part_turned, degenerate, unoriented, "
+        "isolated, off_surface, copies. What "
         "`pointform "
         "reconstruct` does to its input. Raises InvalidInput for fewer than k + 1 usable "
         "points, all coincident or collinear points, or k < 3 or a radius_scale not positive.");

@@ -10,6 +10,7 @@
 
 #include "orientation_detail.h"
 #include "orientation_lanes.h"
+#include "two_sheets.h"
 
 #include <Eigen/Core>
 
@@ -455,6 +456,20 @@ Guide guide_normals(std::span<const Vec3f> positions, const KnnTable& neighbors,
             if (std::signbit(best_flatness[i]))
                 settle(i, current[i]);
     });
+    // Each sample's offset over its widest neighbourhood, which reaches across the gap of a
+    // thin part where its flattest one may keep to one face (two_sheet_sides()).
+    result.offset.resize(n);
+    parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            const Moments& widest = current[i];
+            const auto& c = widest.covariance;
+            const float spread = std::sqrt(c[0] + c[3] + c[5]);
+            const Vec3f centroid(widest.centroid[0], widest.centroid[1], widest.centroid[2]);
+            const float height = (positions[i] - centroid).dot(best_axis[i]);
+            result.offset[i] = spread > 0.0F && std::isfinite(height) ? height / spread : 0.0F;
+        }
+    });
     FilledLaterVector<Moments>().swap(current);
     FilledLaterVector<Moments>().swap(next);
     result.flatness.swap(best_flatness);
@@ -481,6 +496,8 @@ void finish_guide(std::span<const Vec3f> positions, std::span<const Vec3f> norma
         }
     });
     mark_sheets(positions, neighbors, result);
+    result.side = detail::two_sheet_sides(positions, neighbors, result.normals, result.offset);
+    std::vector<float>().swap(result.offset);
 }
 
 std::size_t count_flipped(std::span<const Vec3f> before, std::span<const Vec3f> after)
@@ -1704,6 +1721,10 @@ OrientedNormals orient_graph(std::span<const Vec3f> positions, std::span<const V
         vote_normals(positions, neighbors, guide, result.normals);
         turn_regions_by_winding(positions, neighbors, guide, columns,
                                 1.0F - static_cast<float>(options.patch_cost), result.normals);
+        const detail::TwoSheetFacing facing =
+            detail::face_two_sheet_regions(neighbors, guide.normals, guide.side, result.normals);
+        result.thin_parts = facing.faced;
+        result.thin_part_turned = facing.turned;
         for (std::size_t i = 0; i < n; ++i)
             result.normals[i] = usable(fine_normals[i]) ? result.normals[i] : fine_normals[i];
     }

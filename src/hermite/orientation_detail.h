@@ -37,6 +37,14 @@ struct Guide
     /// The flatness (flatness() in orientation.cpp) of the neighbourhood the guide was taken from:
     /// 0 on a plane.
     std::vector<float> flatness;
+    /// Where a sample's wider neighbourhood is two bands of heights along its guide (the faces of
+    /// a thin part that noise joins), the band it lies in: +1 along its guide, -1 against it;
+    /// else 0 (two_sheet_sides()).
+    std::vector<std::int8_t> side;
+    /// Each sample's height along its guide over the centroid of its widest neighbourhood (the
+    /// guide's last ring), in units of that neighbourhood's spread (√ of its covariance's trace);
+    /// freed once the sides are found.
+    std::vector<float> offset;
 
     /// How well a plane fits sample i's neighbourhood: (1 - flatness)², 0 for an isotropic blob.
     [[nodiscard]] float confidence(std::size_t i) const

@@ -83,6 +83,8 @@ SurfelsFromSamples surfels_from_samples(const PointCloudView& samples,
         out.components = result.orientation.components;
         out.crease_refits = result.crease_refits;
         out.flipped = result.orientation.flipped;
+        out.thin_parts = result.orientation.thin_parts;
+        out.thin_part_turned = result.orientation.thin_part_turned;
         out.degenerate = result.degenerate;
         out.unoriented = result.orientation.unoriented.size();
         // The isolated samples, those off the surface and the copies first (their indices are

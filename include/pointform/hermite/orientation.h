@@ -146,6 +146,11 @@ struct OrientedNormals
     std::size_t inherited = 0;
     /// Samples that could not be oriented (a component with no usable normal), ascending.
     std::vector<std::uint32_t> unoriented;
+    /// Noisy clouds: thin parts whose two faces the noise joins, oriented by their two bands of
+    /// samples (each face away from the other) where orientation left them undecided, and the
+    /// normals that turned there.
+    std::size_t thin_parts = 0;
+    std::size_t thin_part_turned = 0;
 };
 
 /// \brief Orients normals consistently by propagation along a minimum spanning tree of the

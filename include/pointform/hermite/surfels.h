@@ -146,6 +146,9 @@ struct SurfelsFromSamples
     std::size_t components = 0;
     std::size_t flipped = 0;
     std::size_t degenerate = 0;
+    /// OrientedNormals::thin_parts and thin_part_turned.
+    std::size_t thin_parts = 0;
+    std::size_t thin_part_turned = 0;
     /// Normals refitted at creases (SurfelsFromSamplesOptions::sharp_creases).
     std::size_t crease_refits = 0;
     /// Samples left out for want of a usable normal: ones that could not be oriented, or given

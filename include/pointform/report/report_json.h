@@ -40,7 +40,8 @@ inline constexpr const char* hausdorff_definition =
 [[nodiscard]] std::string stop_reason(const SemiRegularReport& report);
 
 /// \brief surfels_from_samples()'s report: estimated_normals, estimated_radii, components,
-/// flipped, degenerate, unoriented.
+/// flipped, crease_refits, thin_parts, thin_part_turned, degenerate, unoriented, isolated,
+/// off_surface, copies.
 [[nodiscard]] nlohmann::json report_json(const SurfelsFromSamples& surfels);
 
 /// \brief One refined level (RefineLevelStats), its distances also relative to `diagonal`.

@@ -1,0 +1,62 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+#pragma once
+
+#include "pointform/core/types.h"
+#include "pointform/spatial/neighborhoods.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace pointform::detail {
+
+/// The two faces of a thin part whose gap noise fills (faces a few noise deviations apart): no
+/// test of a sample's position against its neighbours' band tells one face's samples from the
+/// other's, and orientation along the guides, which are parallel across the gap, hands both
+/// faces one sign: the field through them is one sheet in the middle, half of it facing away
+/// from the nearer face. Across a wider neighbourhood the heights of such a part along the guide
+/// are two bands, not one: this finds where, and which band each sample lies in.
+///
+/// `offsets` are the samples' heights along their guides over the centroids of their widest
+/// guide neighbourhoods (Guide::offset), which lie between the faces of such a part: two bands
+/// of offsets there, one band elsewhere. Their kurtosis (3 for one normal band, under 2 for two
+/// bands more than 3 deviations apart) is taken over the offsets of the sample's block of
+/// consecutive samples and of its neighbours' blocks (spatially sorted samples, as
+/// compute_surfels() has them, make compact blocks; unsorted ones pool the whole cloud, which
+/// finds only a cloud that is all thin part). Blocks of quantized coordinates (many samples share
+/// a coordinate with a neighbour), whose layers are no faces, are left out. Where it is low, the
+/// sample's side is its offset's sign: ±2 (kurtosis low enough to be certain) or ±1 (likely, next
+/// to certain ones), + along its guide; elsewhere 0. The guide normals are unoriented lines (zero
+/// where unusable).
+[[nodiscard]] std::vector<std::int8_t> two_sheet_sides(std::span<const Vec3f> positions,
+                                                       const KnnTable& neighbors,
+                                                       std::span<const Vec3f> guide_normals,
+                                                       std::span<const float> offsets);
+
+/// What face_two_sheet_regions() did.
+struct TwoSheetFacing
+{
+    /// Connected regions of samples with a side.
+    std::size_t regions = 0;
+    /// Regions whose normals were set by their sides.
+    std::size_t faced = 0;
+    /// Samples whose normal turned.
+    std::size_t turned = 0;
+};
+
+/// Orients the two-sheet regions (samples with a side, connected through the neighbour table,
+/// with enough certain ones) that orientation left undecided: where the oriented normals of a
+/// region's samples agree with the direction away from its mid-surface (side times guide) about
+/// as often as they disagree, each normal becomes that direction (the two faces of a thin solid
+/// face away from each other; a region whose normals lean to facing inwards, a narrow slot,
+/// faces inwards). Regions that orientation got right keep their normals, and the sides' errors
+/// (samples that noise carried past the mid-surface) with them. `normals` are the oriented guide
+/// normals.
+TwoSheetFacing face_two_sheet_regions(const KnnTable& neighbors,
+                                      std::span<const Vec3f> guide_normals,
+                                      std::span<const std::int8_t> sides, std::span<Vec3f> normals);
+
+} // namespace pointform::detail
