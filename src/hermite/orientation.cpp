@@ -70,10 +70,7 @@ bool row_contains(const KnnTable& table, std::size_t row, std::size_t columns, s
     return hits != 0;
 }
 
-bool usable(const Vec3f& n)
-{
-    return n.squaredNorm() > 0.5F;
-}
+using detail::usable;
 
 /// The signed agreement of normal nb at pb with the orientation rule predicts from na at pa
 /// (agreement() takes them from one array).

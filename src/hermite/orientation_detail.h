@@ -14,6 +14,12 @@
 
 namespace pointform::detail {
 
+/// Whether a normal (unit, or zero where there is none) can be used.
+[[nodiscard]] inline bool usable(const Vec3f& n)
+{
+    return n.squaredNorm() > 0.5F;
+}
+
 /// Guide normals (grow_guide()) and, for each sample, the band of heights along its guide that
 /// its own sheet fills (set by orient_with_guide()). Moves, never copies: `normals` views either
 /// `storage` or an array a caller lent to grow_guide().

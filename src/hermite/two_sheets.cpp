@@ -6,6 +6,8 @@
 #include "pointform/core/disjoint_sets.h"
 #include "pointform/core/parallel.h"
 
+#include "orientation_detail.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -47,11 +49,6 @@ constexpr double leaning_in = 0.1;
 /// are no faces: a sphere whose coordinates were rounded to 0.03 (about 1.5 sampling steps)
 /// scored 2.07-2.69, and its normals turned.
 constexpr double max_tied_share = 0.25;
-
-bool usable(const Vec3f& n)
-{
-    return n.allFinite() && n.squaredNorm() > 0.5F;
-}
 
 /// Whether sample i has a coordinate exactly equal to one of its neighbours' (other than its own
 /// place).
@@ -144,14 +141,12 @@ std::vector<std::int8_t> two_sheet_sides(std::span<const Vec3f> positions,
         std::vector<std::size_t> pooled;
         for (std::size_t i = begin; i < end; ++i)
         {
-            if (!counts(i) || offsets[i] == 0.0F)
+            if (!counts(i) || offsets[i] == 0.0F || block_sums[i / pooled_block].count == 0.0)
                 continue;
             pooled.assign(1, i / pooled_block);
             for (const std::uint32_t j : neighbors.neighbors(i))
                 if (std::find(pooled.begin(), pooled.end(), j / pooled_block) == pooled.end())
                     pooled.push_back(j / pooled_block);
-            if (block_sums[i / pooled_block].count == 0.0)
-                continue;
             Powers sum;
             for (const std::size_t b : pooled)
                 sum.add(block_sums[b]);
@@ -196,7 +191,6 @@ TwoSheetFacing face_two_sheet_regions(const KnnTable& neighbors,
         if (sides[i] == 0)
             continue;
         Tally& t = tally[regions.find(i)];
-        facing.regions += t.samples == 0 ? 1 : 0;
         ++t.samples;
         t.certain += std::abs(sides[i]) == 2 ? 1U : 0U;
         const float along = normals[i].dot(guide_normals[i]) * static_cast<float>(sides[i]);

@@ -39,8 +39,6 @@ namespace pointform::detail {
 /// What face_two_sheet_regions() did.
 struct TwoSheetFacing
 {
-    /// Connected regions of samples with a side.
-    std::size_t regions = 0;
     /// Regions whose normals were set by their sides.
     std::size_t faced = 0;
     /// Samples whose normal turned.

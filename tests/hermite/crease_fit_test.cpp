@@ -40,12 +40,6 @@ double mean_angle_deg(std::span<const Vec3f> estimated, std::span<const Vec3f> t
     return sum * 180.0 / M_PI / static_cast<double>(truth.size());
 }
 
-PointCloud without_normals(PointCloud cloud)
-{
-    cloud.normals.clear();
-    return cloud;
-}
-
 // Every edge and corner of the thin plate (side 2, thickness 0.05) and of the CAD-like part is a
 // crease the principal normals blend over: about 5% of the plate's 40,000 samples have a normal
 // more than 10° off its face's. Refitted, the normals at the edges take their own face's, and
@@ -55,7 +49,7 @@ TEST(SharpCreases, EdgeSamplesTakeTheirOwnFacesNormal)
     for (const Shape shape : {Shape::Plate, Shape::Part})
     {
         const PointCloud truth = sample_shape(shape, {.count = 40000, .seed = 5});
-        const PointCloud raw = without_normals(truth);
+        const PointCloud raw = test::without_normals(truth);
         const SurfelResult blended = compute_surfels(raw);
         const SurfelResult sharp = compute_surfels(raw, {.sharp_creases = true});
         EXPECT_EQ(blended.crease_refits, 0U);
@@ -82,7 +76,7 @@ TEST(SharpCreases, EdgeSamplesTakeTheirOwnFacesNormal)
 TEST(SharpCreases, AConesRimKeepsItsSigns)
 {
     const PointCloud truth = sample_shape(Shape::Cone, {.count = 40000, .seed = 6});
-    const PointCloud raw = without_normals(truth);
+    const PointCloud raw = test::without_normals(truth);
     const SurfelResult blended = compute_surfels(raw);
     const SurfelResult sharp = compute_surfels(raw, {.sharp_creases = true});
     EXPECT_GE(test::oriented_fraction(sharp.surfels.normals, truth.normals),
@@ -95,13 +89,13 @@ TEST(SharpCreases, AConesRimKeepsItsSigns)
 // noise's) the normals are the principal ones.
 TEST(SharpCreases, SmoothOrNoisyCloudsKeepTheirNormals)
 {
-    const PointCloud torus = without_normals(sample_shape(Shape::Torus, {.count = 30000}));
+    const PointCloud torus = test::without_normals(sample_shape(Shape::Torus, {.count = 30000}));
     const SurfelResult smooth = compute_surfels(torus, {.sharp_creases = true});
     EXPECT_EQ(smooth.crease_refits, 0U);
     EXPECT_EQ(smooth.surfels.normals, compute_surfels(torus).surfels.normals);
 
     const PointCloud noisy =
-        without_normals(sample_shape(Shape::Plate, {.count = 30000, .noise = 0.002}));
+        test::without_normals(sample_shape(Shape::Plate, {.count = 30000, .noise = 0.002}));
     const SurfelResult kept = compute_surfels(noisy, {.sharp_creases = true});
     EXPECT_EQ(kept.crease_refits, 0U);
     EXPECT_EQ(kept.surfels.normals, compute_surfels(noisy).surfels.normals);
@@ -115,7 +109,7 @@ TEST(SharpCreases, SmoothOrNoisyCloudsKeepTheirNormals)
 // any thread count (150,000 samples: 37 blocks of crease_refit_block).
 TEST(SharpCreases, SameNormalsWhateverTheThreadCount)
 {
-    const PointCloud cloud = without_normals(sample_shape(Shape::Part, {.count = 150000}));
+    const PointCloud cloud = test::without_normals(sample_shape(Shape::Part, {.count = 150000}));
     const auto runs =
         test::at_thread_counts([&] { return compute_surfels(cloud, {.sharp_creases = true}); },
                                {.min_multi_block_loops = 16}, {1, 2, 3});

@@ -145,13 +145,6 @@ TEST(OrientNormalsMst, NoisySphereWithHoles)
 
 /// Share of the samples of one face of a plate (true normal along ±z with the sign of `side`) whose
 /// normal points the true way.
-/// The cloud's positions alone, as a scan gives them.
-PointCloud positions_only(PointCloud cloud)
-{
-    cloud.normals.clear();
-    return cloud;
-}
-
 double face_oriented_fraction(const PointCloud& plate, std::span<const Vec3f> normals, float side)
 {
     std::vector<Vec3f> est;
@@ -248,7 +241,7 @@ TEST(OrientNormalsMst, NoisyPlateThinnerThanItsNoiseFacesAwayFromItsMidplane)
                                                              .holes = 8,
                                                              .hole_radius = 0.04,
                                                              .thickness = c.thickness});
-        const SurfelResult result = compute_surfels(positions_only(plate));
+        const SurfelResult result = compute_surfels(test::without_normals(plate));
         const std::vector<Vec3f>& normals = result.surfels.normals;
         EXPECT_GE(result.orientation.thin_parts, 1U) << "thickness " << c.thickness;
         EXPECT_GT(result.orientation.thin_part_turned, plate.size() / 4);
@@ -261,12 +254,12 @@ TEST(OrientNormalsMst, NoisyPlateThinnerThanItsNoiseFacesAwayFromItsMidplane)
 
 TEST(OrientNormalsMst, NoisyPlateThinnerThanItsNoiseIsTheSameWhateverTheThreadCount)
 {
-    const PointCloud plate = positions_only(sample_shape(Shape::Plate, {.count = 100000,
-                                                                        .seed = 1,
-                                                                        .noise = 0.002,
-                                                                        .holes = 8,
-                                                                        .hole_radius = 0.04,
-                                                                        .thickness = 0.02}));
+    const PointCloud plate = test::without_normals(sample_shape(Shape::Plate, {.count = 100000,
+                                                                               .seed = 1,
+                                                                               .noise = 0.002,
+                                                                               .holes = 8,
+                                                                               .hole_radius = 0.04,
+                                                                               .thickness = 0.02}));
     const auto runs = test::at_thread_counts([&] { return compute_surfels(plate); },
                                              {.min_multi_block_loops = 2});
     for (const SurfelResult& run : runs)
@@ -290,7 +283,7 @@ TEST(OrientNormalsMst, NoisyShapesOfOneSheetFindNoThinPart)
     {
         const PointCloud cloud = sample_shape(
             shape, {.count = 60000, .seed = 7, .noise = 0.002, .holes = 8, .hole_radius = 0.04});
-        const SurfelResult result = compute_surfels(positions_only(cloud));
+        const SurfelResult result = compute_surfels(test::without_normals(cloud));
         EXPECT_EQ(result.orientation.thin_parts, 0U) << static_cast<int>(shape);
         EXPECT_EQ(result.orientation.thin_part_turned, 0U);
     }

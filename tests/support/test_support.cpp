@@ -88,4 +88,10 @@ double line_angle_quantile_deg(std::span<const Vec3f> estimated, std::span<const
     return angles[at];
 }
 
+PointCloud without_normals(PointCloud cloud)
+{
+    cloud.normals.clear();
+    return cloud;
+}
+
 } // namespace pointform::test

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "pointform/core/types.h"
+#include "pointform/geometry/point_cloud.h"
 
 #include <filesystem>
 #include <span>
@@ -38,6 +39,9 @@ void write_file(const std::filesystem::path& path, const std::string& content);
 
 /// \brief Reads a whole file as raw bytes.
 [[nodiscard]] std::string read_file(const std::filesystem::path& path);
+
+/// \brief The cloud without its normals: its positions (and anything else) as a scan gives them.
+[[nodiscard]] PointCloud without_normals(PointCloud cloud);
 
 /// \brief Fraction of normals whose sign agrees with the truth (dot product > 0).
 [[nodiscard]] double oriented_fraction(std::span<const Vec3f> estimated,
