@@ -220,6 +220,26 @@ TEST(OrientNormalsMst, NoisyThinPlateSevenDeviationsThickKeepsItsFacesApart)
     }
 }
 
+/// orient_normals_mst() of `plate` (17 neighbours, graph k = 10) at every thread count, with
+/// more than one parallel block: expects the same normals and flips from each.
+std::vector<OrientedNormals> oriented_at_thread_counts(const PointCloud& plate)
+{
+    const Prepared p = prepare(plate, 17);
+    auto runs = test::at_thread_counts(
+        [&] { return orient_normals_mst(plate.positions, p.normals.normals, p.table, {.k = 10}); },
+        {.min_multi_block_loops = 2});
+    for (const OrientedNormals& run : runs)
+    {
+        EXPECT_EQ(run.normals.size(), runs[0].normals.size());
+        if (run.normals.size() == runs[0].normals.size())
+            EXPECT_EQ(std::memcmp(run.normals.data(), runs[0].normals.data(),
+                                  run.normals.size() * sizeof(Vec3f)),
+                      0);
+        EXPECT_EQ(run.flipped, runs[0].flipped);
+    }
+    return runs;
+}
+
 TEST(OrientNormalsMst, NoisyThinPlateTurnedWithItsBandIsTheSameWhateverTheThreadCount)
 {
     // Seed 1 of the plate above: its bottom face turns over only once the band has turned with
@@ -230,17 +250,8 @@ TEST(OrientNormalsMst, NoisyThinPlateTurnedWithItsBandIsTheSameWhateverTheThread
                                                          .holes = 8,
                                                          .hole_radius = 0.04,
                                                          .thickness = 0.04});
-    const Prepared p = prepare(plate, 17);
-    const auto runs = test::at_thread_counts(
-        [&] { return orient_normals_mst(plate.positions, p.normals.normals, p.table, {.k = 10}); },
-        {.min_multi_block_loops = 2});
-    for (const OrientedNormals& run : runs)
-    {
-        ASSERT_EQ(run.normals.size(), runs[0].normals.size());
-        EXPECT_EQ(std::memcmp(run.normals.data(), runs[0].normals.data(),
-                              run.normals.size() * sizeof(Vec3f)),
-                  0);
-    }
+    const std::vector<OrientedNormals> runs = oriented_at_thread_counts(plate);
+    ASSERT_FALSE(runs.empty());
     EXPECT_GE(face_oriented_fraction(plate, runs[0].normals, -1.0F), 0.995);
 }
 
@@ -319,18 +330,7 @@ TEST(OrientNormalsMst, NoisyThinPlateIsTheSameWhateverTheThreadCount)
 {
     const PointCloud plate = sample_shape(
         Shape::Plate, {.count = 30000, .seed = 3, .noise = 0.002, .holes = 4, .hole_radius = 0.04});
-    const Prepared p = prepare(plate, 17);
-    const auto runs = test::at_thread_counts(
-        [&] { return orient_normals_mst(plate.positions, p.normals.normals, p.table, {.k = 10}); },
-        {.min_multi_block_loops = 2});
-    for (const OrientedNormals& run : runs)
-    {
-        ASSERT_EQ(run.normals.size(), runs[0].normals.size());
-        EXPECT_EQ(std::memcmp(run.normals.data(), runs[0].normals.data(),
-                              run.normals.size() * sizeof(Vec3f)),
-                  0);
-        EXPECT_EQ(run.flipped, runs[0].flipped);
-    }
+    oriented_at_thread_counts(plate);
 }
 
 TEST(OrientNormalsMst, NoisyThinPlateStrayNormalsFollowTheirNeighbours)
