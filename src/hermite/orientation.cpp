@@ -1367,8 +1367,10 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
         });
     };
     WindingEnergy current = energy();
-    // Already a closed, consistently oriented surface's: nothing to turn (see closed_energy).
-    if (current.fitted <= closed_energy * static_cast<double>(queries.size()))
+    // The most fitted energy of a closed, consistently oriented surface (closed_energy a query).
+    const double closed_bound = closed_energy * static_cast<double>(queries.size());
+    // Already a closed, consistently oriented surface's: nothing to turn.
+    if (current.fitted <= closed_bound)
         return;
     bool any = false;
     for (bool changed = true; changed;)
@@ -1397,7 +1399,7 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
     //    deviations apart, whose guides' wider scales span both faces, had 44% of its samples in
     //    the band: turning its inside-out bottom face left 0.10 per query). Then the energy is
     //    taken again once step 4 has run, and the turns stand only if that one is closed.
-    const bool closed = current.fitted <= closed_energy * static_cast<double>(queries.size());
+    const bool closed = current.fitted <= closed_bound;
 
     // 4. The turned regions turn. The band between a turned region and its neighbours is then a
     //    crease sharper than a right angle, whose guides are the wedge's axes, not either face's
@@ -1502,7 +1504,7 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
             [](std::uint32_t) { return -1; },
             [&](std::size_t qi, std::size_t, double term) { w[qi] += term; });
         if (winding_energy(queries.size(), [&](std::size_t qi) { return w[qi]; }).fitted >
-            closed_energy * static_cast<double>(queries.size()))
+            closed_bound)
         {
             for (std::size_t i = 0; i < n; ++i) // the turned regions back as they were
             {
