@@ -5,11 +5,16 @@
 
 #include "pointform/core/disjoint_sets.h"
 #include "pointform/core/parallel.h"
+#include "pointform/spatial/kd_tree.h"
 
 #include "orientation_detail.h"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -32,8 +37,17 @@ constexpr float certain_kurtosis = 2.2F;
 /// to this kurtosis (where the bands part, at a thin plate's rims and holes, the test is weaker):
 /// the plate 0.03 thick, Chamfer 0.274% of the diagonal (only the certain ones) -> 0.16.
 constexpr float likely_kurtosis = 2.5F;
-/// A region is oriented by its bands when this many of its samples are certain.
+/// A region is oriented by its bands when this many of its samples are certain (by their
+/// kurtosis or from a ball, ball_sides())...
 constexpr std::size_t min_certain = 64;
+/// ... and at least this share of them. Where the offsets are one band, a few blocks still pool
+/// to a low kurtosis by chance, and the sides they give are the offsets' signs, which say
+/// nothing: at 1M samples (the widest guide neighbourhood leans to the sample's own face) a plate
+/// 0.04 thick had regions of 7,600-14,300 samples, 0-5.7% of them certain, and facing them left
+/// 5.16% of its normals facing away (0.23% with this share). Plates at 100k whose faces noise
+/// joins: 36% certain (0.015 thick, by their kurtosis alone; the balls do not dip) to 100%
+/// (0.035).
+constexpr double min_certain_share = 0.15;
 /// A region is undecided when its normals facing away from its mid-surface outnumber those facing
 /// towards it, or the other way round, by less than this share of its samples: where
 /// orientation gave both faces of a thin part one sign, the two counts are the faces' (0.000 to
@@ -101,7 +115,185 @@ struct Powers
     }
 };
 
+/// Samples in a ball of ball_sides(): its centre sample and the nearest others. Measured
+/// (Python on the positions, about 8,000 balls a cloud; `pointform sample`, 100k samples, noise
+/// 0.2% of the diagonal, 8 holes): with 256, 89-95% of the balls on plates 6-7 deviations thick
+/// dip, and 0-0.1% on noisy cones, CAD-like parts, spheres and simulated scans of CAD parts.
+constexpr std::size_t ball_samples = 256;
+/// Every ball_stride-th sample (in index order: spatially sorted samples, as compute_surfels()
+/// has them, spread the centres evenly) is a ball's centre: each sample lies in about four balls.
+constexpr std::size_t ball_stride = 64;
+/// A ball's heights dip when the centre bin of their histogram holds at most this share of the
+/// lower of the two sides' highest bins. Over the balls above: median 0.08-0.23 on the plates,
+/// 0.75-0.89 at the 0.1st percentile on the one-sheet shapes.
+constexpr double max_dip = 0.6;
+/// The other balls' centres in a ball that its neighbour test looks at (the nearest first).
+constexpr std::size_t ball_neighbours = 16;
+/// A dipping ball counts when at least this many of the other balls' centres in it, and at least
+/// half of them, dip too: a thin part's balls dip together, while on one sheet a ball dips alone
+/// (the rim of a hole in a curved face, which takes the middle heights away). With every dipping
+/// ball counting, the normals of 11 of the 64 noisy shapes and simulated scans of CAD parts in the
+/// A/B set of RESULTS_reconstruct.md turned (40-2,308 samples: blobbies, tori, cones, brackets,
+/// teapots; the torus's 132 at the rim of a hole in its outer face); with the test, none.
+constexpr std::size_t min_agreeing_balls = 2;
+/// A sample's guide must lie within 60° of its ball's axis for the ball to give it a side.
+constexpr float min_axis_alignment = 0.5F;
+
+/// A ball of ball_sides() whose heights dip: the plane between its two bands.
+struct Ball
+{
+    Vec3f centroid = Vec3f::Zero();
+    Vec3f axis = Vec3f::Zero();
+};
+
+/// Whether heights (about their mean, with mean square `variance`) dip: a histogram of the
+/// heights over their deviation, in 9 bins of half a deviation, has a hole in the middle. Two
+/// bands more than about 4 deviations of the noise apart leave one; one sheet's heights,
+/// curved or creased, do not (a curved cap's heights are spread evenly, its kurtosis as low as
+/// two bands').
+bool dipped(std::span<const float> heights, double variance)
+{
+    if (!(variance > 0.0))
+        return false;
+    const double scale = 2.0 / std::sqrt(variance); // bins of half a deviation
+    std::array<std::uint32_t, 9> bins{};
+    for (const float h : heights)
+    {
+        const double b = std::floor(static_cast<double>(h) * scale + 4.5);
+        if (b >= 0.0 && b < 9.0)
+            ++bins[static_cast<std::size_t>(b)];
+    }
+    const std::uint32_t below = *std::max_element(bins.begin(), bins.begin() + 4);
+    const std::uint32_t above = *std::max_element(bins.begin() + 5, bins.end());
+    const double side = static_cast<double>(std::max<std::uint32_t>(1, std::min(below, above)));
+    return static_cast<double>(bins[4]) <= max_dip * side;
+}
+
+/// The ball about sample `centre`, and whether its heights dip. `members`, `distances` and
+/// `heights` are buffers of ball_samples; `near` receives the other balls' centres in it.
+bool dipping_ball(const KdTree& tree, std::span<const Vec3f> positions, std::size_t centre,
+                  std::span<std::uint32_t> members, std::span<float> distances,
+                  std::span<float> heights, std::vector<std::uint32_t>& near, Ball& ball)
+{
+    near.clear();
+    const std::size_t found = tree.knn(positions[centre], ball_samples, members, distances);
+    if (found < ball_samples)
+        return false;
+    for (std::size_t k = 1; k < found && near.size() < ball_neighbours; ++k)
+        if (members[k] % ball_stride == 0)
+            near.push_back(members[k] / ball_stride);
+    // About the centre sample in double: the sums of squares neither lose the noise to the
+    // coordinates' size nor depend on the order of the members.
+    const Eigen::Vector3d origin = positions[centre].cast<double>();
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const std::uint32_t m : members)
+        mean += positions[m].cast<double>() - origin;
+    mean /= static_cast<double>(found);
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (const std::uint32_t m : members)
+    {
+        const Eigen::Vector3d d = positions[m].cast<double>() - origin - mean;
+        covariance += d * d.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+    if (solver.info() != Eigen::Success || !(solver.eigenvalues()(2) > 0.0))
+        return false;
+    const Eigen::Vector3d axis = solver.eigenvectors().col(0);
+    double variance = 0.0;
+    for (std::size_t k = 0; k < found; ++k)
+    {
+        const double h = (positions[members[k]].cast<double>() - origin - mean).dot(axis);
+        heights[k] = static_cast<float>(h);
+        variance += h * h;
+    }
+    if (!dipped(heights.first(found), variance / static_cast<double>(found)))
+        return false;
+    ball.centroid = (origin + mean).cast<float>();
+    ball.axis = axis.cast<float>();
+    return true;
+}
+
 } // namespace
+
+void ball_sides(const KdTree& tree, std::span<const Vec3f> positions,
+                std::span<const Vec3f> guide_normals, std::span<std::int8_t> sides)
+{
+    const std::size_t n = positions.size();
+    if (n < 2 * ball_samples || guide_normals.size() != n || sides.size() != n || tree.size() != n)
+        return;
+    const std::size_t count = (n + ball_stride - 1) / ball_stride;
+    std::vector<Ball> balls(count);
+    std::vector<std::uint8_t> dips(count, 0);
+    std::vector<std::array<std::uint32_t, ball_neighbours>> near(count);
+    std::vector<std::uint8_t> near_count(count, 0);
+    parallel_blocks(count, 16, [&](std::size_t begin, std::size_t end) {
+        std::vector<std::uint32_t> members(ball_samples);
+        std::vector<float> distances(ball_samples);
+        std::vector<float> heights(ball_samples);
+        std::vector<std::uint32_t> others;
+        for (std::size_t b = begin; b < end; ++b)
+        {
+            dips[b] = dipping_ball(tree, positions, b * ball_stride, members, distances, heights,
+                                   others, balls[b])
+                          ? 1
+                          : 0;
+            std::copy(others.begin(), others.end(), near[b].begin());
+            near_count[b] = static_cast<std::uint8_t>(others.size());
+        }
+    });
+    std::vector<std::uint8_t> kept(count, 0);
+    bool any = false;
+    for (std::size_t b = 0; b < count; ++b)
+    {
+        if (dips[b] == 0)
+            continue;
+        std::size_t agreeing = 0;
+        for (std::size_t k = 0; k < near_count[b]; ++k)
+            agreeing += dips[near[b][k]];
+        kept[b] = agreeing >= min_agreeing_balls && 2 * agreeing >= near_count[b] ? 1 : 0;
+        any = any || kept[b] != 0;
+    }
+    if (!any)
+        return;
+    // Each sample's claim: the squared distance to the nearest centre of a kept ball holding it
+    // (its float bits, which order as the values do) above that ball's index; the least claim
+    // wins whichever thread makes it.
+    constexpr std::uint64_t unclaimed = ~std::uint64_t{0};
+    std::vector<std::uint64_t> claim(n, unclaimed);
+    parallel_blocks(count, 16, [&](std::size_t begin, std::size_t end) {
+        std::vector<std::uint32_t> members(ball_samples);
+        std::vector<float> distances(ball_samples);
+        for (std::size_t b = begin; b < end; ++b)
+        {
+            if (kept[b] == 0)
+                continue;
+            const std::size_t found =
+                tree.knn(positions[b * ball_stride], ball_samples, members, distances);
+            for (std::size_t k = 0; k < found; ++k)
+            {
+                const std::uint64_t mine =
+                    (std::uint64_t{std::bit_cast<std::uint32_t>(distances[k])} << 32U) | b;
+                std::atomic_ref<std::uint64_t> slot(claim[members[k]]);
+                std::uint64_t held = slot.load(std::memory_order_relaxed);
+                while (mine < held &&
+                       !slot.compare_exchange_weak(held, mine, std::memory_order_relaxed))
+                {}
+            }
+        }
+    });
+    parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            if (claim[i] == unclaimed)
+                continue;
+            const Ball& ball = balls[claim[i] & 0xFFFFFFFFU];
+            const float along = guide_normals[i].dot(ball.axis);
+            const float height = (positions[i] - ball.centroid).dot(ball.axis);
+            if (std::abs(along) >= min_axis_alignment && height != 0.0F)
+                sides[i] = (height > 0.0F) == (along > 0.0F) ? ball_side : -ball_side;
+        }
+    });
+}
 
 std::vector<std::int8_t> two_sheet_sides(std::span<const Vec3f> positions,
                                          const KnnTable& neighbors,
@@ -151,7 +343,6 @@ std::vector<std::int8_t> two_sheet_sides(std::span<const Vec3f> positions,
             for (const std::size_t b : pooled)
                 sum.add(block_sums[b]);
             const double kurtosis = sum.kurtosis();
-
             const std::int8_t strength = kurtosis <= static_cast<double>(certain_kurtosis)  ? 2
                                          : kurtosis <= static_cast<double>(likely_kurtosis) ? 1
                                                                                             : 0;
@@ -167,11 +358,11 @@ TwoSheetFacing face_two_sheet_regions(const KnnTable& neighbors,
 {
     TwoSheetFacing facing;
     const std::size_t n = sides.size();
-    if (std::none_of(sides.begin(), sides.end(), [](std::int8_t s) { return std::abs(s) == 2; }))
+    if (std::none_of(sides.begin(), sides.end(), [](std::int8_t s) { return std::abs(s) >= 2; }))
         return facing;
     // Regions: the samples with a side, joined through the table. Per region (by its root):
-    // samples, certain samples, and how many of their normals face away from the mid-surface
-    // less how many face towards it.
+    // samples, certain samples (|side| at least 2), and how many of their normals face away
+    // from the mid-surface less how many face towards it.
     DisjointSets regions(n);
     for (std::size_t i = 0; i < n; ++i)
         if (sides[i] != 0)
@@ -192,18 +383,22 @@ TwoSheetFacing face_two_sheet_regions(const KnnTable& neighbors,
             continue;
         Tally& t = tally[regions.find(i)];
         ++t.samples;
-        t.certain += std::abs(sides[i]) == 2 ? 1U : 0U;
+        t.certain += std::abs(sides[i]) >= 2 ? 1U : 0U;
         const float along = normals[i].dot(guide_normals[i]) * static_cast<float>(sides[i]);
         t.away += along > 0.0F ? 1 : along < 0.0F ? -1 : 0;
     }
     for (Tally& t : tally)
     {
         const auto samples = static_cast<double>(t.samples);
-        if (t.certain < min_certain || std::abs(static_cast<double>(t.away)) >= undecided * samples)
+        const auto certain_samples = static_cast<double>(t.certain);
+        if (t.certain < min_certain || certain_samples < min_certain_share * samples ||
+            std::abs(static_cast<double>(t.away)) >= undecided * samples)
             continue;
         t.turn = static_cast<double>(t.away) < -leaning_in * samples ? -1 : 1;
         ++facing.faced;
     }
+    if (facing.faced > 0)
+        facing.faced_by_balls.assign(n, 0);
     for (std::size_t i = 0; i < n; ++i)
     {
         if (sides[i] == 0)
@@ -211,6 +406,7 @@ TwoSheetFacing face_two_sheet_regions(const KnnTable& neighbors,
         const std::int8_t turn = tally[regions.find(i)].turn;
         if (turn == 0)
             continue;
+        facing.faced_by_balls[i] = std::abs(sides[i]) == ball_side ? 1 : 0;
         const Vec3f wanted = guide_normals[i] * static_cast<float>(sides[i] > 0 ? turn : -turn);
         if (!(wanted.dot(normals[i]) > 0.0F))
         {

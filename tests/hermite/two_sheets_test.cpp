@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 the pointform authors
+
+// The balls that find the two faces of a thin part a few noise deviations thick
+// (src/hermite/two_sheets.h, ball_sides()): on analytic clouds, which samples they give a side,
+// whether it is their face's, and that one sheet (curved, creased, with holes) gets none.
+
+#include "two_sheets.h"
+
+#include "pointform/geometry/shapes.h"
+#include "pointform/spatial/kd_tree.h"
+
+#include "support/thread_counts.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace pointform::detail {
+namespace {
+
+/// ball_sides() of `cloud` with guides along `guide` (the true normals where it is empty).
+std::vector<std::int8_t> sides_of(const PointCloud& cloud, const std::vector<Vec3f>& guide = {})
+{
+    const KdTree tree(cloud.positions);
+    std::vector<std::int8_t> sides(cloud.size(), 0);
+    ball_sides(tree, cloud.positions, guide.empty() ? cloud.normals : guide, sides);
+    return sides;
+}
+
+std::size_t sided(const std::vector<std::int8_t>& sides)
+{
+    std::size_t count = 0;
+    for (const std::int8_t s : sides)
+        count += s != 0 ? 1U : 0U;
+    return count;
+}
+
+TEST(BallSides, PlateSixDeviationsThickHasItsFacesFound)
+{
+    // Faces 0.035 apart under noise σ = 0.002 of the diagonal (2.83): 6σ, so that noise fills
+    // the gap and no neighbourhood grown through the neighbour table reaches the far face. The
+    // guides are the faces' normals, one sign for both faces (+z): each sample's side is then
+    // + on the top face and - on the bottom one.
+    const PointCloud plate = sample_shape(
+        Shape::Plate, {.count = 100000, .seed = 2, .noise = 0.002, .thickness = 0.035});
+    std::vector<Vec3f> up(plate.size(), Vec3f::UnitZ());
+    const std::vector<std::int8_t> sides = sides_of(plate, up);
+    std::size_t faces = 0;
+    std::size_t found = 0;
+    std::size_t right = 0;
+    for (std::size_t i = 0; i < plate.size(); ++i)
+    {
+        const Vec3f& p = plate.positions[i];
+        if (std::abs(plate.normals[i].z()) < 0.9F || std::abs(p.x()) > 0.9F ||
+            std::abs(p.y()) > 0.9F)
+            continue;
+        ++faces;
+        if (sides[i] == 0)
+            continue;
+        EXPECT_EQ(std::abs(sides[i]), ball_side);
+        ++found;
+        right += (sides[i] > 0) == (plate.normals[i].z() > 0.0F) ? 1U : 0U;
+    }
+    // Measured: 92% found (the balls along the rim hold its wall too), 99.4% of them right
+    // (noise carries a few past the midplane).
+    EXPECT_GE(static_cast<double>(found), 0.9 * static_cast<double>(faces));
+    EXPECT_GE(static_cast<double>(right), 0.99 * static_cast<double>(found))
+        << right << " of " << found;
+}
+
+TEST(BallSides, SideFollowsTheGuide)
+{
+    // The same plate with the bottom face's guides pointing down: every side is then + (each
+    // sample lies away from the midplane along its guide).
+    const PointCloud plate = sample_shape(
+        Shape::Plate, {.count = 100000, .seed = 3, .noise = 0.002, .thickness = 0.035});
+    const std::vector<std::int8_t> sides = sides_of(plate);
+    std::size_t found = 0;
+    std::size_t along = 0;
+    for (std::size_t i = 0; i < plate.size(); ++i)
+        if (sides[i] != 0 && std::abs(plate.normals[i].z()) > 0.9F)
+        {
+            ++found;
+            along += sides[i] > 0 ? 1U : 0U;
+        }
+    EXPECT_GT(found, plate.size() / 2);
+    EXPECT_GE(static_cast<double>(along), 0.99 * static_cast<double>(found));
+}
+
+TEST(BallSides, OneSheetHasNoSides)
+{
+    // The same noise on one sheet: curved (a sphere, whose cap heights are spread evenly, and a
+    // torus), creased (the part, the cone's rim, the blobby's concave creases), a plate 0.1 thick
+    // whose balls keep to one face, each with holes, which take the middle heights of a curved
+    // cap away.
+    for (const Shape shape :
+         {Shape::Sphere, Shape::Torus, Shape::Part, Shape::Cone, Shape::Blobby, Shape::Plate})
+    {
+        const PointCloud cloud = sample_shape(shape, {.count = 100000,
+                                                      .seed = 7,
+                                                      .noise = 0.002,
+                                                      .holes = 8,
+                                                      .hole_radius = 0.04,
+                                                      .thickness = 0.1});
+        EXPECT_EQ(sided(sides_of(cloud)), 0U) << static_cast<int>(shape);
+    }
+}
+
+TEST(BallSides, GuidesAcrossTheAxisTakeNoSide)
+{
+    // Guides lying in the plate's plane say nothing of which way its faces look.
+    const PointCloud plate = sample_shape(
+        Shape::Plate, {.count = 100000, .seed = 2, .noise = 0.002, .thickness = 0.035});
+    EXPECT_EQ(sided(sides_of(plate, std::vector<Vec3f>(plate.size(), Vec3f::UnitX()))), 0U);
+}
+
+TEST(BallSides, SmallOrMismatchedInputIsLeftAlone)
+{
+    const PointCloud plate =
+        sample_shape(Shape::Plate, {.count = 400, .seed = 2, .noise = 0.002, .thickness = 0.035});
+    EXPECT_EQ(sided(sides_of(plate)), 0U); // fewer samples than two balls
+    const KdTree tree(plate.positions);
+    std::vector<std::int8_t> short_sides(3, 0);
+    ball_sides(tree, plate.positions, plate.normals, short_sides);
+    EXPECT_EQ(sided(short_sides), 0U);
+}
+
+TEST(BallSides, SameSidesWhateverTheThreadCount)
+{
+    const PointCloud plate = sample_shape(Shape::Plate, {.count = 100000,
+                                                         .seed = 1,
+                                                         .noise = 0.002,
+                                                         .holes = 8,
+                                                         .hole_radius = 0.04,
+                                                         .thickness = 0.035});
+    const auto runs =
+        test::at_thread_counts([&] { return sides_of(plate); }, {.min_multi_block_loops = 2});
+    ASSERT_FALSE(runs.empty());
+    EXPECT_GT(sided(runs[0]), plate.size() / 2);
+    for (const auto& run : runs)
+        EXPECT_EQ(run, runs[0]);
+}
+
+} // namespace
+} // namespace pointform::detail
