@@ -17,6 +17,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace pointform::detail {
 namespace {
@@ -120,9 +121,16 @@ struct Powers
 /// 0.2% of the diagonal, 8 holes): with 256, 89-95% of the balls on plates 6-7 deviations thick
 /// dip, and 0-0.1% on noisy cones, CAD-like parts, spheres and simulated scans of CAD parts.
 constexpr std::size_t ball_samples = 256;
-/// Every ball_stride-th sample (in index order: spatially sorted samples, as compute_surfels()
-/// has them, spread the centres evenly) is a ball's centre: each sample lies in about four balls.
+/// Every ball_stride-th sample of the balls' cloud (in index order: spatially sorted samples, as
+/// compute_surfels() has them, spread the centres evenly) is a ball's centre: each sample lies in
+/// about four balls.
 constexpr std::size_t ball_stride = 64;
+/// Above this many samples the balls are made of every s-th sample (index order), s = n over
+/// it: a ball of a fixed number of samples is then as wide at 1M or 10M samples as at 100k,
+/// where it was measured (at 1M the 256 nearest of all the samples span a third as much, a plate
+/// 0.035 thick's faces no longer both), and the balls cost the same at any size (0.29-0.36 s
+/// for the balls of all 1M samples of a noisy blobby, 2 threads).
+constexpr std::size_t ball_cloud = 100000;
 /// A ball's heights dip when the centre bin of their histogram holds at most this share of the
 /// lower of the two sides' highest bins. Over the balls above: median 0.08-0.23 on the plates,
 /// 0.75-0.89 at the 0.1st percentile on the one-sheet shapes.
@@ -215,14 +223,27 @@ bool dipping_ball(const KdTree& tree, std::span<const Vec3f> positions, std::siz
 
 } // namespace
 
-void ball_sides(const KdTree& tree, std::span<const Vec3f> positions,
-                std::span<const Vec3f> guide_normals, std::span<std::int8_t> sides)
+void ball_sides(std::span<const Vec3f> positions, std::span<const Vec3f> guide_normals,
+                std::span<std::int8_t> sides)
 {
     const std::size_t n = positions.size();
-    if (n < 2 * ball_samples || guide_normals.size() != n || sides.size() != n || tree.size() != n)
+    if (n < 2 * ball_samples || guide_normals.size() != n || sides.size() != n)
         return;
-    const std::size_t count = (n + ball_stride - 1) / ball_stride;
+    // The balls' cloud: every step-th sample.
+    const std::size_t step = std::max<std::size_t>(1, n / ball_cloud);
+    std::vector<Vec3f> thinned;
+    if (step > 1)
+    {
+        thinned.reserve(n / step + 1);
+        for (std::size_t i = 0; i < n; i += step)
+            thinned.push_back(positions[i]);
+    }
+    const std::span<const Vec3f> cloud =
+        step > 1 ? std::span<const Vec3f>(thinned) : std::span<const Vec3f>(positions);
+    const KdTree tree(cloud);
+    const std::size_t count = (cloud.size() + ball_stride - 1) / ball_stride;
     std::vector<Ball> balls(count);
+    std::vector<float> reach2(count, 0.0F); // the squared distance to a ball's farthest sample
     std::vector<std::uint8_t> dips(count, 0);
     std::vector<std::array<std::uint32_t, ball_neighbours>> near(count);
     std::vector<std::uint8_t> near_count(count, 0);
@@ -233,10 +254,11 @@ void ball_sides(const KdTree& tree, std::span<const Vec3f> positions,
         std::vector<std::uint32_t> others;
         for (std::size_t b = begin; b < end; ++b)
         {
-            dips[b] = dipping_ball(tree, positions, b * ball_stride, members, distances, heights,
+            dips[b] = dipping_ball(tree, cloud, b * ball_stride, members, distances, heights,
                                    others, balls[b])
                           ? 1
                           : 0;
+            reach2[b] = distances.back();
             std::copy(others.begin(), others.end(), near[b].begin());
             near_count[b] = static_cast<std::uint8_t>(others.size());
         }
@@ -257,7 +279,11 @@ void ball_sides(const KdTree& tree, std::span<const Vec3f> positions,
         return;
     // Each sample's claim: the squared distance to the nearest centre of a kept ball holding it
     // (its float bits, which order as the values do) above that ball's index; the least claim
-    // wins whichever thread makes it.
+    // wins whichever thread makes it. A ball of the thinned cloud holds every sample within its
+    // reach.
+    std::optional<KdTree> all;
+    if (step > 1)
+        all.emplace(positions);
     constexpr std::uint64_t unclaimed = ~std::uint64_t{0};
     std::vector<std::uint64_t> claim(n, unclaimed);
     parallel_blocks(count, 16, [&](std::size_t begin, std::size_t end) {
@@ -267,9 +293,16 @@ void ball_sides(const KdTree& tree, std::span<const Vec3f> positions,
         {
             if (kept[b] == 0)
                 continue;
-            const std::size_t found =
-                tree.knn(positions[b * ball_stride], ball_samples, members, distances);
-            for (std::size_t k = 0; k < found; ++k)
+            const Vec3f& centre = cloud[b * ball_stride];
+            if (all)
+            {
+                members.clear();
+                distances.clear();
+                all->radius_search(centre, std::sqrt(reach2[b]), members, distances);
+            }
+            else
+                tree.knn(centre, ball_samples, members, distances);
+            for (std::size_t k = 0; k < members.size(); ++k)
             {
                 const std::uint64_t mine =
                     (std::uint64_t{std::bit_cast<std::uint32_t>(distances[k])} << 32U) | b;
@@ -398,7 +431,7 @@ TwoSheetFacing face_two_sheet_regions(const KnnTable& neighbors,
         ++facing.faced;
     }
     if (facing.faced > 0)
-        facing.faced_by_balls.assign(n, 0);
+        facing.faced_by.assign(n, 0);
     for (std::size_t i = 0; i < n; ++i)
     {
         if (sides[i] == 0)
@@ -406,7 +439,7 @@ TwoSheetFacing face_two_sheet_regions(const KnnTable& neighbors,
         const std::int8_t turn = tally[regions.find(i)].turn;
         if (turn == 0)
             continue;
-        facing.faced_by_balls[i] = std::abs(sides[i]) == ball_side ? 1 : 0;
+        facing.faced_by[i] = std::abs(sides[i]) == ball_side ? faced_by_ball : faced_by_kurtosis;
         const Vec3f wanted = guide_normals[i] * static_cast<float>(sides[i] > 0 ? turn : -turn);
         if (!(wanted.dot(normals[i]) > 0.0F))
         {

@@ -11,10 +11,6 @@
 #include <span>
 #include <vector>
 
-namespace pointform {
-class KdTree;
-}
-
 namespace pointform::detail {
 
 /// The two faces of a thin part whose gap noise fills (faces a few noise deviations apart): no
@@ -44,19 +40,22 @@ namespace pointform::detail {
 constexpr std::int8_t ball_side = 3;
 
 /// The faces of a thin part a few noise deviations apart, seen from balls: each ball_stride-th
-/// sample (in index order) and its nearest samples, Euclidean, which reach across the gap where
-/// a neighbourhood grown through the table keeps to its centre's face. Where the heights of a
-/// ball's samples along its least axis dip (their histogram has a hole in the middle, which one
-/// sheet's heights, curved or creased, do not) and most of the balls about it dip too, each
+/// sample (in index order) and its ball_samples nearest samples, Euclidean, which reach across the
+/// gap where a neighbourhood grown through the table keeps to its centre's face. Where the heights
+/// of a ball's samples along its least axis dip (their histogram has a hole in the middle, which
+/// one sheet's heights, curved or creased, do not) and most of the balls about it dip too, each
 /// sample in it whose guide lies along that axis takes the band it lies in, from the dipping ball
 /// whose centre is nearest: ±ball_side, + along its guide. The sides from two_sheet_sides() it
 /// overrides. On a plate 6 deviations thick (100k samples, noise 0.2% of the diagonal, 8 holes),
 /// 83% of the balls count; they give 92% of the faces' samples a side, 99.4% of them their own
-/// band's. The balls hold a fixed number of samples, so at 1M they are a third as wide and
-/// reach across thinner parts only (a plate 0.035 thick at 1M none, but there the guides keep
-/// its faces apart).
-void ball_sides(const KdTree& tree, std::span<const Vec3f> positions,
-                std::span<const Vec3f> guide_normals, std::span<std::int8_t> sides);
+/// band's. Above ball_cloud samples the balls are made of an even subsample, so that they are as
+/// wide at any size.
+void ball_sides(std::span<const Vec3f> positions, std::span<const Vec3f> guide_normals,
+                std::span<std::int8_t> sides);
+
+/// TwoSheetFacing::faced_by's values.
+constexpr std::uint8_t faced_by_kurtosis = 1;
+constexpr std::uint8_t faced_by_ball = 2;
 
 /// What face_two_sheet_regions() did.
 struct TwoSheetFacing
@@ -65,9 +64,10 @@ struct TwoSheetFacing
     std::size_t faced = 0;
     /// Samples whose normal turned.
     std::size_t turned = 0;
-    /// One a sample when a region was faced (else empty): 1 where the sample's side came from a
-    /// ball (ball_sides()) and its region was faced.
-    std::vector<std::uint8_t> faced_by_balls;
+    /// One a sample when a region was faced (else empty): where the sample's region was faced,
+    /// faced_by_ball if its side came from a ball (ball_sides()), else faced_by_kurtosis; 0
+    /// elsewhere.
+    std::vector<std::uint8_t> faced_by;
 };
 
 /// Orients the two-sheet regions (samples with a side, connected through the neighbour table,

@@ -337,6 +337,41 @@ TEST(OrientNormalsMst, NoisyPlateSixDeviationsThickFacesAwayFromItsMidplane)
     }
 }
 
+TEST(OrientNormalsMst, NoisyPlateSixDeviationsThickStandingOnItsEdgeFacesOutwards)
+{
+    // The plate above stood on its edge (turned 90° about x, its faces' normals along ±y): a
+    // thin solid encloses too little volume for the flux test to judge, and the component's
+    // root, its highest sample, lies on the rim, whose normal is about horizontal; turning the
+    // root to face +z turned the faced plate inside out (98.7% of its normals facing away). A
+    // component holding a faced thin part keeps the faces' outward normals.
+    PointCloud plate = sample_shape(Shape::Plate, {.count = 100000,
+                                                   .seed = 1,
+                                                   .noise = 0.002,
+                                                   .holes = 8,
+                                                   .hole_radius = 0.04,
+                                                   .thickness = 0.035});
+    for (std::size_t i = 0; i < plate.size(); ++i)
+    {
+        const auto stand = [](const Vec3f& v) {
+            return Vec3f(v.x(), -v.z(), v.y());
+        };
+        plate.positions[i] = stand(plate.positions[i]);
+        plate.normals[i] = stand(plate.normals[i]);
+    }
+    const SurfelResult result = compute_surfels(test::without_normals(plate));
+    const std::vector<Vec3f>& normals = result.surfels.normals;
+    EXPECT_GE(result.orientation.thin_parts, 1U);
+    std::size_t faces = 0;
+    std::size_t outward = 0;
+    for (std::size_t i = 0; i < plate.size(); ++i)
+        if (std::abs(plate.normals[i].y()) > 0.9F)
+        {
+            ++faces;
+            outward += normals[i].dot(plate.normals[i]) > 0.0F ? 1U : 0U;
+        }
+    EXPECT_GE(static_cast<double>(outward), 0.99 * static_cast<double>(faces));
+}
+
 TEST(OrientNormalsMst, NoisyPlateSixDeviationsThickIsTheSameWhateverTheThreadCount)
 {
     const PointCloud plate =
