@@ -1098,6 +1098,25 @@ constexpr double winding_gain = 0.2;
 /// 0.1 that bounded it before the fit).
 constexpr double closed_energy = 0.05;
 
+/// Runs `step(begin, end, round)` over fixed blocks of [0, n) in parallel, round after round
+/// (from 1), until no block's step returns true (it made progress) or `most` rounds have run.
+/// Steps that read what earlier rounds wrote, and skip what this round writes, give the same
+/// result whatever the thread count.
+template <class Step>
+void in_rounds(std::size_t n, std::uint32_t most, const Step& step)
+{
+    for (std::uint32_t round = 1; round <= most; ++round)
+    {
+        std::atomic<bool> progressed{false};
+        parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+            if (step(begin, end, round))
+                progressed.store(true, std::memory_order_relaxed);
+        });
+        if (!progressed.load())
+            break;
+    }
+}
+
 /// The samples of a guided cloud in a crease band (crease_band_flatness) or next to one.
 std::vector<std::uint8_t> crease_band(std::span<const Vec3f> positions, const KnnTable& neighbors,
                                       const Guide& guide, std::size_t columns)
@@ -1443,10 +1462,9 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
             normals[i] = -normals[i];
     }
     std::vector<Vec3f> adopted(normals);
-    for (std::uint32_t round = 1;; ++round)
-    {
-        std::atomic<bool> progressed{false};
-        parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
+    in_rounds(
+        n, std::numeric_limits<std::uint32_t>::max(),
+        [&](std::size_t begin, std::size_t end, std::uint32_t round) {
             std::vector<float> residual(neighbors.k);
             bool local = false;
             for (std::size_t i = begin; i < end; ++i)
@@ -1488,12 +1506,8 @@ void turn_regions_by_winding(std::span<const Vec3f> positions, const KnnTable& n
                 std::atomic_ref<std::uint32_t>(stamp[i]).store(round, std::memory_order_relaxed);
                 local = true;
             }
-            if (local)
-                progressed.store(true, std::memory_order_relaxed);
+            return local;
         });
-        if (!progressed.load())
-            break;
-    }
     //    A sample that no round reached (every edge of its row jumps between sheets: an outlier
     //    of the noise off its sheet) kept its own normal, whose side was never set against the
     //    turned regions: it takes the side that its row's reached samples point to. On 100k
@@ -1561,50 +1575,43 @@ std::size_t follow_faced_regions(std::span<const Vec3f> positions, const KnnTabl
         if (faced[i] == detail::faced_by_ball)
             stamp[i] = 0;
     std::atomic<std::size_t> turned{0};
-    for (std::uint32_t round = 1; round <= follow_rounds; ++round)
-    {
-        std::atomic<bool> progressed{false};
-        parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
-            bool local = false;
-            for (std::size_t i = begin; i < end; ++i)
+    in_rounds(n, follow_rounds, [&](std::size_t begin, std::size_t end, std::uint32_t round) {
+        bool local = false;
+        for (std::size_t i = begin; i < end; ++i)
+        {
+            if (stamp[i] != none || guide.side[i] != 0 || !usable(normals[i]))
+                continue;
+            float vote = 0.0F;
+            float weight = 0.0F;
+            bool reached = false;
+            for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
             {
-                if (stamp[i] != none || guide.side[i] != 0 || !usable(normals[i]))
+                // Samples that took their sign in this round are skipped whichever thread
+                // got there first.
+                const std::uint32_t taken =
+                    std::atomic_ref<std::uint32_t>(stamp[j]).load(std::memory_order_relaxed);
+                if (j == i || taken >= round ||
+                    guide.jumps(positions, neighbors, static_cast<std::uint32_t>(i), j))
                     continue;
-                float vote = 0.0F;
-                float weight = 0.0F;
-                bool reached = false;
-                for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
-                {
-                    // Samples that took their sign in this round are skipped whichever thread
-                    // got there first.
-                    const std::uint32_t taken =
-                        std::atomic_ref<std::uint32_t>(stamp[j]).load(std::memory_order_relaxed);
-                    if (j == i || taken >= round ||
-                        guide.jumps(positions, neighbors, static_cast<std::uint32_t>(i), j))
-                        continue;
-                    reached = true;
-                    const float a = normals[i].dot(normals[j]);
-                    vote += a;
-                    weight += std::abs(a);
-                }
-                // Only where the samples that reach it agree: where both faces' samples do (next
-                // to a thin part's faced region that holds both), the sample waits.
-                if (!reached || !(std::abs(vote) >= follow_consensus * weight))
-                    continue;
-                if (vote < 0.0F)
-                {
-                    normals[i] = -normals[i];
-                    turned.fetch_add(1, std::memory_order_relaxed);
-                }
-                std::atomic_ref<std::uint32_t>(stamp[i]).store(round, std::memory_order_relaxed);
-                local = true;
+                reached = true;
+                const float a = normals[i].dot(normals[j]);
+                vote += a;
+                weight += std::abs(a);
             }
-            if (local)
-                progressed.store(true, std::memory_order_relaxed);
-        });
-        if (!progressed.load())
-            break;
-    }
+            // Only where the samples that reach it agree: where both faces' samples do (next
+            // to a thin part's faced region that holds both), the sample waits.
+            if (!reached || !(std::abs(vote) >= follow_consensus * weight))
+                continue;
+            if (vote < 0.0F)
+            {
+                normals[i] = -normals[i];
+                turned.fetch_add(1, std::memory_order_relaxed);
+            }
+            std::atomic_ref<std::uint32_t>(stamp[i]).store(round, std::memory_order_relaxed);
+            local = true;
+        }
+        return local;
+    });
     return turned.load();
 }
 

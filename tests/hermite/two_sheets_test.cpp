@@ -36,6 +36,34 @@ std::size_t sided(const std::vector<std::int8_t>& sides)
     return count;
 }
 
+/// Of the samples on the faces of `plate` away from its rim: how many have a side (`found`),
+/// and how many of those the side of their own face, + on the top one (`right`).
+struct FaceSides
+{
+    std::size_t faces = 0;
+    std::size_t found = 0;
+    std::size_t right = 0;
+};
+
+FaceSides face_sides(const PointCloud& plate, const std::vector<std::int8_t>& sides)
+{
+    FaceSides count;
+    for (std::size_t i = 0; i < plate.size(); ++i)
+    {
+        const Vec3f& p = plate.positions[i];
+        if (std::abs(plate.normals[i].z()) < 0.9F || std::abs(p.x()) > 0.9F ||
+            std::abs(p.y()) > 0.9F)
+            continue;
+        ++count.faces;
+        if (sides[i] == 0)
+            continue;
+        EXPECT_EQ(std::abs(sides[i]), ball_side);
+        ++count.found;
+        count.right += (sides[i] > 0) == (plate.normals[i].z() > 0.0F) ? 1U : 0U;
+    }
+    return count;
+}
+
 TEST(BallSides, PlateSixDeviationsThickHasItsFacesFound)
 {
     // Faces 0.035 apart under noise σ = 0.002 of the diagonal (2.83): 6σ, so that noise fills
@@ -44,29 +72,13 @@ TEST(BallSides, PlateSixDeviationsThickHasItsFacesFound)
     // + on the top face and - on the bottom one.
     const PointCloud plate = sample_shape(
         Shape::Plate, {.count = 100000, .seed = 2, .noise = 0.002, .thickness = 0.035});
-    std::vector<Vec3f> up(plate.size(), Vec3f::UnitZ());
-    const std::vector<std::int8_t> sides = sides_of(plate, up);
-    std::size_t faces = 0;
-    std::size_t found = 0;
-    std::size_t right = 0;
-    for (std::size_t i = 0; i < plate.size(); ++i)
-    {
-        const Vec3f& p = plate.positions[i];
-        if (std::abs(plate.normals[i].z()) < 0.9F || std::abs(p.x()) > 0.9F ||
-            std::abs(p.y()) > 0.9F)
-            continue;
-        ++faces;
-        if (sides[i] == 0)
-            continue;
-        EXPECT_EQ(std::abs(sides[i]), ball_side);
-        ++found;
-        right += (sides[i] > 0) == (plate.normals[i].z() > 0.0F) ? 1U : 0U;
-    }
+    const FaceSides count =
+        face_sides(plate, sides_of(plate, std::vector<Vec3f>(plate.size(), Vec3f::UnitZ())));
     // Measured: 92% found (the balls along the rim hold its wall too), 99.4% of them right
     // (noise carries a few past the midplane).
-    EXPECT_GE(static_cast<double>(found), 0.9 * static_cast<double>(faces));
-    EXPECT_GE(static_cast<double>(right), 0.99 * static_cast<double>(found))
-        << right << " of " << found;
+    EXPECT_GE(static_cast<double>(count.found), 0.9 * static_cast<double>(count.faces));
+    EXPECT_GE(static_cast<double>(count.right), 0.99 * static_cast<double>(count.found))
+        << count.right << " of " << count.found;
 }
 
 TEST(BallSides, BallsOfALargerCloudAreAsWide)
@@ -76,24 +88,11 @@ TEST(BallSides, BallsOfALargerCloudAreAsWide)
     // and every sample within a counted ball's reach takes its side.
     const PointCloud plate = sample_shape(
         Shape::Plate, {.count = 250000, .seed = 2, .noise = 0.002, .thickness = 0.035});
-    std::vector<Vec3f> up(plate.size(), Vec3f::UnitZ());
-    const std::vector<std::int8_t> sides = sides_of(plate, up);
-    std::size_t faces = 0;
-    std::size_t found = 0;
-    std::size_t right = 0;
-    for (std::size_t i = 0; i < plate.size(); ++i)
-    {
-        const Vec3f& p = plate.positions[i];
-        if (std::abs(plate.normals[i].z()) < 0.9F || std::abs(p.x()) > 0.9F ||
-            std::abs(p.y()) > 0.9F)
-            continue;
-        ++faces;
-        found += sides[i] != 0 ? 1U : 0U;
-        right += sides[i] != 0 && (sides[i] > 0) == (plate.normals[i].z() > 0.0F) ? 1U : 0U;
-    }
+    const FaceSides count =
+        face_sides(plate, sides_of(plate, std::vector<Vec3f>(plate.size(), Vec3f::UnitZ())));
     // Measured: 88.7% found.
-    EXPECT_GE(static_cast<double>(found), 0.85 * static_cast<double>(faces));
-    EXPECT_GE(static_cast<double>(right), 0.99 * static_cast<double>(found));
+    EXPECT_GE(static_cast<double>(count.found), 0.85 * static_cast<double>(count.faces));
+    EXPECT_GE(static_cast<double>(count.right), 0.99 * static_cast<double>(count.found));
 }
 
 TEST(BallSides, SideFollowsTheGuide)
