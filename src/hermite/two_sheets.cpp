@@ -45,9 +45,9 @@ constexpr std::size_t min_certain = 64;
 /// to a low kurtosis by chance, and the sides they give are the offsets' signs, which say
 /// nothing: at 1M samples (the widest guide neighbourhood leans to the sample's own face) a plate
 /// 0.04 thick had regions of 7,600-14,300 samples, 0-5.7% of them certain, and facing them left
-/// 5.16% of its normals facing away (0.23% with this share). Plates at 100k whose faces noise
-/// joins: 36% certain (0.015 thick, by their kurtosis alone; the balls do not dip) to 100%
-/// (0.035).
+/// 5.16% of its normals facing away (0.23% with this share; 0.05% once the balls, made of a
+/// subsample, found the plate). Plates at 100k whose faces noise joins: 36% certain (0.015
+/// thick, by their kurtosis alone; the balls do not dip) to 100% (0.035).
 constexpr double min_certain_share = 0.15;
 /// A region is undecided when its normals facing away from its mid-surface outnumber those facing
 /// towards it, or the other way round, by less than this share of its samples: where
