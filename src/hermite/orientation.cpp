@@ -563,12 +563,6 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
     const auto edge_of = [](std::uint64_t key) {
         return static_cast<std::size_t>(key & ((std::uint64_t{1} << 33) - 1));
     };
-    const auto lower = [](std::uint64_t& slot, std::uint64_t key) {
-        std::atomic_ref<std::uint64_t> shared(slot);
-        std::uint64_t seen = shared.load(std::memory_order_relaxed);
-        while (key < seen && !shared.compare_exchange_weak(seen, key, std::memory_order_relaxed))
-        {}
-    };
     std::vector<std::uint32_t> label(n); // the component of each sample: a representative
     std::vector<std::uint32_t> up(n);    // by label: the next label towards its round's root
     std::iota(label.begin(), label.end(), 0U);
@@ -596,10 +590,10 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
                 bits[c / 8] |= static_cast<std::uint8_t>(1U << (c % 8));
                 const std::uint64_t key = key_of(cost_of(a, b), i * columns + c);
                 own = std::min(own, key);
-                lower(cheapest[b], key);
+                detail::lower_atomically(cheapest[b], key);
             }
             if (own != no_key)
-                lower(cheapest[a], own);
+                detail::lower_atomically(cheapest[a], own);
             else
                 internal[i] = 1;
         }
@@ -632,10 +626,10 @@ RiemannianForest spanning_forest(std::span<const Vec3f> positions, std::span<con
                     leaves = true;
                     const std::uint64_t key = key_of(cost_of(a, row[c]), i * columns + c);
                     own = std::min(own, key);
-                    lower(cheapest[lb], key);
+                    detail::lower_atomically(cheapest[lb], key);
                 }
                 if (leaves)
-                    lower(cheapest[la], own);
+                    detail::lower_atomically(cheapest[la], own);
                 else
                     internal[i] = 1; // components only grow: it stays so
             }
@@ -2522,14 +2516,7 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
                 for (const std::uint32_t i : neighbors.neighbors(j).first(columns))
                     if (std::atomic_ref<std::uint32_t>(stamp[i]).load(std::memory_order_relaxed) ==
                         not_yet)
-                    {
-                        std::atomic_ref<std::uint32_t> slot(offer[i]);
-                        std::uint32_t seen = slot.load(std::memory_order_relaxed);
-                        while (j < seen &&
-                               !slot.compare_exchange_weak(seen, static_cast<std::uint32_t>(j),
-                                                           std::memory_order_relaxed))
-                        {}
-                    }
+                        detail::lower_atomically(offer[i], static_cast<std::uint32_t>(j));
             }
             if (local)
                 open.store(true, std::memory_order_relaxed);

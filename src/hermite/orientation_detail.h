@@ -6,6 +6,7 @@
 #include "pointform/hermite/orientation.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -13,6 +14,17 @@
 #include <vector>
 
 namespace pointform::detail {
+
+/// Lowers `slot` to `value` where that is less, atomically: of the values that threads offer one
+/// slot, the least stays, whichever thread offers it when (a result the same at any thread count).
+template <class T>
+void lower_atomically(T& slot, T value)
+{
+    std::atomic_ref<T> shared(slot);
+    T seen = shared.load(std::memory_order_relaxed);
+    while (value < seen && !shared.compare_exchange_weak(seen, value, std::memory_order_relaxed))
+    {}
+}
 
 /// Whether a normal (unit, or zero where there is none) can be used.
 [[nodiscard]] inline bool usable(const Vec3f& n)

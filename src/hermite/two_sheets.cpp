@@ -13,7 +13,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -303,15 +302,9 @@ void ball_sides(std::span<const Vec3f> positions, std::span<const Vec3f> guide_n
             else
                 tree.knn(centre, ball_samples, members, distances);
             for (std::size_t k = 0; k < members.size(); ++k)
-            {
-                const std::uint64_t mine =
-                    (std::uint64_t{std::bit_cast<std::uint32_t>(distances[k])} << 32U) | b;
-                std::atomic_ref<std::uint64_t> slot(claim[members[k]]);
-                std::uint64_t held = slot.load(std::memory_order_relaxed);
-                while (mine < held &&
-                       !slot.compare_exchange_weak(held, mine, std::memory_order_relaxed))
-                {}
-            }
+                lower_atomically(
+                    claim[members[k]],
+                    (std::uint64_t{std::bit_cast<std::uint32_t>(distances[k])} << 32U) | b);
         }
     });
     parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
