@@ -124,16 +124,31 @@ constexpr std::size_t ball_samples = 256;
 /// compute_surfels() has them, spread the centres evenly) is a ball's centre: each sample lies in
 /// about four balls.
 constexpr std::size_t ball_stride = 64;
-/// Above this many samples the balls are made of every s-th sample (index order), s = n over
+/// Above this many samples the balls are found in every s-th sample (index order), s = n over
 /// it: a ball of a fixed number of samples is then as wide at 1M or 10M samples as at 100k,
 /// where it was measured (at 1M the 256 nearest of all the samples span a third as much, a plate
-/// 0.035 thick's faces no longer both), and the balls cost the same at any size (0.29-0.36 s
-/// for the balls of all 1M samples of a noisy blobby, 2 threads).
+/// 0.035 thick's faces no longer both), and there are as many balls at any size. Their heights
+/// are then those of all the samples within the ball's reach (about s · 256), whose histogram is
+/// that much less noisy: on a noisy plate 0.02 thick at 1M, 75% of the balls dip where 46% did
+/// with the subsample's 256 alone, and no ball of noisy 1M spheres, tori, cones, blobbies or
+/// CAD-like parts comes near a dip (the centre bin at least 0.9 of the sides' peak in all but
+/// one of 8,300).
 constexpr std::size_t ball_cloud = 100000;
 /// A ball's heights dip when the centre bin of their histogram holds at most this share of the
 /// lower of the two sides' highest bins. Over the balls above: median 0.08-0.23 on the plates,
 /// 0.75-0.89 at the 0.1st percentile on the one-sheet shapes.
 constexpr double max_dip = 0.6;
+/// A ball beside one that counts (below) counts too when its dip is at least shallow: the centre
+/// bin at most this share of the sides' peak, and below it by at least min_dip_significance
+/// deviations of the two counts' difference (Poisson counts: √(centre + peak)). Faces 3.5
+/// deviations apart dip only so much (two normal bands at ±1.75 leave 0.43 of the peak between
+/// them, less the bins' and the counts' noise): on the 1M plate 0.02 thick 96% of the balls are
+/// below 0.7 and 60% count by max_dip and their neighbours; with this, 91%. A ball of 256
+/// samples, whose bins hold 30-40, is never that significant without a dip of max_dip: on one
+/// sheet, at 100k, such balls (0.7 to 0.8: 6 of 786 on a simulated scan of the teapot) had grown
+/// into the teapot's body and turned it inside out.
+constexpr double max_shallow_dip = 0.8;
+constexpr double min_dip_significance = 3.0;
 /// The other balls' centres in a ball that its neighbour test looks at (the nearest first).
 constexpr std::size_t ball_neighbours = 16;
 /// A dipping ball counts when at least this many of the other balls' centres in it, and at least
@@ -143,25 +158,59 @@ constexpr std::size_t ball_neighbours = 16;
 /// A/B set of RESULTS_reconstruct.md turned (40-2,308 samples: blobbies, tori, cones, brackets,
 /// teapots; the torus's 132 at the rim of a hole in its outer face); with the test, none.
 constexpr std::size_t min_agreeing_balls = 2;
-/// A sample's guide must lie within 60° of its ball's axis for the ball to give it a side.
+/// A sample's guide must lie within 60° of its ball's axis for the ball to give it a side...
 constexpr float min_axis_alignment = 0.5F;
+/// ... unless the ball's two bands lie less than this many of their own deviations apart
+/// (Ball::separation): then the sample's guide becomes the ball's axis, and it takes its band.
+/// Where faces are that close, a sample's guide is grown from a neighbourhood whose flatness the
+/// noise sets, 0.21-0.29 (0.06-0.12 on a plate 0.05 thick at 100k), and 14% of the faces' guides
+/// on the 1M plate 0.02 thick (3.8 deviations) lay more than 60° off. Their normals, oriented
+/// by neighbours alone, were 16% wrong; with the axis, the plate's normals facing away went from
+/// 5.8% to 4.8%. Where the faces are farther apart (5.0 at 0.03 thick, 7.1 at 0.05), a guide
+/// across the axis is most likely the plate's rim, a face of its own, and is kept.
+constexpr float max_realigned_separation = 4.5F;
+/// ... and the guides across the axis in the ball agree in direction less than this
+/// (Ball::across_agreement): where they agree, they are a rim's.
+constexpr float max_across_agreement = 0.5F;
+/// ... and lie about the ball like its other samples (Ball::across_offset below this): at a
+/// corner, where two rims' guides cross, their directions do not agree, but the rims lie at
+/// the ball's edge.
+constexpr float max_across_offset = 0.25F;
 
-/// A ball of ball_sides() whose heights dip: the plane between its two bands.
+/// A ball of ball_sides(): the plane through its samples' centroid across their least axis, and
+/// how their heights along the axis dip.
 struct Ball
 {
     Vec3f centroid = Vec3f::Zero();
     Vec3f axis = Vec3f::Zero();
+    /// The histogram's centre bin over the lower of the sides' highest bins (dip_of()).
+    double dip = std::numeric_limits<double>::infinity();
+    /// That difference in deviations of the counts.
+    double significance = 0.0;
+    /// The mean heights above and below the centroid, apart, over the deviation of the heights
+    /// about their own side's mean: two normal bands d deviations apart score about d.
+    float separation = 0.0F;
+    /// How much the guides of its samples that lie across the axis (more than 60° off) agree in
+    /// direction within the plane: |Σ (cos 2θ, sin 2θ)| over their count, θ their angle in the
+    /// plane (lines, not directions). A rim's guides, across the rim, score near 1; guides that
+    /// noise turned, at random, near 0.
+    float across_agreement = 0.0F;
+    /// Where those samples lie: their centroid's distance from all the samples' centroid, across
+    /// the axis, over the samples' deviation across it. A rim's samples lie at the ball's edge
+    /// (about 0.8 for a ball halved by a straight rim); samples that noise turned are spread
+    /// over the ball like the others (near 0).
+    float across_offset = 0.0F;
 };
 
-/// Whether heights (about their mean, with mean square `variance`) dip: a histogram of the
-/// heights over their deviation, in 9 bins of half a deviation, has a hole in the middle. Two
-/// bands more than about 4 deviations of the noise apart leave one; one sheet's heights,
-/// curved or creased, do not (a curved cap's heights are spread evenly, its kurtosis as low as
-/// two bands').
-bool dipped(std::span<const float> heights, double variance)
+/// How heights (about their mean, with mean square `variance`) dip: a histogram of the heights
+/// over their deviation, in 9 bins of half a deviation, and its centre bin against the lower of
+/// the two sides' highest bins. Two bands more than about 4 deviations of the noise apart leave a
+/// hole in the middle; one sheet's heights, curved or creased, do not (a curved cap's heights are
+/// spread evenly, its kurtosis as low as two bands').
+void dip_of(std::span<const float> heights, double variance, Ball& ball)
 {
     if (!(variance > 0.0))
-        return false;
+        return;
     const double scale = 2.0 / std::sqrt(variance); // bins of half a deviation
     std::array<std::uint32_t, 9> bins{};
     for (const float h : heights)
@@ -173,25 +222,112 @@ bool dipped(std::span<const float> heights, double variance)
     const std::uint32_t below = *std::max_element(bins.begin(), bins.begin() + 4);
     const std::uint32_t above = *std::max_element(bins.begin() + 5, bins.end());
     const double side = static_cast<double>(std::max<std::uint32_t>(1, std::min(below, above)));
-    return static_cast<double>(bins[4]) <= max_dip * side;
+    const auto centre = static_cast<double>(bins[4]);
+    ball.dip = centre / side;
+    ball.significance = (side - centre) / std::sqrt(side + centre);
 }
 
-/// The ball about sample `centre`, and whether its heights dip. `members`, `distances` and
-/// `heights` are buffers of ball_samples; `near` receives the other balls' centres in it.
-bool dipping_ball(const KdTree& tree, std::span<const Vec3f> positions, std::size_t centre,
-                  std::span<std::uint32_t> members, std::span<float> distances,
-                  std::span<float> heights, std::vector<std::uint32_t>& near, Ball& ball)
+/// The separation of heights about their mean (Ball::separation).
+float separation_of(std::span<const float> heights)
+{
+    std::array<double, 2> sum{};
+    std::array<std::size_t, 2> count{};
+    for (const float h : heights)
+    {
+        sum[h > 0.0F ? 1 : 0] += static_cast<double>(h);
+        ++count[h > 0.0F ? 1 : 0];
+    }
+    if (count[0] == 0 || count[1] == 0)
+        return 0.0F;
+    const std::array<double, 2> mean{sum[0] / static_cast<double>(count[0]),
+                                     sum[1] / static_cast<double>(count[1])};
+    double within = 0.0;
+    for (const float h : heights)
+    {
+        const double d = static_cast<double>(h) - mean[h > 0.0F ? 1 : 0];
+        within += d * d;
+    }
+    within /= static_cast<double>(heights.size());
+    return within > 0.0 ? static_cast<float>((mean[1] - mean[0]) / std::sqrt(within)) : 0.0F;
+}
+
+/// Ball::across_agreement and Ball::across_offset of the guides of `members` (at
+/// `positions`) about the ball's axis.
+void measure_across(std::span<const std::uint32_t> members, std::span<const Vec3f> positions,
+                    std::span<const Vec3f> guide_normals, Ball& ball)
+{
+    const Vec3f& axis = ball.axis;
+    const Vec3f u = axis.unitOrthogonal();
+    const Vec3f v = axis.cross(u);
+    double c = 0.0;
+    double s = 0.0;
+    Eigen::Vector2d at_all = Eigen::Vector2d::Zero();
+    Eigen::Vector2d at_across = Eigen::Vector2d::Zero();
+    double spread = 0.0;
+    std::size_t across = 0;
+    for (const std::uint32_t m : members)
+    {
+        const Vec3f d = positions[m] - ball.centroid;
+        const Eigen::Vector2d place(d.dot(u), d.dot(v));
+        at_all += place;
+        spread += place.squaredNorm();
+        const Vec3f& g = guide_normals[m];
+        if (!(g.squaredNorm() > 0.0F) || std::abs(g.dot(axis)) >= min_axis_alignment)
+            continue;
+        const double a = g.dot(u);
+        const double b = g.dot(v);
+        const double length2 = a * a + b * b;
+        if (!(length2 > 0.0))
+            continue;
+        c += (a * a - b * b) / length2;
+        s += 2.0 * a * b / length2;
+        at_across += place;
+        ++across;
+    }
+    if (across == 0 || members.empty())
+        return;
+    const auto count = static_cast<double>(members.size());
+    at_all /= count;
+    spread = std::sqrt(std::max(0.0, spread / count - at_all.squaredNorm()));
+    ball.across_agreement = static_cast<float>(std::hypot(c, s) / static_cast<double>(across));
+    if (spread > 0.0)
+        ball.across_offset =
+            static_cast<float>((at_across / static_cast<double>(across) - at_all).norm() / spread);
+}
+
+/// The ball about sample `centre` of `cloud` (its ball_samples nearest there); with `all`, its
+/// heights are those of every sample of `all_positions` within its reach. `near` receives the
+/// other balls' centres in it, `reach2` its squared reach. False where it has too few samples
+/// or no plane.
+bool measure_ball(const KdTree& tree, std::span<const Vec3f> cloud, std::size_t centre,
+                  const KdTree* all, std::span<const Vec3f> all_positions,
+                  std::span<const Vec3f> guide_normals, std::vector<std::uint32_t>& members,
+                  std::vector<float>& distances, std::vector<float>& heights,
+                  std::vector<std::uint32_t>& near, float& reach2, Ball& ball)
 {
     near.clear();
-    const std::size_t found = tree.knn(positions[centre], ball_samples, members, distances);
-    if (found < ball_samples)
+    members.resize(ball_samples);
+    distances.resize(ball_samples);
+    if (tree.knn(cloud[centre], ball_samples, members, distances) < ball_samples)
         return false;
-    for (std::size_t k = 1; k < found && near.size() < ball_neighbours; ++k)
+    for (std::size_t k = 1; k < ball_samples && near.size() < ball_neighbours; ++k)
         if (members[k] % ball_stride == 0)
             near.push_back(members[k] / ball_stride);
+    reach2 = distances.back();
+    std::span<const Vec3f> positions = cloud;
+    if (all != nullptr)
+    {
+        members.clear();
+        distances.clear();
+        all->radius_search(cloud[centre], std::sqrt(reach2), members, distances);
+        positions = all_positions;
+    }
+    const std::size_t found = members.size();
+    if (found < ball_samples)
+        return false;
     // About the centre sample in double: the sums of squares neither lose the noise to the
     // coordinates' size nor depend on the order of the members.
-    const Eigen::Vector3d origin = positions[centre].cast<double>();
+    const Eigen::Vector3d origin = cloud[centre].cast<double>();
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     for (const std::uint32_t m : members)
         mean += positions[m].cast<double>() - origin;
@@ -206,6 +342,7 @@ bool dipping_ball(const KdTree& tree, std::span<const Vec3f> positions, std::siz
     if (solver.info() != Eigen::Success || !(solver.eigenvalues()(2) > 0.0))
         return false;
     const Eigen::Vector3d axis = solver.eigenvectors().col(0);
+    heights.resize(found);
     double variance = 0.0;
     for (std::size_t k = 0; k < found; ++k)
     {
@@ -213,16 +350,17 @@ bool dipping_ball(const KdTree& tree, std::span<const Vec3f> positions, std::siz
         heights[k] = static_cast<float>(h);
         variance += h * h;
     }
-    if (!dipped(heights.first(found), variance / static_cast<double>(found)))
-        return false;
     ball.centroid = (origin + mean).cast<float>();
     ball.axis = axis.cast<float>();
+    dip_of(heights, variance / static_cast<double>(found), ball);
+    ball.separation = separation_of(heights);
+    measure_across(members, positions, guide_normals, ball);
     return true;
 }
 
 } // namespace
 
-void ball_sides(std::span<const Vec3f> positions, std::span<const Vec3f> guide_normals,
+void ball_sides(std::span<const Vec3f> positions, std::span<Vec3f> guide_normals,
                 std::span<std::int8_t> sides)
 {
     const std::size_t n = positions.size();
@@ -240,49 +378,78 @@ void ball_sides(std::span<const Vec3f> positions, std::span<const Vec3f> guide_n
     const std::span<const Vec3f> cloud =
         step > 1 ? std::span<const Vec3f>(thinned) : std::span<const Vec3f>(positions);
     const KdTree tree(cloud);
+    std::optional<KdTree> all;
+    if (step > 1)
+        all.emplace(positions);
     const std::size_t count = (cloud.size() + ball_stride - 1) / ball_stride;
     std::vector<Ball> balls(count);
     std::vector<float> reach2(count, 0.0F); // the squared distance to a ball's farthest sample
-    std::vector<std::uint8_t> dips(count, 0);
+    std::vector<std::uint8_t> measured(count, 0);
     std::vector<std::array<std::uint32_t, ball_neighbours>> near(count);
     std::vector<std::uint8_t> near_count(count, 0);
     parallel_blocks(count, 16, [&](std::size_t begin, std::size_t end) {
-        std::vector<std::uint32_t> members(ball_samples);
-        std::vector<float> distances(ball_samples);
-        std::vector<float> heights(ball_samples);
+        std::vector<std::uint32_t> members;
+        std::vector<float> distances;
+        std::vector<float> heights;
         std::vector<std::uint32_t> others;
         for (std::size_t b = begin; b < end; ++b)
         {
-            dips[b] = dipping_ball(tree, cloud, b * ball_stride, members, distances, heights,
-                                   others, balls[b])
-                          ? 1
-                          : 0;
-            reach2[b] = distances.back();
+            measured[b] = measure_ball(tree, cloud, b * ball_stride, all ? &*all : nullptr,
+                                       positions, guide_normals, members, distances, heights,
+                                       others, reach2[b], balls[b])
+                              ? 1
+                              : 0;
             std::copy(others.begin(), others.end(), near[b].begin());
             near_count[b] = static_cast<std::uint8_t>(others.size());
         }
     });
+    const auto dips = [&](std::size_t b) {
+        return measured[b] != 0 && balls[b].dip <= max_dip;
+    };
+    const auto dips_shallowly = [&](std::size_t b) {
+        return measured[b] != 0 && balls[b].dip <= max_shallow_dip &&
+               balls[b].significance >= min_dip_significance;
+    };
+    // Whether ball b and enough of the balls about it pass `test`.
+    const auto agreed = [&](std::size_t b, const auto& test) {
+        if (!test(b))
+            return false;
+        std::size_t agreeing = 0;
+        for (std::size_t k = 0; k < near_count[b]; ++k)
+            agreeing += test(near[b][k]) ? 1U : 0U;
+        return agreeing >= min_agreeing_balls && 2 * agreeing >= near_count[b];
+    };
     std::vector<std::uint8_t> kept(count, 0);
     bool any = false;
     for (std::size_t b = 0; b < count; ++b)
     {
-        if (dips[b] == 0)
-            continue;
-        std::size_t agreeing = 0;
-        for (std::size_t k = 0; k < near_count[b]; ++k)
-            agreeing += dips[near[b][k]];
-        kept[b] = agreeing >= min_agreeing_balls && 2 * agreeing >= near_count[b] ? 1 : 0;
+        kept[b] = agreed(b, dips) ? 1 : 0;
         any = any || kept[b] != 0;
     }
     if (!any)
         return;
+    // The balls that dip shallowly, among enough others that do, beside counted ones, and beside
+    // those, to the end: the set the sweeps grow to is the same in any order.
+    for (bool grown = true; grown;)
+    {
+        grown = false;
+        for (std::size_t b = 0; b < count; ++b)
+        {
+            if (kept[b] != 0 || !agreed(b, dips_shallowly))
+                continue;
+            const auto others = std::span(near[b]).first(near_count[b]);
+            if (std::any_of(others.begin(), others.end(),
+                            [&](std::uint32_t o) { return kept[o] != 0; }))
+            {
+                kept[b] = 1;
+                grown = true;
+            }
+        }
+    }
     // Each sample's claim: the squared distance to the nearest centre of a kept ball holding it
     // (its float bits, which order as the values do) above that ball's index; the least claim
     // wins whichever thread makes it. A ball of the thinned cloud holds every sample within its
     // reach.
-    std::optional<KdTree> all;
-    if (step > 1)
-        all.emplace(positions);
     constexpr std::uint64_t unclaimed = ~std::uint64_t{0};
     std::vector<std::uint64_t> claim(n, unclaimed);
     parallel_blocks(count, 16, [&](std::size_t begin, std::size_t end) {
@@ -307,16 +474,43 @@ void ball_sides(std::span<const Vec3f> positions, std::span<const Vec3f> guide_n
                     (std::uint64_t{std::bit_cast<std::uint32_t>(distances[k])} << 32U) | b);
         }
     });
+    // The kept balls whose faces are close: their own bands, and those of every kept ball about
+    // them (at a rim, a ball's rim samples fill its gap and close its bands up).
+    std::vector<std::uint8_t> close(count, 0);
+    for (std::size_t b = 0; b < count; ++b)
+    {
+        if (kept[b] == 0)
+            continue;
+        const auto others = std::span(near[b]).first(near_count[b]);
+        close[b] = balls[b].separation < max_realigned_separation &&
+                           balls[b].across_agreement < max_across_agreement &&
+                           balls[b].across_offset < max_across_offset &&
+                           std::none_of(others.begin(), others.end(),
+                                        [&](std::uint32_t o) {
+                                            return kept[o] != 0 && !(balls[o].separation <
+                                                                     max_realigned_separation);
+                                        })
+                       ? 1
+                       : 0;
+    }
     parallel_blocks(n, 4096, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
         {
             if (claim[i] == unclaimed)
                 continue;
-            const Ball& ball = balls[claim[i] & 0xFFFFFFFFU];
-            const float along = guide_normals[i].dot(ball.axis);
+            const std::size_t b = claim[i] & 0xFFFFFFFFU;
+            const Ball& ball = balls[b];
             const float height = (positions[i] - ball.centroid).dot(ball.axis);
-            if (std::abs(along) >= min_axis_alignment && height != 0.0F)
+            if (height == 0.0F)
+                continue;
+            const float along = guide_normals[i].dot(ball.axis);
+            if (std::abs(along) >= min_axis_alignment)
                 sides[i] = (height > 0.0F) == (along > 0.0F) ? ball_side : -ball_side;
+            else if (close[b] != 0)
+            {
+                guide_normals[i] = ball.axis;
+                sides[i] = height > 0.0F ? ball_side : -ball_side;
+            }
         }
     });
 }

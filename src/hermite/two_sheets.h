@@ -46,11 +46,14 @@ constexpr std::int8_t ball_side = 3;
 /// one sheet's heights, curved or creased, do not) and most of the balls about it dip too, each
 /// sample in it whose guide lies along that axis takes the band it lies in, from the dipping ball
 /// whose centre is nearest: ±ball_side, + along its guide. The sides from two_sheet_sides() it
-/// overrides. On a plate 6 deviations thick (100k samples, noise 0.2% of the diagonal, 8 holes),
-/// 83% of the balls count; they give 92% of the faces' samples a side, 99.4% of them their own
-/// band's. Above ball_cloud samples the balls are made of an even subsample, so that they are as
-/// wide at any size.
-void ball_sides(std::span<const Vec3f> positions, std::span<const Vec3f> guide_normals,
+/// overrides. Beside such balls, balls whose heights dip only shallowly but surely (many samples)
+/// count too. Where a counted ball's faces are so close that the noise turned the guides of
+/// some of its samples across the axis at random (not a rim's), those guides become the axis and
+/// the samples take their band too. On a plate 6 deviations thick (100k samples, noise 0.2% of
+/// the diagonal, 8 holes), 83% of the balls count; they give 92% of the faces' samples a side,
+/// 99.4% of them their own band's. Above ball_cloud samples the balls are found in an even
+/// subsample, so that they are as wide at any size, and measured over all the samples in them.
+void ball_sides(std::span<const Vec3f> positions, std::span<Vec3f> guide_normals,
                 std::span<std::int8_t> sides);
 
 /// TwoSheetFacing::faced_by's values.
