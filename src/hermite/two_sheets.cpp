@@ -129,7 +129,7 @@ constexpr std::size_t ball_stride = 64;
 /// where it was measured (at 1M the 256 nearest of all the samples span a third as much, a plate
 /// 0.035 thick's faces no longer both), and there are as many balls at any size. Their heights
 /// are then those of all the samples within the ball's reach (about s · 256), whose histogram is
-/// that much less noisy: on a noisy plate 0.02 thick at 1M, 75% of the balls dip where 46% did
+/// that much less noisy: on a noisy plate 0.02 thick at 1M, 75% of the balls dip where 62% did
 /// with the subsample's 256 alone, and no ball of noisy 1M spheres, tori, cones, blobbies or
 /// CAD-like parts comes near a dip (the centre bin at least 0.9 of the sides' peak in all but
 /// one of 8,300).
@@ -138,15 +138,17 @@ constexpr std::size_t ball_cloud = 100000;
 /// lower of the two sides' highest bins. Over the balls above: median 0.08-0.23 on the plates,
 /// 0.75-0.89 at the 0.1st percentile on the one-sheet shapes.
 constexpr double max_dip = 0.6;
-/// A ball beside one that counts (below) counts too when its dip is at least shallow: the centre
-/// bin at most this share of the sides' peak, and below it by at least min_dip_significance
-/// deviations of the two counts' difference (Poisson counts: √(centre + peak)). Faces 3.5
-/// deviations apart dip only so much (two normal bands at ±1.75 leave 0.43 of the peak between
-/// them, less the bins' and the counts' noise): on the 1M plate 0.02 thick 96% of the balls are
-/// below 0.7 and 60% count by max_dip and their neighbours; with this, 91%. A ball of 256
-/// samples, whose bins hold 30-40, is never that significant without a dip of max_dip: on one
-/// sheet, at 100k, such balls (0.7 to 0.8: 6 of 786 on a simulated scan of the teapot) had grown
-/// into the teapot's body and turned it inside out.
+/// A ball beside one that counts (below) counts too when its dip is at least shallow but sure:
+/// the centre bin at most this share of the sides' peak, and below it by at least
+/// min_dip_significance deviations of the two counts' difference (Poisson counts:
+/// √(centre + peak)), among enough balls about it that are too (the neighbour test below). Faces
+/// 3.5 deviations apart dip only so much (two normal bands at ±1.75 leave 0.43 of the peak
+/// between them, less the bins' and the counts' noise): on the 1M plate 0.02 thick 96% of the
+/// balls are below 0.7 and 60% count by max_dip and their neighbours; with this, 90%. The
+/// balls of 256 samples in the 0.7-0.8 band on one sheet are not that sure (1.2-2.4 deviations on
+/// a simulated scan of the teapot); but deep dips that failed the neighbour test are, and let in
+/// beside counted balls without that test they grew into the teapot's body and turned it inside
+/// out (47% of its area facing away).
 constexpr double max_shallow_dip = 0.8;
 constexpr double min_dip_significance = 3.0;
 /// The other balls' centres in a ball that its neighbour test looks at (the nearest first).
@@ -164,10 +166,10 @@ constexpr float min_axis_alignment = 0.5F;
 /// (Ball::separation): then the sample's guide becomes the ball's axis, and it takes its band.
 /// Where faces are that close, a sample's guide is grown from a neighbourhood whose flatness the
 /// noise sets, 0.21-0.29 (0.06-0.12 on a plate 0.05 thick at 100k), and 14% of the faces' guides
-/// on the 1M plate 0.02 thick (3.8 deviations) lay more than 60° off. Their normals, oriented
-/// by neighbours alone, were 16% wrong; with the axis, the plate's normals facing away went from
-/// 5.8% to 4.8%. Where the faces are farther apart (5.0 at 0.03 thick, 7.1 at 0.05), a guide
-/// across the axis is most likely the plate's rim, a face of its own, and is kept.
+/// on the 1M plate 0.02 thick (3.8 deviations) lay more than 60° off. The samples left without a
+/// side were 16% wrong; with the axis, the plate's normals facing away went from 5.8% to 4.8%.
+/// Where the faces are farther apart (5.0 at 0.03 thick, 7.1 at 0.05), a guide across the axis is
+/// most likely the plate's rim, a face of its own, and is kept.
 constexpr float max_realigned_separation = 4.5F;
 /// ... and the guides across the axis in the ball agree in direction less than this
 /// (Ball::across_agreement): where they agree, they are a rim's.
