@@ -15,6 +15,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace pointform::detail {
@@ -244,6 +245,41 @@ TEST(BallSides, SameSidesWhateverTheThreadCount)
     EXPECT_GT(sided(runs[0]), plate.size() / 2);
     for (const auto& run : runs)
         EXPECT_EQ(run, runs[0]);
+}
+
+TEST(BallSides, SameSidesAndGuidesWhateverTheThreadCountAboveTheSubsample)
+{
+    // Balls found in the subsample and measured over all the samples, shallow dips counted
+    // beside deep ones, and guides turned across the axis taking it: a plate 0.02 thick at 400k
+    // with every seventh guide turned into the plane.
+    const PointCloud plate = sample_shape(Shape::Plate, {.count = 400000,
+                                                         .seed = 5,
+                                                         .noise = 0.002,
+                                                         .holes = 8,
+                                                         .hole_radius = 0.04,
+                                                         .thickness = 0.02});
+    std::vector<Vec3f> turned = plate.normals;
+    for (std::size_t i = 0; i < plate.size(); i += 7)
+    {
+        const float angle = 2.39996F * static_cast<float>(i);
+        turned[i] = Vec3f(std::cos(angle), std::sin(angle), 0.0F);
+    }
+    const auto runs = test::at_thread_counts(
+        [&] {
+            std::vector<Vec3f> guide = turned;
+            std::vector<std::int8_t> sides(plate.size(), 0);
+            ball_sides(plate.positions, guide, sides);
+            return std::make_pair(sides, guide);
+        },
+        {.min_multi_block_loops = 2});
+    ASSERT_FALSE(runs.empty());
+    EXPECT_GT(sided(runs[0].first), plate.size() / 2);
+    EXPECT_NE(runs[0].second, turned); // some guides took their ball's axis
+    for (const auto& run : runs)
+    {
+        EXPECT_EQ(run.first, runs[0].first);
+        EXPECT_EQ(run.second, runs[0].second);
+    }
 }
 
 } // namespace
