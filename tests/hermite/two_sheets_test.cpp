@@ -39,6 +39,31 @@ std::size_t sided(const std::vector<std::int8_t>& sides)
     return count;
 }
 
+/// A noisy plate with 8 holes, as the bench's noisy+holes inputs.
+PointCloud holed_plate(std::size_t count, std::uint64_t seed, double thickness)
+{
+    return sample_shape(Shape::Plate, {.count = count,
+                                       .seed = seed,
+                                       .noise = 0.002,
+                                       .holes = 8,
+                                       .hole_radius = 0.04,
+                                       .thickness = thickness});
+}
+
+/// The true normals of `plate`, with every seventh on a face turned into the plane at its own
+/// angle (as noise turns the guides grown between close faces).
+std::vector<Vec3f> turned_guides(const PointCloud& plate)
+{
+    std::vector<Vec3f> guide = plate.normals;
+    for (std::size_t i = 0; i < plate.size(); i += 7)
+        if (std::abs(plate.normals[i].z()) > 0.9F)
+        {
+            const float angle = 2.39996F * static_cast<float>(i); // the golden angle
+            guide[i] = Vec3f(std::cos(angle), std::sin(angle), 0.0F);
+        }
+    return guide;
+}
+
 /// Of the samples on the faces of `plate` away from its rim: how many have a side (`found`),
 /// and how many of those the side of their own face, + on the top one (`right`).
 struct FaceSides
@@ -124,13 +149,7 @@ TEST(BallSides, GuidesThatNoiseTurnedTakeTheAxisWhereFacesAreClose)
     {
         const PointCloud plate = sample_shape(
             Shape::Plate, {.count = 400000, .seed = 4, .noise = 0.002, .thickness = thickness});
-        std::vector<Vec3f> guide = plate.normals;
-        for (std::size_t i = 0; i < plate.size(); i += 7)
-            if (std::abs(plate.normals[i].z()) > 0.9F)
-            {
-                const float angle = 2.39996F * static_cast<float>(i); // the golden angle
-                guide[i] = Vec3f(std::cos(angle), std::sin(angle), 0.0F);
-            }
+        std::vector<Vec3f> guide = turned_guides(plate);
         const std::vector<Vec3f> before = guide;
         std::vector<std::int8_t> sides(plate.size(), 0);
         ball_sides(plate.positions, guide, sides);
@@ -233,12 +252,7 @@ TEST(BallSides, SmallOrMismatchedInputIsLeftAlone)
 
 TEST(BallSides, SameSidesWhateverTheThreadCount)
 {
-    const PointCloud plate = sample_shape(Shape::Plate, {.count = 100000,
-                                                         .seed = 1,
-                                                         .noise = 0.002,
-                                                         .holes = 8,
-                                                         .hole_radius = 0.04,
-                                                         .thickness = 0.035});
+    const PointCloud plate = holed_plate(100000, 1, 0.035);
     const auto runs =
         test::at_thread_counts([&] { return sides_of(plate); }, {.min_multi_block_loops = 2});
     ASSERT_FALSE(runs.empty());
@@ -252,18 +266,8 @@ TEST(BallSides, SameSidesAndGuidesWhateverTheThreadCountAboveTheSubsample)
     // Balls found in the subsample and measured over all the samples, shallow dips counted
     // beside deep ones, and guides turned across the axis taking it: a plate 0.02 thick at 400k
     // with every seventh guide turned into the plane.
-    const PointCloud plate = sample_shape(Shape::Plate, {.count = 400000,
-                                                         .seed = 5,
-                                                         .noise = 0.002,
-                                                         .holes = 8,
-                                                         .hole_radius = 0.04,
-                                                         .thickness = 0.02});
-    std::vector<Vec3f> turned = plate.normals;
-    for (std::size_t i = 0; i < plate.size(); i += 7)
-    {
-        const float angle = 2.39996F * static_cast<float>(i);
-        turned[i] = Vec3f(std::cos(angle), std::sin(angle), 0.0F);
-    }
+    const PointCloud plate = holed_plate(400000, 5, 0.02);
+    const std::vector<Vec3f> turned = turned_guides(plate);
     const auto runs = test::at_thread_counts(
         [&] {
             std::vector<Vec3f> guide = turned;
