@@ -468,13 +468,17 @@ void ball_sides(std::span<const Vec3f> positions, std::span<Vec3f> guide_normals
     if (!any)
         return;
     // The balls that dip shallowly, among enough others that do, beside counted ones, and beside
-    // those, to the end: the set the sweeps grow to is the same in any order.
+    // those, to the end: the set the sweeps grow to is the same in any order. Which balls may grow
+    // does not change from sweep to sweep.
+    std::vector<std::uint8_t> may_grow(count, 0);
+    for (std::size_t b = 0; b < count; ++b)
+        may_grow[b] = kept[b] == 0 && agreed(b, dips_shallowly) ? 1 : 0;
     for (bool grown = true; grown;)
     {
         grown = false;
         for (std::size_t b = 0; b < count; ++b)
         {
-            if (kept[b] != 0 || !agreed(b, dips_shallowly))
+            if (kept[b] != 0 || may_grow[b] == 0)
                 continue;
             const auto others = std::span(near[b]).first(near_count[b]);
             if (std::any_of(others.begin(), others.end(),
