@@ -101,9 +101,11 @@ void print_refinement(const SemiRegularReport& r)
                                       ", farthest " +
                                       format_number(r.refinement.face_fit_max_move));
         else if (r.refinement.face_fit_median_move > 0.0)
-            print_row("face fit", "none: the median move " +
-                                      format_number(r.refinement.face_fit_median_move) +
-                                      " is below a quarter of the field residual (noise)");
+            print_row(
+                "face fit",
+                "none: the median move " + format_number(r.refinement.face_fit_median_move) +
+                    (r.refinement.face_fit_median_sampled ? " (over one free vertex in 16)" : "") +
+                    " is below a quarter of the field residual (noise)");
         if (r.refinement.spikes > 0)
             print_row("spikes", std::to_string(r.refinement.spikes) +
                                     " vertices that stood off their neighbours' surface alone, "

@@ -69,6 +69,8 @@ TEST(FaceFit, TakesTheSagOutOfACurvedLevel)
     ASSERT_GE(mesh.finest_level(), 1U);
     ASSERT_EQ(mesh.vertex_count(), before.vertex_count());
     EXPECT_EQ(projected.semi_regular.refinement.face_fit_vertices, 0U);
+    // The probe vertices' median was not far below the bar: the whole fit was measured.
+    EXPECT_FALSE(refinement.face_fit_median_sampled);
 
     // Every vertex of the finest level's own moved (a closed sphere: no boundary, crease or
     // faired region), outwards by about the sag, and no vertex of a coarser level.
@@ -108,13 +110,15 @@ TEST(FaceFit, NoiseIsNotFitted)
     EXPECT_EQ(smoothed.semi_regular.hierarchy.positions().front(),
               reconstruct(samples, interpolating).semi_regular.hierarchy.positions().front());
     // Unsmoothed, the moves it asks for are far below the noise that the field leaves at the
-    // samples, and none is made.
+    // samples, and none is made: the probe vertices' median says so, under half the bar, and
+    // the whole fit is not measured.
     ReconstructOptions unsmoothed;
     unsmoothed.semi_regular.denoise_rounds = 0;
     const ReconstructReport noisy = reconstruct(samples, unsmoothed);
     const RefineReport& refinement = noisy.semi_regular.refinement;
     EXPECT_GT(refinement.face_fit_median_move, 0.0);
-    EXPECT_LT(refinement.face_fit_median_move, 0.25 * refinement.field_residual);
+    EXPECT_TRUE(refinement.face_fit_median_sampled);
+    EXPECT_LT(refinement.face_fit_median_move, 0.5 * 0.25 * refinement.field_residual);
     EXPECT_EQ(refinement.face_fit_vertices, 0U);
     unsmoothed.semi_regular.fit_faces = false;
     const MultiresMesh& kept = noisy.semi_regular.hierarchy;
