@@ -104,7 +104,7 @@ void print_refinement(const SemiRegularReport& r)
             print_row(
                 "face fit",
                 "none: the median move " + format_number(r.refinement.face_fit_median_move) +
-                    (r.refinement.face_fit_median_sampled ? " (over one free vertex in 16)" : "") +
+                    (r.refinement.face_fit_median_sampled ? " (over about 2,048 vertices)" : "") +
                     " is below a quarter of the field residual (noise)");
         if (r.refinement.spikes > 0)
             print_row("spikes", std::to_string(r.refinement.spikes) +

@@ -329,8 +329,9 @@ struct RefineReport
     /// quarter of field_residual (the moves would follow the field's noise more than the faces'
     /// sag); 0 if the fit did not run.
     double face_fit_median_move = 0.0;
-    /// True when face_fit_median_move is the median over one free vertex in 16 only: far enough
-    /// below the bar that the whole fit was not measured (no fit is made then).
+    /// True when face_fit_median_move is the median over about 2,048 of the level's free
+    /// vertices only: far enough below the bar that the whole fit was not measured (no fit is
+    /// made then).
     bool face_fit_median_sampled = false;
     /// Vertices of the finest level that stood off their neighbours' surface alone (a spike or
     /// dent on a narrow step of the field, such as the blend between two local fits at a
