@@ -72,7 +72,9 @@ py::array owning_array(std::vector<T> values, std::vector<py::ssize_t> shape,
 /// for the library's options that lets Ctrl-C stop the work: when the library reports progress
 /// from the calling thread (signals reach Python's main thread only), it takes the GIL and runs
 /// Python's signal handlers; a KeyboardInterrupt asks the library to stop (it throws Cancelled)
-/// and is raised once the work has unwound. Results do not depend on it.
+/// and is raised once the work has unwound. It is raised too where the work returns although
+/// it was asked to stop (a step that ends early on a false progress instead of throwing): the
+/// handler has taken the signal, and the caller must still see it. Results do not depend on it.
 template <class Work>
 auto run_interruptible(Work&& work)
 {
@@ -92,8 +94,16 @@ auto run_interruptible(Work&& work)
     };
     try
     {
-        const py::gil_scoped_release release;
-        return work(progress);
+        auto result = [&] {
+            const py::gil_scoped_release release;
+            return work(progress);
+        }();
+        if (interrupted->load())
+        {
+            PyErr_SetNone(PyExc_KeyboardInterrupt);
+            throw py::error_already_set();
+        }
+        return result;
     }
     catch (const Cancelled&)
     {
