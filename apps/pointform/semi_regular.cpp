@@ -104,7 +104,9 @@ void print_refinement(const SemiRegularReport& r)
             print_row(
                 "face fit",
                 "none: the median move " + format_number(r.refinement.face_fit_median_move) +
-                    (r.refinement.face_fit_median_sampled ? " (over about 2,048 vertices)" : "") +
+                    (r.refinement.face_fit_probes > 0
+                         ? " (over " + std::to_string(r.refinement.face_fit_probes) + " vertices)"
+                         : std::string()) +
                     " is below a quarter of the field residual (noise)");
         if (r.refinement.spikes > 0)
             print_row("spikes", std::to_string(r.refinement.spikes) +

@@ -1165,8 +1165,9 @@ struct FaceFit
     double max_move = 0.0;
     /// The median of the moves the fit asked for, made or not (below fit_least_move).
     double median_move = 0.0;
-    /// Whether median_move is that of the probe vertices only (fit_probes).
-    bool estimated = false;
+    /// How many probe vertices' moves median_move is the median of (fit_probes); 0 when it is
+    /// that of the whole level.
+    std::size_t probes = 0;
 };
 
 /// fit_faces(): the field is evaluated at the faces in batches of this many faces (three points
@@ -1336,7 +1337,7 @@ FaceFit fit_faces(MultiresMesh& mesh, std::span<const Triangle> faces, const Rin
         accumulate(around);
         const auto [median, count] = moves(probe);
         fit.median_move = median;
-        fit.estimated = true;
+        fit.probes = count;
         if (count >= fit_probe_least && median < fit_probe_margin * fit_least_move * noise)
             return fit;
     }
@@ -1346,7 +1347,7 @@ FaceFit fit_faces(MultiresMesh& mesh, std::span<const Triangle> faces, const Rin
     accumulate(all);
     const auto [median, count] = moves({});
     fit.median_move = median;
-    fit.estimated = false;
+    fit.probes = 0;
     if (count == 0 || median < fit_least_move * noise)
         return fit;
     for (std::size_t v = 0; v < n; ++v)
@@ -2085,7 +2086,7 @@ RefineReport refine(MultiresMesh& mesh, const Field& field, const PointCloud& sa
         report.face_fit_vertices = fit.vertices;
         report.face_fit_max_move = fit.max_move;
         report.face_fit_median_move = fit.median_move;
-        report.face_fit_median_sampled = fit.estimated;
+        report.face_fit_probes = fit.probes;
         moved = moved || fit.vertices > 0;
     }
     if (automatic)

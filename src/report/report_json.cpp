@@ -236,7 +236,7 @@ nlohmann::json report_json(const SemiRegularReport& r, const SemiRegularOptions&
         out["face_fit_vertices"] = r.refinement.face_fit_vertices;
         out["face_fit_max_move"] = r.refinement.face_fit_max_move;
         out["face_fit_median_move"] = r.refinement.face_fit_median_move;
-        out["face_fit_median_sampled"] = r.refinement.face_fit_median_sampled;
+        out["face_fit_probes"] = r.refinement.face_fit_probes;
         out["spikes"] = r.refinement.spikes;
         out["unsupported_regions"] = r.refinement.unsupported.regions;
         out["unsupported_membranes"] = r.refinement.unsupported.membranes;

@@ -70,7 +70,7 @@ TEST(FaceFit, TakesTheSagOutOfACurvedLevel)
     ASSERT_EQ(mesh.vertex_count(), before.vertex_count());
     EXPECT_EQ(projected.semi_regular.refinement.face_fit_vertices, 0U);
     // The probe vertices' median was not far below the bar: the whole fit was measured.
-    EXPECT_FALSE(refinement.face_fit_median_sampled);
+    EXPECT_EQ(refinement.face_fit_probes, 0U);
 
     // Every vertex of the finest level's own moved (a closed sphere: no boundary, crease or
     // faired region), outwards by about the sag, and no vertex of a coarser level.
@@ -117,7 +117,13 @@ TEST(FaceFit, NoiseIsNotFitted)
     const ReconstructReport noisy = reconstruct(samples, unsmoothed);
     const RefineReport& refinement = noisy.semi_regular.refinement;
     EXPECT_GT(refinement.face_fit_median_move, 0.0);
-    EXPECT_TRUE(refinement.face_fit_median_sampled);
+    // At least fit_probe_least (256) of the level's vertices, and about 2,048 of them, fewer
+    // than half of the finest level's own.
+    const MultiresMesh& levels = noisy.semi_regular.hierarchy;
+    const std::size_t own = levels.vertex_count() - levels.vertex_count(levels.finest_level() - 1);
+    EXPECT_GE(refinement.face_fit_probes, 256U);
+    EXPECT_LE(refinement.face_fit_probes, 2 * 2048U);
+    EXPECT_LT(2 * refinement.face_fit_probes, own);
     EXPECT_LT(refinement.face_fit_median_move, 0.5 * 0.25 * refinement.field_residual);
     EXPECT_EQ(refinement.face_fit_vertices, 0U);
     unsmoothed.semi_regular.fit_faces = false;

@@ -329,10 +329,11 @@ struct RefineReport
     /// quarter of field_residual (the moves would follow the field's noise more than the faces'
     /// sag); 0 if the fit did not run.
     double face_fit_median_move = 0.0;
-    /// True when face_fit_median_move is the median over about 2,048 of the level's free
-    /// vertices only: far enough below the bar that the whole fit was not measured (no fit is
-    /// made then).
-    bool face_fit_median_sampled = false;
+    /// When face_fit_median_move is the median of the moves of a sample of the level's free
+    /// vertices only (evenly spread; far enough below the bar that the whole fit was not
+    /// measured, and no fit is made), the number of moves in that sample; 0 when it is the
+    /// whole level's.
+    std::size_t face_fit_probes = 0;
     /// Vertices of the finest level that stood off their neighbours' surface alone (a spike or
     /// dent on a narrow step of the field, such as the blend between two local fits at a
     /// concave crease) and were put back on the field from their neighbours' centroid, after
