@@ -24,6 +24,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <utility>
 
 namespace pointform {
@@ -1061,17 +1062,19 @@ std::vector<std::uint8_t> crease_edges(std::span<const Vec3d> x, std::span<const
         }
     });
     // Each edge with the faces beside it: (smaller end, larger end, face), sorted.
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> sides;
-    sides.reserve(3 * faces.size());
-    for (std::size_t f = 0; f < faces.size(); ++f)
-        for (std::size_t c = 0; c < 3; ++c)
-        {
-            const std::uint64_t a = faces[f][c];
-            const std::uint64_t b = faces[f][(c + 1) % 3];
-            sides.emplace_back(std::min(a, b) << 32U | std::max(a, b),
-                               static_cast<std::uint32_t>(f));
-        }
-    std::sort(sides.begin(), sides.end());
+    // Every pair differs (a face has an edge once), so the parallel sort's order is the one.
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> sides(3 * faces.size());
+    parallel_blocks(faces.size(), vertex_block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t f = begin; f < end; ++f)
+            for (std::size_t c = 0; c < 3; ++c)
+            {
+                const std::uint64_t a = faces[f][c];
+                const std::uint64_t b = faces[f][(c + 1) % 3];
+                sides[3 * f + c] = {std::min(a, b) << 32U | std::max(a, b),
+                                    static_cast<std::uint32_t>(f)};
+            }
+    });
+    parallel_sort(sides);
     std::vector<std::uint8_t> crease(rings.adjacent.size(), 0);
     const auto mark = [&](std::uint32_t v, std::uint32_t w) {
         const auto first = rings.adjacent.begin() + rings.offsets[v];
@@ -1081,22 +1084,25 @@ std::vector<std::uint8_t> crease_edges(std::span<const Vec3d> x, std::span<const
             crease[static_cast<std::size_t>(at - rings.adjacent.begin())] = 1;
     };
     const double least = std::acos(crease_cosine);
-    for (std::size_t i = 0; i + 1 < sides.size(); ++i)
-    {
-        if (sides[i].first != sides[i + 1].first ||
-            (i + 2 < sides.size() && sides[i + 2].first == sides[i].first))
-            continue; // a boundary edge, or a non-manifold one
-        const auto a = static_cast<std::uint32_t>(sides[i].first >> 32U);
-        const auto b = static_cast<std::uint32_t>(sides[i].first & 0xffffffffU);
-        const double length = (x[a] - x[b]).norm();
-        const double bound = std::max(least, 3.0 * std::atan(noise / std::max(length, 1e-300)));
-        const double cosine = normal[sides[i].second].dot(normal[sides[i + 1].second]);
-        if (bound < std::numbers::pi && cosine < std::cos(bound))
+    // Each edge marks its own two slots: the blocks write apart.
+    parallel_blocks(sides.size(), 4 * vertex_block, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end && i + 1 < sides.size(); ++i)
         {
-            mark(a, b);
-            mark(b, a);
+            if (sides[i].first != sides[i + 1].first ||
+                (i + 2 < sides.size() && sides[i + 2].first == sides[i].first))
+                continue; // a boundary edge, or a non-manifold one
+            const auto a = static_cast<std::uint32_t>(sides[i].first >> 32U);
+            const auto b = static_cast<std::uint32_t>(sides[i].first & 0xffffffffU);
+            const double length = (x[a] - x[b]).norm();
+            const double bound = std::max(least, 3.0 * std::atan(noise / std::max(length, 1e-300)));
+            const double cosine = normal[sides[i].second].dot(normal[sides[i + 1].second]);
+            if (bound < std::numbers::pi && cosine < std::cos(bound))
+            {
+                mark(a, b);
+                mark(b, a);
+            }
         }
-    }
+    });
     return crease;
 }
 
@@ -1798,6 +1804,24 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
                 std::max(deepest, depth_at(at[i], nearest_sample[region_vertices[i]], nearest));
         return deepest;
     };
+    // The regions first, then their fairings, in waves of regions solved in parallel: a
+    // region's system reads the positions of the vertices two rings out from it (its rim's
+    // neighbours), which may be another region's, and it must see them as a pass over the
+    // regions in order would: faired for an earlier region, not yet for a later one. So a
+    // region's wave comes after that of every earlier region within two rings, and each wave's
+    // solutions go in once the whole wave is solved: the same positions whatever the thread
+    // count, and the same as one region after another.
+    struct Found
+    {
+        std::vector<std::uint32_t> members;
+        std::vector<Vec3d> rim_at;
+        std::vector<Vec3d> rim_normals;
+        detail::Fairing fill = detail::Fairing::thin_plate;
+        std::size_t wave = 0;
+        std::optional<std::vector<Vec3d>> solution;
+        std::vector<Vec3d> before;
+    };
+    std::vector<Found> found;
     for (std::size_t seed = 0; seed < n; ++seed)
     {
         if (free[seed] == 0 || region[seed] != unset)
@@ -1825,32 +1849,80 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
         if (!held)
             continue;
         std::sort(members.begin(), members.end());
-        const auto [rim_at, rim_normals] = rim_of(members);
-        const detail::Fairing fill = detail::fill_for_rim(rim_at, rim_normals);
-        const std::optional<std::vector<Vec3d>> solution =
-            detail::thin_plate_fairing(n, members, for_each_neighbour, position, fill);
-        if (!solution)
+        Found& f = found.emplace_back();
+        f.members = members;
+        std::tie(f.rim_at, f.rim_normals) = rim_of(members);
+        f.fill = detail::fill_for_rim(f.rim_at, f.rim_normals);
+    }
+    std::size_t waves = 0;
+    {
+        std::vector<std::uint32_t> found_of(n, none);
+        for (std::size_t r = 0; r < found.size(); ++r)
+        {
+            Found& f = found[r];
+            for (const std::uint32_t v : f.members)
+                found_of[v] = static_cast<std::uint32_t>(r);
+            for (const std::uint32_t v : f.members)
+                for (const std::uint32_t w : ring(v))
+                    if (free[w] == 0)
+                        for (const std::uint32_t u : ring(w))
+                            if (found_of[u] != none && found_of[u] < r)
+                                f.wave = std::max(f.wave, found[found_of[u]].wave + 1);
+            waves = std::max(waves, f.wave + 1);
+        }
+    }
+    std::vector<std::uint32_t> in_wave;
+    for (std::size_t wave = 0; wave < waves; ++wave)
+    {
+        in_wave.clear();
+        for (std::size_t r = 0; r < found.size(); ++r)
+            if (found[r].wave == wave)
+                in_wave.push_back(static_cast<std::uint32_t>(r));
+        parallel_blocks(in_wave.size(), 1, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i)
+            {
+                Found& f = found[in_wave[i]];
+                f.solution =
+                    detail::thin_plate_fairing(n, f.members, for_each_neighbour, position, f.fill);
+            }
+        });
+        for (const std::uint32_t r : in_wave)
+        {
+            Found& f = found[r];
+            if (!f.solution)
+                continue;
+            f.before.resize(f.members.size());
+            for (std::size_t i = 0; i < f.members.size(); ++i)
+            {
+                f.before[i] = x[f.members[i]];
+                x[f.members[i]] = (*f.solution)[i];
+            }
+        }
+    }
+    for (Found& f : found)
+    {
+        if (!f.solution)
             continue;
+        const std::vector<std::uint32_t>& region_members = f.members;
         ++out.regions;
-        if (fill == detail::Fairing::membrane)
+        if (f.fill == detail::Fairing::membrane)
             ++out.membranes;
-        else if (hole_depth(members) >= crease_fill_depth)
+        else if (hole_depth(region_members) >= crease_fill_depth)
         {
             std::optional<detail::CreaseFill> crease =
-                detail::crease_fill_for_rim(rim_at, rim_normals);
+                detail::crease_fill_for_rim(f.rim_at, f.rim_normals);
             if (crease && spans_a_wall(*crease) &&
-                faired_depth(members, *solution) < crease_fill_depth)
+                faired_depth(region_members, *f.solution) < crease_fill_depth)
                 crease.reset();
             if (crease)
-                creased.push_back({members, rim_at, std::move(*crease)});
+                creased.push_back({region_members, f.rim_at, std::move(*crease)});
         }
-        for (std::size_t i = 0; i < members.size(); ++i)
+        for (std::size_t i = 0; i < region_members.size(); ++i)
         {
-            flat_fill[members[i]] = fill == detail::Fairing::membrane ? 1 : 0;
-            before.push_back(x[members[i]]);
-            x[members[i]] = (*solution)[i];
-            faired[members[i]] = 1;
-            unknowns.push_back(members[i]);
+            flat_fill[region_members[i]] = f.fill == detail::Fairing::membrane ? 1 : 0;
+            before.push_back(f.before[i]);
+            faired[region_members[i]] = 1;
+            unknowns.push_back(region_members[i]);
         }
     }
     if (unknowns.empty())

@@ -68,51 +68,62 @@ void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces,
         }
     }
     const TriangleBvh surface(reference);
-    std::vector<Vec3d> normal(free.size());
     std::vector<Vec3d> next(free.size());
     // RelaxTarget::face_centroids: each free vertex's faces' centroids, weighted by the faces'
     // areas (twice, as area_normal() gives them).
     const bool by_area = target == RelaxTarget::face_centroids;
-    std::vector<Vec3d> centroid(by_area ? free.size() : 0);
-    std::vector<double> area(by_area ? free.size() : 0);
+    // Each free vertex's faces among `touching`, in ascending order: the sums over them below
+    // are made in the order of a pass over the faces, whatever the thread count.
+    std::vector<std::uint32_t> first(free.size() + 1, 0);
+    for (const std::uint32_t f : touching)
+        for (const std::uint32_t v : faces[f])
+            if (slot[v] != std::numeric_limits<std::uint32_t>::max())
+                ++first[slot[v] + 1];
+    for (std::size_t i = 0; i < free.size(); ++i)
+        first[i + 1] += first[i];
+    std::vector<std::uint32_t> around(first.back());
+    {
+        std::vector<std::uint32_t> filled(first.begin(), first.end() - 1);
+        for (std::size_t k = 0; k < touching.size(); ++k)
+            for (const std::uint32_t v : faces[touching[k]])
+                if (slot[v] != std::numeric_limits<std::uint32_t>::max())
+                    around[filled[slot[v]]++] = static_cast<std::uint32_t>(k);
+    }
     for (int round = 0; round < rounds; ++round)
     {
         const bool project = round + 1 == rounds;
-        std::fill(normal.begin(), normal.end(), Vec3d::Zero());
-        std::fill(centroid.begin(), centroid.end(), Vec3d::Zero());
-        std::fill(area.begin(), area.end(), 0.0);
-        for (const std::uint32_t f : touching)
-        {
-            const Triangle& t = faces[f];
-            const Vec3d n = area_normal(x[t[0]], x[t[1]], x[t[2]]);
-            const double a = n.norm();
-            const Vec3d c = (x[t[0]] + x[t[1]] + x[t[2]]) / 3.0;
-            for (const std::uint32_t v : t)
-                if (slot[v] != std::numeric_limits<std::uint32_t>::max())
-                {
-                    normal[slot[v]] += n;
-                    if (by_area)
-                    {
-                        centroid[slot[v]] += a * c;
-                        area[slot[v]] += a;
-                    }
-                }
-        }
         parallel_blocks(free.size(), relax_block, [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i)
             {
+                // The vertex's faces' area normals summed, and their centroids weighted by
+                // their areas (face_centroids), in ascending face order.
+                Vec3d face_normals = Vec3d::Zero();
+                Vec3d centroids = Vec3d::Zero();
+                double areas = 0.0;
+                for (std::uint32_t e = first[i]; e < first[i + 1]; ++e)
+                {
+                    const Triangle& t = faces[touching[around[e]]];
+                    const Vec3d n = area_normal(x[t[0]], x[t[1]], x[t[2]]);
+                    face_normals += n;
+                    if (by_area)
+                    {
+                        const double a = n.norm();
+                        centroids += a * ((x[t[0]] + x[t[1]] + x[t[2]]) / 3.0);
+                        areas += a;
+                    }
+                }
                 const std::uint32_t v = free[i];
                 next[i] = x[v];
-                const double length = normal[i].norm();
+                const double length = face_normals.norm();
                 if (!(length > 0.0) || ring_offsets[v + 1] == ring_offsets[v])
                     continue;
-                const Vec3d n = normal[i] / length;
+                const Vec3d n = face_normals / length;
                 Vec3d mean = Vec3d::Zero();
                 for (std::uint32_t e = ring_offsets[v]; e < ring_offsets[v + 1]; ++e)
                     mean += x[ring_adjacent[e]];
                 mean /= static_cast<double>(ring_offsets[v + 1] - ring_offsets[v]);
-                if (by_area && area[i] > 0.0)
-                    mean = centroid[i] / area[i];
+                if (by_area && areas > 0.0)
+                    mean = centroids / areas;
                 const Vec3d move = mean - x[v];
                 next[i] = x[v] + move - move.dot(n) * n;
                 if (project)
