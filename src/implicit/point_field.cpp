@@ -5,6 +5,7 @@
 
 #include "pointform/core/error.h"
 #include "pointform/core/parallel.h"
+#include "pointform/core/progress.h"
 #include "pointform/hermite/crease_fit.h"
 #include "pointform/hermite/normals.h"
 #include "pointform/hermite/scatter.h"
@@ -1344,6 +1345,7 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
     }
     impl_ = std::make_unique<Impl>(std::move(surfels), options);
     Impl& m = *impl_;
+    m.options.progress = nullptr; // for the construction only: options() keeps no callback
     const std::size_t n = m.surfels.size();
     for (std::size_t i = 0; i < n; ++i)
     {
@@ -1434,81 +1436,88 @@ PointField::PointField(PointCloud surfels, const PointFieldOptions& options)
         narrow_tests.resize(fit_grid.slot_count());
         narrow_candidates.resize(block_area.size());
     }
-    parallel_blocks(fit_grid.slot_count(), block, [&](std::size_t begin, std::size_t end) {
-        std::vector<std::uint32_t> samples; // fit-grid slots
-        std::vector<Vec3f> queries;
-        samples.reserve(end - begin);
-        queries.reserve(end - begin);
-        for (std::size_t slot = begin; slot < end; ++slot)
-        {
-            if (fit_grid.original_index(static_cast<std::uint32_t>(slot)) !=
-                PointGrid::padding_slot)
+    ProgressReporter reporter(options.progress, "field");
+    parallel_blocks(
+        fit_grid.slot_count(), block,
+        [&](std::size_t begin, std::size_t end) {
+            std::vector<std::uint32_t> samples; // fit-grid slots
+            std::vector<Vec3f> queries;
+            samples.reserve(end - begin);
+            queries.reserve(end - begin);
+            for (std::size_t slot = begin; slot < end; ++slot)
             {
-                samples.push_back(static_cast<std::uint32_t>(slot));
-                queries.push_back(fit_positions[slot]);
+                if (fit_grid.original_index(static_cast<std::uint32_t>(slot)) !=
+                    PointGrid::padding_slot)
+                {
+                    samples.push_back(static_cast<std::uint32_t>(slot));
+                    queries.push_back(fit_positions[slot]);
+                }
             }
-        }
-        std::vector<std::uint32_t> slots;
-        std::vector<float> dist2;
-        knn_of_batch(fit_grid, m.tree, queries, k, slots, dist2);
-        double area = 0.0;
-        for (std::size_t q = 0; q < samples.size(); ++q)
-        {
-            const std::span<std::uint32_t> neighbors(slots.data() + q * k, k);
-            const std::span<const float> d2(dist2.data() + q * k, k);
-            // The ball to the last neighbour holds k samples: π d² / k of surface per sample.
-            area += std::numbers::pi * static_cast<double>(d2[k - 1]) / static_cast<double>(k);
-            const std::uint32_t i = fit_grid.original_index(samples[q]);
-            if (!m.slot_reach.empty())
-                m.slot_reach[m.grid->slot_of(i)] = std::sqrt(d2[reach_rank - 1]);
-            PackedSurfel packed;
-            packed.position = m.surfels.positions[i];
-            packed.radius = m.surfels.radii[i];
-            CreaseFit crease{m.surfels.normals[i]};
-            if (options.fit == PlaneFit::Quadric && options.crease_fit)
-                crease = crease_normal(fit_positions, fit_normals, neighbors, samples[q],
-                                       m.surfels.normals[i], clean);
-            packed.normal = crease.normal;
-            if (!m.crease.empty())
+            std::vector<std::uint32_t> slots;
+            std::vector<float> dist2;
+            knn_of_batch(fit_grid, m.tree, queries, k, slots, dist2);
+            double area = 0.0;
+            for (std::size_t q = 0; q < samples.size(); ++q)
             {
-                m.crease[m.grid->slot_of(i)] = crease.crease;
-                m.other_plane[m.grid->slot_of(i)] = crease.other;
+                const std::span<std::uint32_t> neighbors(slots.data() + q * k, k);
+                const std::span<const float> d2(dist2.data() + q * k, k);
+                // The ball to the last neighbour holds k samples: π d² / k of surface per sample.
+                area += std::numbers::pi * static_cast<double>(d2[k - 1]) / static_cast<double>(k);
+                const std::uint32_t i = fit_grid.original_index(samples[q]);
+                if (!m.slot_reach.empty())
+                    m.slot_reach[m.grid->slot_of(i)] = std::sqrt(d2[reach_rank - 1]);
+                PackedSurfel packed;
+                packed.position = m.surfels.positions[i];
+                packed.radius = m.surfels.radii[i];
+                CreaseFit crease{m.surfels.normals[i]};
+                if (options.fit == PlaneFit::Quadric && options.crease_fit)
+                    crease = crease_normal(fit_positions, fit_normals, neighbors, samples[q],
+                                           m.surfels.normals[i], clean);
+                packed.normal = crease.normal;
+                if (!m.crease.empty())
+                {
+                    m.crease[m.grid->slot_of(i)] = crease.crease;
+                    m.other_plane[m.grid->slot_of(i)] = crease.other;
+                }
+                packed.tangent = tangent_of(packed.normal);
+                // Where the neighbours lie (a rim?): for the quadric's fit and the blend's rim
+                // limit.
+                const NeighbourhoodOffset offset =
+                    blends(options.fit)
+                        ? neighbourhood_offset(fit_positions, neighbors, samples[q], packed)
+                        : NeighbourhoodOffset{};
+                NarrowFit narrow;
+                const bool on_rim = offset.centroid.norm() >= rim_full;
+                const double noise =
+                    fit_local_surface(fit_positions, fit_normals, neighbors, samples[q],
+                                      options.fit, options.quadric_narrow_k, on_rim, packed,
+                                      narrow_tests.empty() ? nullptr : &narrow);
+                if (!fit_noise.empty() &&
+                    (options.noise_scale_region.cells.empty() ||
+                     options.noise_scale_region.contains(m.surfels.origin +
+                                                         m.surfels.positions[i].cast<double>())))
+                {
+                    fit_noise[i] = static_cast<float>(noise);
+                    fit_on_rim[i] = on_rim ? 1 : 0;
+                }
+                if (!narrow_tests.empty())
+                {
+                    narrow_tests[samples[q]] = narrow.test;
+                    if (narrow.candidate)
+                        narrow_candidates[begin / block].push_back({samples[q], narrow.coef});
+                }
+                m.packed[m.grid->slot_of(i)] = packed;
+                // A wedge's edge is no rim: past it the field stays defined as far as past any
+                // crease (on the clean 100k cone it ended about 0.7 of a radius past the tip, a
+                // cell of the intermediate grid, and marching cubes left holes along the rim).
+                if (blends(options.fit) && options.rim_reach < 1.0 && !crease.wedge)
+                    m.rim[m.grid->slot_of(i)] =
+                        rim_limit(offset, static_cast<double>(packed.radius), options.rim_reach);
             }
-            packed.tangent = tangent_of(packed.normal);
-            // Where the neighbours lie (a rim?): for the quadric's fit and the blend's rim limit.
-            const NeighbourhoodOffset offset =
-                blends(options.fit)
-                    ? neighbourhood_offset(fit_positions, neighbors, samples[q], packed)
-                    : NeighbourhoodOffset{};
-            NarrowFit narrow;
-            const bool on_rim = offset.centroid.norm() >= rim_full;
-            const double noise = fit_local_surface(
-                fit_positions, fit_normals, neighbors, samples[q], options.fit,
-                options.quadric_narrow_k, on_rim, packed, narrow_tests.empty() ? nullptr : &narrow);
-            if (!fit_noise.empty() &&
-                (options.noise_scale_region.cells.empty() ||
-                 options.noise_scale_region.contains(m.surfels.origin +
-                                                     m.surfels.positions[i].cast<double>())))
-            {
-                fit_noise[i] = static_cast<float>(noise);
-                fit_on_rim[i] = on_rim ? 1 : 0;
-            }
-            if (!narrow_tests.empty())
-            {
-                narrow_tests[samples[q]] = narrow.test;
-                if (narrow.candidate)
-                    narrow_candidates[begin / block].push_back({samples[q], narrow.coef});
-            }
-            m.packed[m.grid->slot_of(i)] = packed;
-            // A wedge's edge is no rim: past it the field stays defined as far as past any
-            // crease (on the clean 100k cone it ended about 0.7 of a radius past the tip, a
-            // cell of the intermediate grid, and marching cubes left holes along the rim).
-            if (blends(options.fit) && options.rim_reach < 1.0 && !crease.wedge)
-                m.rim[m.grid->slot_of(i)] =
-                    rim_limit(offset, static_cast<double>(packed.radius), options.rim_reach);
-        }
-        block_area[begin / block] = area;
-    });
+            block_area[begin / block] = area;
+        },
+        &reporter);
+    reporter.finish();
     if (!narrow_tests.empty())
     {
         pool_narrow_fits(

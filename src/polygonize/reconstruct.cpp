@@ -357,7 +357,9 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
     if (!options.base_mesh.empty())
         given = surfels;
     auto field = std::make_unique<const PointField>(
-        std::move(surfels), PointFieldOptions{.fit = options.fit, .rim_reach = options.rim_reach});
+        std::move(surfels),
+        PointFieldOptions{
+            .fit = options.fit, .rim_reach = options.rim_reach, .progress = options.progress});
     clock.lap("field");
 
     if (!options.base_mesh.empty() || !options.picked_vertices.empty())
@@ -388,7 +390,9 @@ ReconstructReport reconstruct(PointCloud surfels, const ReconstructOptions& opti
             report.sponge_cells = refit->options.noise_scale_region.cells.size();
             PointCloud samples = field->surfels();
             field.reset();
-            field = std::make_unique<const PointField>(std::move(samples), refit->options);
+            PointFieldOptions field_options = refit->options;
+            field_options.progress = options.progress;
+            field = std::make_unique<const PointField>(std::move(samples), field_options);
             clock.lap("field (noise scale)");
             intermediate_mesh =
                 intermediate_mesh_of(*field, bounds, options, report, clock, " (noise scale)");

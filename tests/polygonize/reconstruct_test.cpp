@@ -18,6 +18,8 @@
 #include <cmath>
 #include <numeric>
 #include <random>
+#include <string>
+#include <vector>
 
 namespace pointform {
 namespace {
@@ -78,6 +80,56 @@ void expect_unit_sphere(const ReconstructReport& report, double tolerance = 0.0)
     EXPECT_EQ(topo.components, 1U);
     EXPECT_LT(sphere_error(finest),
               tolerance > 0.0 ? tolerance : report.semi_regular.refinement.sampling_density);
+}
+
+/// Every stage that reports progress stops when the callback asks it to, by throwing Cancelled
+/// (the Python module's Ctrl-C relies on it): asked at each stage's first report and at its
+/// last in turn, from raw points (the normals' stages too) to the refinement's last level, with
+/// the levels given and with the automatic stop.
+TEST(Reconstruct, EveryStageStopsWhenAsked)
+{
+    PointCloud raw = sample_shape(Shape::Torus, {.count = 6000, .seed = 7});
+    raw.normals.clear();
+    for (const bool exact : {true, false})
+    {
+        ReconstructOptions options;
+        if (exact)
+            options.semi_regular.levels = 2; // else the automatic stop
+        // Runs the pipeline as the Python module does, with `progress`.
+        const auto run = [&](const ProgressCallback& progress) {
+            SurfelsFromSamples input = surfels_from_samples(raw, {.progress = progress});
+            ReconstructOptions with_progress = options;
+            with_progress.progress = progress;
+            return reconstruct(std::move(input.surfels), with_progress);
+        };
+        // The stages' names, in the order they first reported.
+        std::vector<std::string> stages;
+        (void)run([&](std::string_view stage, double) {
+            if (std::find(stages.begin(), stages.end(), stage) == stages.end())
+                stages.emplace_back(stage);
+            return true;
+        });
+        ASSERT_GE(stages.size(), 6U);
+        // Asked at each stage's first report, and at its report of the stage done (fraction 1;
+        // how many reports come between depends on the threads).
+        for (const std::string& stop_at : stages)
+            for (const bool at_end : {false, true})
+            {
+                bool asked = false;
+                EXPECT_THROW((void)run([&](std::string_view stage, double fraction) {
+                                 asked =
+                                     asked || (stage == stop_at && (!at_end || fraction >= 1.0));
+                                 return !asked;
+                             }),
+                             Cancelled)
+                    << "stage " << stop_at << (at_end ? ", at its end" : ", at its start");
+                EXPECT_TRUE(asked) << "stage " << stop_at;
+            }
+        std::string names;
+        for (const std::string& stage : stages)
+            names += (names.empty() ? "" : ", ") + stage;
+        RecordProperty(exact ? "stages_exact" : "stages_automatic", names);
+    }
 }
 
 TEST(Reconstruct, TheIntermediateMeshHasAFewFacesPerBaseFace)

@@ -3,6 +3,7 @@
 
 #pragma once
 
+#include "pointform/core/progress.h"
 #include "pointform/geometry/point_cloud.h"
 #include "pointform/implicit/field.h"
 #include "pointform/spatial/kd_tree.h"
@@ -126,6 +127,10 @@ struct PointFieldOptions
     /// slower deep inside a closed scan; for callers that take inside values as distances
     /// (morphs, UndefinedPolicy::Ignore).
     bool far_grid = true;
+    /// Optional: told how the samples' fits advance (stage "field"); returning false stops the
+    /// build, which then throws Cancelled. Called during construction only (options() returns
+    /// the options without it).
+    ProgressCallback progress;
 };
 
 /// \brief The signed field of oriented surfels (§4).
