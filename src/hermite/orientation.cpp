@@ -2112,155 +2112,162 @@ OrientedNormals orient_by_patches(std::span<const Vec3f> positions, std::span<co
     //    the unreliable ones and those off the sheet), for the votes: edge i * columns + c of
     //    the block is column c of its sample i.
     std::vector<std::vector<std::uint32_t>> crossing(blocks);
-    parallel_blocks(blocks, 1, [&](std::size_t first, std::size_t last) {
-        SignedSets sets;
-        std::vector<std::uint32_t> later;
-        std::vector<std::uint32_t> local_id(patch_block);
-        for (std::size_t b = first; b < last; ++b)
-        {
-            const std::size_t begin = b * patch_block;
-            const std::size_t end = std::min(n, begin + patch_block);
-            sets.reset(end - begin);
-            later.clear();
-            auto& open = crossing[b];
-            //    Joins i (whose set and sign are root and odd) and its column c, j.
-            const auto join = [&](std::size_t i, std::size_t c, std::uint32_t j,
-                                  std::pair<std::uint32_t, std::uint8_t>& own) {
-                const auto edge = static_cast<std::uint32_t>((i - begin) * columns + c);
-                const auto [rj, oj] = sets.find(static_cast<std::uint32_t>(j - begin));
-                if (rj == own.first)
-                    return;
-                if (off_sheet(positions[i], normals[i], positions[j], normals[j]))
-                    open.push_back(edge);
-                else
-                    own =
-                        sets.link(own.first, own.second, rj, oj, normals[i].dot(normals[j]) < 0.0F);
-            };
-            //    Creased samples: Hoppe's rule is not trusted (hoppe_trusted()) on the edge to
-            //    some neighbour in the block (a normal more than a reliable step away, or the
-            //    other side of a knife edge or a thin part). They join no patch: near a crease
-            //    the estimated normals turn from one face's to the other's the short way round
-            //    as lines, which at a crease sharper than 90° is the wrong way, and a chain of
-            //    reliable steps through them would join the two faces with one turned over.
-            //    A sample is creased too where two of its neighbours in the block are more than
-            //    a reliable step apart (its neighbourhood spans the turn, in steps each small
-            //    enough to pass: the head of an arrow, whose rim turns by 124°, was joined to
-            //    its shaft inside out, 73% of the samples). (Only the block's own samples can
-            //    chain within it, so only its own edges are looked at.)
-            bool any_creased = false;
-            //    Whether j is a neighbour of i in the block with a normal.
-            const auto in_block = [&](std::size_t i, std::uint32_t j) {
-                return j >= begin && j < end && j != i && usable(normals[j]);
-            };
-            for (std::size_t i = begin; i < end; ++i)
+    //    (Reported as the blocks' patches are made, the bulk of the work.)
+    ProgressReporter progress(options.progress, "orientation");
+    parallel_blocks(
+        blocks, 1,
+        [&](std::size_t first, std::size_t last) {
+            SignedSets sets;
+            std::vector<std::uint32_t> later;
+            std::vector<std::uint32_t> local_id(patch_block);
+            for (std::size_t b = first; b < last; ++b)
             {
-                if (!usable(normals[i]))
-                    continue;
-                const auto row = neighbors.neighbors(i).first(columns);
-                float farthest = 1.0F;
-                std::uint32_t apart = none;
-                for (const std::uint32_t j : row)
+                const std::size_t begin = b * patch_block;
+                const std::size_t end = std::min(n, begin + patch_block);
+                sets.reset(end - begin);
+                later.clear();
+                auto& open = crossing[b];
+                //    Joins i (whose set and sign are root and odd) and its column c, j.
+                const auto join = [&](std::size_t i, std::size_t c, std::uint32_t j,
+                                      std::pair<std::uint32_t, std::uint8_t>& own) {
+                    const auto edge = static_cast<std::uint32_t>((i - begin) * columns + c);
+                    const auto [rj, oj] = sets.find(static_cast<std::uint32_t>(j - begin));
+                    if (rj == own.first)
+                        return;
+                    if (off_sheet(positions[i], normals[i], positions[j], normals[j]))
+                        open.push_back(edge);
+                    else
+                        own = sets.link(own.first, own.second, rj, oj,
+                                        normals[i].dot(normals[j]) < 0.0F);
+                };
+                //    Creased samples: Hoppe's rule is not trusted (hoppe_trusted()) on the edge to
+                //    some neighbour in the block (a normal more than a reliable step away, or the
+                //    other side of a knife edge or a thin part). They join no patch: near a crease
+                //    the estimated normals turn from one face's to the other's the short way round
+                //    as lines, which at a crease sharper than 90° is the wrong way, and a chain of
+                //    reliable steps through them would join the two faces with one turned over.
+                //    A sample is creased too where two of its neighbours in the block are more than
+                //    a reliable step apart (its neighbourhood spans the turn, in steps each small
+                //    enough to pass: the head of an arrow, whose rim turns by 124°, was joined to
+                //    its shaft inside out, 73% of the samples). (Only the block's own samples can
+                //    chain within it, so only its own edges are looked at.)
+                bool any_creased = false;
+                //    Whether j is a neighbour of i in the block with a normal.
+                const auto in_block = [&](std::size_t i, std::uint32_t j) {
+                    return j >= begin && j < end && j != i && usable(normals[j]);
+                };
+                for (std::size_t i = begin; i < end; ++i)
                 {
-                    if (!in_block(i, j))
+                    if (!usable(normals[i]))
                         continue;
-                    if (!hoppe_trusted(positions[i], normals[i], positions[j], normals[j],
-                                       reliable))
-                    {
-                        creased[i] = 1;
-                        creased[j] = 1;
-                        any_creased = true;
-                        apart = none;
-                        break;
-                    }
-                    const float agree = std::abs(normals[i].dot(normals[j]));
-                    if (agree < farthest)
-                    {
-                        farthest = agree;
-                        apart = j;
-                    }
-                }
-                //    The neighbour farthest from i against the others (unless all are within a
-                //    firm step of i, and so of each other within a reliable one).
-                if (apart != none && farthest < firm)
+                    const auto row = neighbors.neighbors(i).first(columns);
+                    float farthest = 1.0F;
+                    std::uint32_t apart = none;
                     for (const std::uint32_t j : row)
                     {
-                        if (in_block(i, j) && std::abs(normals[apart].dot(normals[j])) < reliable)
+                        if (!in_block(i, j))
+                            continue;
+                        if (!hoppe_trusted(positions[i], normals[i], positions[j], normals[j],
+                                           reliable))
                         {
                             creased[i] = 1;
+                            creased[j] = 1;
                             any_creased = true;
+                            apart = none;
                             break;
                         }
-                    }
-            }
-            //    And the samples next to a creased one in the block (marked 2): the blend of a
-            //    crease's normals is wider than the neighbourhoods that find it, and a patch
-            //    chained past it through samples each within a reliable step turned the base
-            //    of a cone as wide as high over (41% of the samples inside out).
-            for (std::size_t i = begin; i < end && any_creased; ++i)
-                if (creased[i] == 0)
-                    for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
-                        if (j >= begin && j < end && creased[j] == 1)
+                        const float agree = std::abs(normals[i].dot(normals[j]));
+                        if (agree < farthest)
                         {
-                            creased[i] = 2;
-                            break;
+                            farthest = agree;
+                            apart = j;
                         }
-            for (std::size_t i = begin; i < end; ++i)
-            {
-                if (!usable(normals[i]))
-                    continue;
-                auto own = sets.find(static_cast<std::uint32_t>(i - begin));
-                const auto row = neighbors.neighbors(i).first(columns);
-                for (std::size_t c = 0; c < columns; ++c)
-                {
-                    const std::uint32_t j = row[c];
-                    if (j == i)
-                        continue;
-                    const auto edge = static_cast<std::uint32_t>((i - begin) * columns + c);
-                    if (j < begin || j >= end)
-                    {
-                        open.push_back(edge);
-                        continue;
                     }
-                    if (!usable(normals[j]))
-                        continue;
-                    if (creased[i] != 0 || creased[j] != 0)
-                    {
-                        open.push_back(edge);
-                        continue;
-                    }
-                    const float agree = std::abs(normals[i].dot(normals[j]));
-                    if (agree >= firm)
-                        join(i, c, j, own);
-                    else if (agree >= reliable)
-                        later.push_back(edge);
-                    else
-                        open.push_back(edge);
+                    //    The neighbour farthest from i against the others (unless all are within a
+                    //    firm step of i, and so of each other within a reliable one).
+                    if (apart != none && farthest < firm)
+                        for (const std::uint32_t j : row)
+                        {
+                            if (in_block(i, j) &&
+                                std::abs(normals[apart].dot(normals[j])) < reliable)
+                            {
+                                creased[i] = 1;
+                                any_creased = true;
+                                break;
+                            }
+                        }
                 }
+                //    And the samples next to a creased one in the block (marked 2): the blend of a
+                //    crease's normals is wider than the neighbourhoods that find it, and a patch
+                //    chained past it through samples each within a reliable step turned the base
+                //    of a cone as wide as high over (41% of the samples inside out).
+                for (std::size_t i = begin; i < end && any_creased; ++i)
+                    if (creased[i] == 0)
+                        for (const std::uint32_t j : neighbors.neighbors(i).first(columns))
+                            if (j >= begin && j < end && creased[j] == 1)
+                            {
+                                creased[i] = 2;
+                                break;
+                            }
+                for (std::size_t i = begin; i < end; ++i)
+                {
+                    if (!usable(normals[i]))
+                        continue;
+                    auto own = sets.find(static_cast<std::uint32_t>(i - begin));
+                    const auto row = neighbors.neighbors(i).first(columns);
+                    for (std::size_t c = 0; c < columns; ++c)
+                    {
+                        const std::uint32_t j = row[c];
+                        if (j == i)
+                            continue;
+                        const auto edge = static_cast<std::uint32_t>((i - begin) * columns + c);
+                        if (j < begin || j >= end)
+                        {
+                            open.push_back(edge);
+                            continue;
+                        }
+                        if (!usable(normals[j]))
+                            continue;
+                        if (creased[i] != 0 || creased[j] != 0)
+                        {
+                            open.push_back(edge);
+                            continue;
+                        }
+                        const float agree = std::abs(normals[i].dot(normals[j]));
+                        if (agree >= firm)
+                            join(i, c, j, own);
+                        else if (agree >= reliable)
+                            later.push_back(edge);
+                        else
+                            open.push_back(edge);
+                    }
+                }
+                for (const std::uint32_t edge : later)
+                {
+                    const std::size_t i = begin + edge / columns;
+                    auto own = sets.find(static_cast<std::uint32_t>(i - begin));
+                    join(i, edge % columns, neighbors.neighbors(i)[edge % columns], own);
+                }
+                std::uint32_t count = 0;
+                for (std::size_t i = begin; i < end; ++i)
+                    if (usable(normals[i]) &&
+                        sets.find(static_cast<std::uint32_t>(i - begin)).first == i - begin)
+                        local_id[i - begin] = count++;
+                for (std::size_t i = begin; i < end; ++i)
+                {
+                    patch[i] = none;
+                    opposite[i] = 0;
+                    if (!usable(normals[i]))
+                        continue;
+                    const auto [root, odd] = sets.find(static_cast<std::uint32_t>(i - begin));
+                    patch[i] = local_id[root];
+                    opposite[i] = odd;
+                }
+                block_start[b + 1] = count;
             }
-            for (const std::uint32_t edge : later)
-            {
-                const std::size_t i = begin + edge / columns;
-                auto own = sets.find(static_cast<std::uint32_t>(i - begin));
-                join(i, edge % columns, neighbors.neighbors(i)[edge % columns], own);
-            }
-            std::uint32_t count = 0;
-            for (std::size_t i = begin; i < end; ++i)
-                if (usable(normals[i]) &&
-                    sets.find(static_cast<std::uint32_t>(i - begin)).first == i - begin)
-                    local_id[i - begin] = count++;
-            for (std::size_t i = begin; i < end; ++i)
-            {
-                patch[i] = none;
-                opposite[i] = 0;
-                if (!usable(normals[i]))
-                    continue;
-                const auto [root, odd] = sets.find(static_cast<std::uint32_t>(i - begin));
-                patch[i] = local_id[root];
-                opposite[i] = odd;
-            }
-            block_start[b + 1] = count;
-        }
-    });
+        },
+        &progress);
+    progress.finish();
     for (std::size_t b = 0; b < blocks; ++b)
         block_start[b + 1] += block_start[b];
     const std::size_t patch_count = block_start[blocks];
