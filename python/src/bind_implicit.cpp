@@ -142,7 +142,7 @@ void bind_implicit(py::module_& m)
                     for (py::ssize_t a = 0; a < 3; ++a)
                         view(static_cast<py::ssize_t>(k), a) = p[a];
                 }
-                return std::move(out);
+                return out;
             },
             "The positions (K by 3, float64) of a point field's stray samples (None for other "
             "fields): samples past 4 times the median reach to the 16th nearest that fill a "

@@ -68,6 +68,13 @@ py::array owning_array(std::vector<T> values, std::vector<py::ssize_t> shape,
                          writeable);
 }
 
+/// \brief Raises Python's KeyboardInterrupt (the interrupt that a progress callback took).
+[[noreturn]] inline void raise_keyboard_interrupt()
+{
+    PyErr_SetNone(PyExc_KeyboardInterrupt);
+    throw py::error_already_set();
+}
+
 /// \brief Runs `work(progress)` with the GIL released, where `progress` is a ProgressCallback
 /// for the library's options that lets Ctrl-C stop the work: when the library reports progress
 /// from the calling thread (signals reach Python's main thread only), it takes the GIL and runs
@@ -99,18 +106,14 @@ auto run_interruptible(Work&& work)
             return work(progress);
         }();
         if (interrupted->load())
-        {
-            PyErr_SetNone(PyExc_KeyboardInterrupt);
-            throw py::error_already_set();
-        }
+            raise_keyboard_interrupt();
         return result;
     }
     catch (const Cancelled&)
     {
         if (!interrupted->load())
             throw;
-        PyErr_SetNone(PyExc_KeyboardInterrupt);
-        throw py::error_already_set();
+        raise_keyboard_interrupt();
     }
 }
 

@@ -1784,7 +1784,6 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
     };
     std::fill(region.begin(), region.end(), unset);
     std::vector<std::uint32_t> unknowns;
-    std::vector<Vec3d> before;
     std::vector<char> flat_fill(n, 0);
     // The thin plates across a crease, moved onto the crease's faces once every region is faired.
     std::vector<CreasedRegion> creased;
@@ -1819,7 +1818,7 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
         detail::Fairing fill = detail::Fairing::thin_plate;
         std::size_t wave = 0;
         std::optional<std::vector<Vec3d>> solution;
-        std::vector<Vec3d> before;
+        std::vector<Vec3d> before; ///< the members' positions before the fairing
     };
     std::vector<Found> found;
     for (std::size_t seed = 0; seed < n; ++seed)
@@ -1899,30 +1898,28 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
             }
         }
     }
-    for (Found& f : found)
+    for (const Found& f : found)
     {
         if (!f.solution)
             continue;
-        const std::vector<std::uint32_t>& region_members = f.members;
         ++out.regions;
         if (f.fill == detail::Fairing::membrane)
             ++out.membranes;
-        else if (hole_depth(region_members) >= crease_fill_depth)
+        else if (hole_depth(f.members) >= crease_fill_depth)
         {
             std::optional<detail::CreaseFill> crease =
                 detail::crease_fill_for_rim(f.rim_at, f.rim_normals);
             if (crease && spans_a_wall(*crease) &&
-                faired_depth(region_members, *f.solution) < crease_fill_depth)
+                faired_depth(f.members, *f.solution) < crease_fill_depth)
                 crease.reset();
             if (crease)
-                creased.push_back({region_members, f.rim_at, std::move(*crease)});
+                creased.push_back({f.members, f.rim_at, std::move(*crease)});
         }
-        for (std::size_t i = 0; i < region_members.size(); ++i)
+        for (const std::uint32_t v : f.members)
         {
-            flat_fill[region_members[i]] = f.fill == detail::Fairing::membrane ? 1 : 0;
-            before.push_back(f.before[i]);
-            faired[region_members[i]] = 1;
-            unknowns.push_back(region_members[i]);
+            flat_fill[v] = f.fill == detail::Fairing::membrane ? 1 : 0;
+            faired[v] = 1;
+            unknowns.push_back(v);
         }
     }
     if (unknowns.empty())
@@ -1966,8 +1963,9 @@ UnsupportedFairing fair_unsupported(MultiresMesh& mesh, std::span<const Triangle
                 x, faces, rings.offsets, rings.adjacent, relaxed,
                 detail::depth_in_rings(rings.offsets, rings.adjacent, flat_fill));
     }
-    for (std::size_t i = 0; i < unknowns.size(); ++i)
-        out.max_move = std::max(out.max_move, (x[unknowns[i]] - before[i]).norm());
+    for (const Found& f : found)
+        for (std::size_t i = 0; i < f.before.size(); ++i)
+            out.max_move = std::max(out.max_move, (x[f.members[i]] - f.before[i]).norm());
     return out;
 }
 

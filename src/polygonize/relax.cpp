@@ -72,8 +72,8 @@ void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces,
     // RelaxTarget::face_centroids: each free vertex's faces' centroids, weighted by the faces'
     // areas (twice, as area_normal() gives them).
     const bool by_area = target == RelaxTarget::face_centroids;
-    // Each free vertex's faces among `touching`, in ascending order: the sums over them below
-    // are made in the order of a pass over the faces, whatever the thread count.
+    // Each free vertex's faces (indices into `faces`) in ascending order: the sums over them
+    // below are made in the order of a pass over the faces, whatever the thread count.
     std::vector<std::uint32_t> first(free.size() + 1, 0);
     for (const std::uint32_t f : touching)
         for (const std::uint32_t v : faces[f])
@@ -84,10 +84,10 @@ void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces,
     std::vector<std::uint32_t> around(first.back());
     {
         std::vector<std::uint32_t> filled(first.begin(), first.end() - 1);
-        for (std::size_t k = 0; k < touching.size(); ++k)
-            for (const std::uint32_t v : faces[touching[k]])
+        for (const std::uint32_t f : touching)
+            for (const std::uint32_t v : faces[f])
                 if (slot[v] != std::numeric_limits<std::uint32_t>::max())
-                    around[filled[slot[v]]++] = static_cast<std::uint32_t>(k);
+                    around[filled[slot[v]]++] = f;
     }
     for (int round = 0; round < rounds; ++round)
     {
@@ -102,7 +102,7 @@ void relax_tangentially(std::span<Vec3d> x, std::span<const Triangle> faces,
                 double areas = 0.0;
                 for (std::uint32_t e = first[i]; e < first[i + 1]; ++e)
                 {
-                    const Triangle& t = faces[touching[around[e]]];
+                    const Triangle& t = faces[around[e]];
                     const Vec3d n = area_normal(x[t[0]], x[t[1]], x[t[2]]);
                     face_normals += n;
                     if (by_area)
