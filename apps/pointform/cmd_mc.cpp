@@ -158,8 +158,7 @@ void run_mc(const McCommandOptions& options, const GlobalOptions& global)
         return;
     }
     std::printf("%s -> %s\n", options.input.c_str(), options.output.c_str());
-    print_row("samples", std::to_string(input.surfels.size()) +
-                             (input.estimated_normals ? " (normals estimated)" : " (surfels)"));
+    print_row("samples", std::to_string(input.surfels.size()) + describe_normals(input));
     print_row("cell", format_number(cell) + " (" + std::string(to_string(options.fit)) + " field)");
     print_row("vertices", std::to_string(result.mesh.vertex_count()));
     print_row("faces", std::to_string(result.mesh.face_count()));

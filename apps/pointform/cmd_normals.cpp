@@ -25,7 +25,7 @@ struct NormalsCommandOptions
     std::string input;
     std::string output;
     SurfelOptions surfels; ///< its orient and orient_target from --orient
-    std::string orient = "mst";
+    std::string orient = "auto";
     bool ascii = false;
     bool json = false;
 };
@@ -38,9 +38,11 @@ void parse_orient(const std::string& text, SurfelOptions& options)
     const std::string argument = colon == std::string::npos ? "" : text.substr(colon + 1);
     if ((mode == "towards" || mode == "along") == argument.empty())
         throw CLI::ValidationError("--orient", "'" + text +
-                                                   "': expected mst, none, flip, "
+                                                   "': expected auto, mst, none, flip, "
                                                    "towards:X,Y,Z or along:X,Y,Z");
-    if (mode == "mst")
+    if (mode == "auto")
+        options.orient = OrientMode::Auto;
+    else if (mode == "mst")
         options.orient = OrientMode::Mst;
     else if (mode == "none")
         options.orient = OrientMode::None;
@@ -60,8 +62,8 @@ void parse_orient(const std::string& text, SurfelOptions& options)
     }
     else
         throw CLI::ValidationError("--orient", "unknown mode '" + mode +
-                                                   "': expected mst, none, flip, towards:X,Y,Z "
-                                                   "or along:X,Y,Z");
+                                                   "': expected auto, mst, none, flip, "
+                                                   "towards:X,Y,Z or along:X,Y,Z");
 }
 
 void run_normals(const NormalsCommandOptions& options, const GlobalOptions& global)
@@ -100,6 +102,7 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
         out["components"] = orientation.components;
         out["flipped"] = orientation.flipped;
         out["crease_refits"] = result.crease_refits;
+        out["towards_sensor"] = result.towards_sensor;
         out["thin_parts"] = orientation.thin_parts;
         out["thin_part_turned"] = orientation.thin_part_turned;
         out["degenerate"] = result.degenerate;
@@ -121,6 +124,9 @@ void run_normals(const NormalsCommandOptions& options, const GlobalOptions& glob
     std::printf("%s -> %s\n", options.input.c_str(), options.output.c_str());
     print_row("points", std::to_string(result.surfels.size()));
     print_row("components", std::to_string(orientation.components));
+    if (result.towards_sensor)
+        print_row("orientation", "towards the " + describe_sensor(*result.surfels.sensor) +
+                                     " (the input is a depth image seen from it)");
     print_row("normals flipped", std::to_string(orientation.flipped));
     if (options.surfels.sharp_creases)
         print_row("crease refits",
@@ -178,8 +184,10 @@ void register_normals(CLI::App& app, const GlobalOptions& global)
         "{\"center\": [x,y,z], \"radius\": R}, \"set\": r}, {\"box\": {\"min\": "
         "[..], \"max\": [..]}, \"scale\": s}]}");
     cmd->add_option("--orient", options->orient,
-                    "mst (consistent, outward on closed surfaces), none, flip (mst, then "
-                    "inward), towards:X,Y,Z (a viewpoint) or along:X,Y,Z (a direction)")
+                    "auto (towards the sensor of a depth image, an organized PCD with its "
+                    "VIEWPOINT; mst otherwise), mst (consistent, outward on closed surfaces), "
+                    "none, flip (mst, then inward), towards:X,Y,Z (a viewpoint) or along:X,Y,Z "
+                    "(a direction)")
         ->capture_default_str();
     add_sharp_creases_flag(*cmd, options->surfels.sharp_creases);
     add_rule_option(*cmd, options->surfels.rule,

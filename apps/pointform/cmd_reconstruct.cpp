@@ -70,8 +70,7 @@ void run_reconstruct(const ReconstructCommandOptions& options, const GlobalOptio
         return;
     }
     std::printf("%s -> %s\n", options.input.c_str(), options.output.c_str());
-    print_row("samples", std::to_string(samples) +
-                             (input.estimated_normals ? " (normals estimated)" : " (surfels)"));
+    print_row("samples", std::to_string(samples) + describe_normals(input));
     if (base_stats)
     {
         print_row("intermediate mesh",

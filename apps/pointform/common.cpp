@@ -95,6 +95,21 @@ Vec3d parse_vec3(const std::string& text, const std::string& what)
     return v;
 }
 
+std::string describe_normals(const SurfelsFromSamples& input)
+{
+    if (!input.estimated_normals)
+        return " (surfels)";
+    return input.towards_sensor
+               ? " (normals estimated, facing the sensor the depth image was seen from)"
+               : " (normals estimated)";
+}
+
+std::string describe_sensor(const Vec3d& sensor)
+{
+    return "sensor at (" + format_number(sensor.x()) + ", " + format_number(sensor.y()) + ", " +
+           format_number(sensor.z()) + ")";
+}
+
 std::string describe_degenerate(std::size_t degenerate, std::size_t kept)
 {
     return std::to_string(degenerate) + " (" + std::to_string(degenerate - kept) + " flipped, " +

@@ -6,6 +6,7 @@
 #include "pointform/core/progress.h"
 #include "pointform/core/types.h"
 #include "pointform/geometry/aabb.h"
+#include "pointform/hermite/surfels.h"
 #include "pointform/report/report_json.h" // format_number
 
 #include <CLI/CLI.hpp>
@@ -94,6 +95,13 @@ void print_row(const std::string& label, const std::string& value);
 /// \brief The marching-cubes triangles of next to zero area and what became of them, for
 /// reports: "N (F flipped, K kept; none dropped)".
 [[nodiscard]] std::string describe_degenerate(std::size_t degenerate, std::size_t kept);
+
+/// \brief Where the surfels' normals came from, for the "samples" row: " (surfels)",
+/// " (normals estimated)", or that they face the depth image's sensor.
+[[nodiscard]] std::string describe_normals(const SurfelsFromSamples& input);
+
+/// \brief A sensor's position for reports: "sensor at (x, y, z)".
+[[nodiscard]] std::string describe_sensor(const Vec3d& sensor);
 
 /// \brief Registers the subcommands; each is defined in its own cmd_<verb>.cpp.
 void register_info(CLI::App& app, const GlobalOptions& global);

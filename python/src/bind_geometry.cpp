@@ -217,18 +217,24 @@ Vec3d first_row(const py::handle& array, const char* name)
 
 namespace {
 
-Vec3d origin_from(const py::handle& origin)
+/// Three finite numbers given as `name` (origin, sensor).
+Vec3d vec3_from(const py::handle& value, const std::string& name)
 {
-    py::array a = as_array(origin, "origin");
+    py::array a = as_array(value, name.c_str());
     if (dtype_kind(a) != 'f' && dtype_kind(a) != 'i' && dtype_kind(a) != 'u')
-        throw InvalidInput("origin: expected three real numbers, got dtype " + dtype_text(a));
+        throw InvalidInput(name + ": expected three real numbers, got dtype " + dtype_text(a));
     if (a.ndim() != 1 || a.shape(0) != 3)
-        throw InvalidInput("origin: expected three numbers, got shape " + shape_text(a));
+        throw InvalidInput(name + ": expected three numbers, got shape " + shape_text(a));
     auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
     const Vec3d o(d.at(0), d.at(1), d.at(2));
     if (!o.allFinite())
-        throw InvalidInput("origin is not finite: " + row_text(o.x(), o.y(), o.z()));
+        throw InvalidInput(name + " is not finite: " + row_text(o.x(), o.y(), o.z()));
     return o;
+}
+
+Vec3d origin_from(const py::handle& origin)
+{
+    return vec3_from(origin, "origin");
 }
 
 /// Checks an N by 3 integer color array; returns it as int64 C order (a view if it was one).
@@ -447,13 +453,21 @@ void bind_geometry(py::module_& m)
         "them or the cloud is.")
         .def(py::init([](const py::object& positions, const py::object& normals,
                          const py::object& colors, const py::object& radii,
-                         const py::object& origin) {
-                 return make_cloud(positions, normals, colors, radii, origin);
+                         const py::object& origin, const py::object& sensor) {
+                 std::shared_ptr<Cloud> cloud =
+                     make_cloud(positions, normals, colors, radii, origin);
+                 if (!sensor.is_none())
+                 {
+                     cloud->owned.sensor = vec3_from(sensor, "sensor");
+                     cloud->view.sensor = cloud->owned.sensor;
+                 }
+                 return cloud;
              }),
              py::arg("positions"), py::kw_only(), py::arg("normals") = py::none(),
              py::arg("colors") = py::none(), py::arg("radii") = py::none(),
-             py::arg("origin") = py::none(),
-             "PointCloud(positions, *, normals=None, colors=None, radii=None, origin=None)\n\n"
+             py::arg("origin") = py::none(), py::arg("sensor") = py::none(),
+             "PointCloud(positions, *, normals=None, colors=None, radii=None, origin=None, "
+             "sensor=None)\n\n"
              "positions: N by 3 real array (float32 or float64, any memory order), N >= 1, "
              "finite. Without `origin`, float32 positions are taken as they are (origin 0) and "
              "other dtypes are re-centred on their first point rounded to whole units, as the "
@@ -465,6 +479,9 @@ void bind_geometry(py::module_& m)
              "cloud keeps them alive and reads them in every later call, so change them only by "
              "making a new PointCloud. Other dtypes and orders are converted once into the "
              "cloud's own storage.\n"
+             "sensor: where the points were seen from (3 numbers, world units), for a depth "
+             "image: normals estimated for it face the sensor (`read` sets it for an organized "
+             "PCD, from its VIEWPOINT).\n"
              "Raises InvalidInput (a ValueError) for wrong shapes or dtypes, empty positions, "
              "non-finite values or out-of-range colors and radii.")
         .def_property_readonly(
@@ -497,6 +514,15 @@ void bind_geometry(py::module_& m)
                 return readonly_view(self.cast<const Cloud&>().view.origin.data(), {3}, self);
             },
             "float64 3-vector: world position = origin + position (read-only view).")
+        .def_property_readonly(
+            "sensor",
+            [](const Cloud& c) -> py::object {
+                if (!c.view.sensor)
+                    return py::none();
+                return py::make_tuple(c.view.sensor->x(), c.view.sensor->y(), c.view.sensor->z());
+            },
+            "Where the points were seen from, (x, y, z) in world units, for a depth image (an "
+            "organized PCD's VIEWPOINT, or the constructor's `sensor`); None otherwise.")
         .def(
             "world", [](const Cloud& c) { return world_positions(c.view); },
             "world() -> N by 3 float64 array of world positions (origin + positions), a new "

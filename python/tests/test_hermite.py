@@ -109,6 +109,61 @@ def test_sharp_creases_give_edge_samples_their_faces_normals(tmp_path):
     assert ours.read_bytes() == out.read_bytes()
 
 
+def depth_image_pcd(path, sensor):
+    """An organized 40 x 30 depth image of the unit sphere's side facing `sensor`, with the
+    sensor as its VIEWPOINT: the pixels whose ray misses the sphere are NaN, as a camera
+    writes them. Returns the sphere's points the image holds."""
+    sensor = np.asarray(sensor, dtype=np.float64)
+    forward = -sensor / np.linalg.norm(sensor)
+    right = np.cross(forward, [0.3, 1.0, 0.2])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    rows = []
+    for v in np.linspace(-0.25, 0.25, 30):
+        for u in np.linspace(-0.33, 0.33, 40):
+            d = forward + u * right + v * up
+            d /= np.linalg.norm(d)
+            b = np.dot(d, sensor)
+            disc = b * b - (np.dot(sensor, sensor) - 1.0)
+            rows.append(sensor + (-b - np.sqrt(disc)) * d if disc > 0 else [np.nan] * 3)
+    points = np.array(rows)
+    text = (
+        "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 40\nHEIGHT 30\n"
+        "VIEWPOINT %.17g %.17g %.17g 1 0 0 0\nPOINTS 1200\nDATA ascii\n" % tuple(sensor)
+    )
+    text += "".join("%.17g %.17g %.17g\n" % tuple(p) for p in points)
+    path.write_text(text)
+    return points[np.isfinite(points[:, 0])]
+
+
+def test_a_depth_image_faces_its_sensor(tmp_path):
+    # An open cap of a sphere seen by a depth camera: its normals face the camera (outward),
+    # from the file's VIEWPOINT, in the library call and in the CLI alike.
+    for sensor in ([0.0, 0.0, 3.0], [-2.0, 1.5, -2.0]):
+        source = tmp_path / "depth.pcd"
+        seen = depth_image_pcd(source, sensor)
+        cloud = pointform.read_points(source)
+        assert cloud.sensor == pytest.approx(tuple(sensor))
+        assert len(cloud) == len(seen) > 500
+        surfels, report = pointform.surfels(cloud)
+        assert report["towards_sensor"] and report["estimated_normals"]
+        p = surfels.world()
+        assert np.all(np.sum(surfels.normals * (np.asarray(sensor) - p), axis=1) > 0.0)
+        assert np.all(np.sum(surfels.normals * p, axis=1) > 0.9)  # outward on the sphere
+        out = tmp_path / "cli.ply"
+        run_cli("normals", source, "-o", out, "-q")
+        ours = tmp_path / "ours.ply"
+        pointform.write(ours, pointform.surfels(cloud, radius_scale=1.0)[0])
+        assert ours.read_bytes() == out.read_bytes()
+    # Built from arrays: the same with `sensor`, and MST's orientation without.
+    with_sensor = pointform.PointCloud(cloud.world(), sensor=sensor)
+    assert with_sensor.sensor == pytest.approx(tuple(sensor))
+    assert pointform.surfels(with_sensor)[1]["towards_sensor"]
+    assert not pointform.surfels(pointform.PointCloud(cloud.world()))[1]["towards_sensor"]
+    with pytest.raises(ValueError):
+        pointform.PointCloud(cloud.world(), sensor=[0.0, np.nan, 1.0])
+
+
 def test_surfels_do_not_depend_on_threads(bunny_points):
     pointform.set_thread_count(1)
     try:

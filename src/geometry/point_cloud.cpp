@@ -38,6 +38,7 @@ PointCloud to_point_cloud(const PointCloudView& view)
     cloud.normals.assign(view.normals.begin(), view.normals.end());
     cloud.colors.assign(view.colors.begin(), view.colors.end());
     cloud.radii.assign(view.radii.begin(), view.radii.end());
+    cloud.sensor = view.sensor;
     return cloud;
 }
 

@@ -302,10 +302,21 @@ void take_out_of_rows(const KdTree& tree, std::span<const Vec3f> positions,
 
 /// compute_surfels() of `cloud`; when `owner` is given (the cloud that `cloud` views, no longer
 /// needed by the caller), its positions and colours are moved into the result, not copied.
-SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& options,
+SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& requested,
                         PointCloud* owner)
 {
     SurfelResult result;
+    // OrientMode::Auto: towards the cloud's sensor where it was seen from one, else MST.
+    SurfelOptions options = requested;
+    if (options.orient == OrientMode::Auto)
+    {
+        if (cloud.sensor && !cloud.sensor->allFinite())
+            throw InvalidInput("the cloud's sensor position is not finite");
+        result.towards_sensor = cloud.sensor.has_value();
+        options.orient = cloud.sensor ? OrientMode::Towards : OrientMode::Mst;
+        if (cloud.sensor)
+            options.orient_target = *cloud.sensor;
+    }
     StageTimer timer(result.stage_seconds);
     check_surfel_input(cloud, options.k);
     if (!(options.radius_scale > 0.0) || !std::isfinite(options.radius_scale))
@@ -399,6 +410,7 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
     OrientedNormals oriented;
     switch (options.orient)
     {
+        case OrientMode::Auto: // resolved above: not reached
         case OrientMode::Mst:
         case OrientMode::Flip:
         {
@@ -480,6 +492,7 @@ SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& option
     // Back to the input order. The PCA normals' array (its pages already mapped) takes the
     // oriented normals.
     result.surfels.origin = cloud.origin;
+    result.surfels.sensor = cloud.sensor;
     result.surfels.radii.resize(n);
     //    Nothing throws from here on, so the owner's cloud is unchanged if anything did.
     const bool moved = owner != nullptr;

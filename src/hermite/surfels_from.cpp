@@ -82,6 +82,7 @@ SurfelsFromSamples surfels_from_samples(const PointCloudView& samples,
         out.estimated_radii = true;
         out.components = result.orientation.components;
         out.crease_refits = result.crease_refits;
+        out.towards_sensor = result.towards_sensor;
         out.flipped = result.orientation.flipped;
         out.thin_parts = result.orientation.thin_parts;
         out.thin_part_turned = result.orientation.thin_part_turned;

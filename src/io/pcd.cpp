@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace pointform::detail {
 namespace {
@@ -43,6 +44,8 @@ struct PcdHeader
     std::size_t data_offset = 0;
     std::uint64_t header_lines = 0;
     AttributeSet attributes;
+    /// VIEWPOINT's translation (tx ty tz), where the header gives one.
+    std::optional<Vec3d> viewpoint;
 
     [[nodiscard]] std::size_t point_size() const
     {
@@ -109,8 +112,28 @@ PcdHeader parse_header(const std::filesystem::path& path, std::string_view bytes
                      here);
             return v;
         };
-        if (keyword == "VERSION" || keyword == "VIEWPOINT")
+        if (keyword == "VERSION")
         {
+            continue;
+        }
+        if (keyword == "VIEWPOINT")
+        {
+            // tx ty tz qw qx qy qz: the sensor's pose. Its position is what orients the normals
+            // of a depth image (the rotation plays no part).
+            if (values.size() != 7)
+                fail(path, "VIEWPOINT needs 7 values (tx ty tz qw qx qy qz)", here);
+            Vec3d t;
+            for (Eigen::Index a = 0; a < 3; ++a)
+            {
+                double v = 0.0;
+                if (!parse_double(values[static_cast<std::size_t>(a)], v) || !std::isfinite(v))
+                    fail(path,
+                         "malformed number " + quote(values[static_cast<std::size_t>(a)]) +
+                             " in VIEWPOINT",
+                         here);
+                t[a] = v;
+            }
+            header.viewpoint = t;
             continue;
         }
         if (keyword == "FIELDS" || keyword == "COLUMNS")
@@ -506,8 +529,13 @@ ReadResult read_pcd(const std::filesystem::path& path, std::string_view bytes,
     result.points = builder.take();
     result.description = "PCD " + kind;
     if (header.height > 1)
+    {
         result.description += " (organized " + std::to_string(header.width) + " x " +
                               std::to_string(header.height) + ")";
+        // A depth image: every point was seen from the viewpoint (PCL's default, the origin,
+        // where the header gives none).
+        result.points.sensor = header.viewpoint.value_or(Vec3d::Zero());
+    }
     return result;
 }
 

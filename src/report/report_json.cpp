@@ -97,6 +97,7 @@ nlohmann::json report_json(const SurfelsFromSamples& surfels)
             {"components", surfels.components},
             {"flipped", surfels.flipped},
             {"crease_refits", surfels.crease_refits},
+            {"towards_sensor", surfels.towards_sensor},
             {"thin_parts", surfels.thin_parts},
             {"thin_part_turned", surfels.thin_part_turned},
             {"degenerate", surfels.degenerate},

@@ -71,6 +71,79 @@ TEST(ComputeSurfels, OrientModes)
         EXPECT_LE(n.x(), 0.0F);
 }
 
+/// What a depth camera at `sensor` sees of the unit sphere: the samples of a dense draw whose
+/// outward normal faces it, with their true (outward) normals.
+PointCloud sphere_seen_from(const Vec3d& sensor)
+{
+    const PointCloud sphere = sample_shape(Shape::Sphere, {.count = 12000, .seed = 21});
+    PointCloud seen;
+    for (std::size_t i = 0; i < sphere.size(); ++i)
+    {
+        const Vec3d p = sphere.world(i);
+        if (sphere.normals[i].cast<double>().dot(sensor - p) > 0.0)
+        {
+            seen.positions.push_back(sphere.positions[i]);
+            seen.normals.push_back(sphere.normals[i]);
+        }
+    }
+    seen.origin = sphere.origin;
+    return seen;
+}
+
+TEST(ComputeSurfels, DepthImageFacesItsSensor)
+{
+    // A depth image holds only surfaces that faced the camera: its estimated normals face the
+    // sensor (OrientMode::Auto), outward here, whichever side it was seen from.
+    for (const Vec3d& sensor : {Vec3d(0.0, 0.0, 3.0), Vec3d(-2.0, 1.0, -2.5)})
+    {
+        PointCloud seen = sphere_seen_from(sensor);
+        const std::vector<Vec3f> truth = seen.normals;
+        seen.normals.clear();
+        seen.sensor = sensor;
+        const SurfelResult result = compute_surfels(seen);
+        EXPECT_TRUE(result.towards_sensor);
+        ASSERT_TRUE(result.surfels.sensor.has_value());
+        EXPECT_EQ(*result.surfels.sensor, sensor);
+        EXPECT_EQ(test::oriented_fraction(result.surfels.normals, truth), 1.0) << sensor.z();
+        for (std::size_t i = 0; i < seen.size(); ++i)
+            ASSERT_GT(result.surfels.normals[i].cast<double>().dot(sensor - seen.world(i)), 0.0);
+    }
+    // A flat patch seen from below faces down, from above up.
+    PointCloud patch;
+    for (int y = 0; y < 60; ++y)
+        for (int x = 0; x < 60; ++x)
+            patch.positions.emplace_back(0.02F * static_cast<float>(x),
+                                         0.02F * static_cast<float>(y), 0.0F);
+    for (const double side : {-1.0, 1.0})
+    {
+        patch.sensor = Vec3d(0.6, 0.6, 2.0 * side);
+        const SurfelResult result = compute_surfels(patch);
+        for (const Vec3f& n : result.surfels.normals)
+            ASSERT_GT(static_cast<double>(n.z()) * side, 0.99);
+    }
+}
+
+TEST(ComputeSurfels, AutoIsMstWithoutASensor)
+{
+    // No sensor: the default orientation is the minimum spanning tree's, the same normals.
+    PointCloud cloud =
+        sample_shape(Shape::Torus, {.count = 6000, .seed = 22, .noise = 0.002, .holes = 2});
+    cloud.normals.clear();
+    const SurfelResult automatic = compute_surfels(cloud);
+    const SurfelResult mst = compute_surfels(cloud, {.orient = OrientMode::Mst});
+    EXPECT_FALSE(automatic.towards_sensor);
+    EXPECT_FALSE(mst.towards_sensor);
+    EXPECT_EQ(automatic.surfels.normals, mst.surfels.normals);
+    // An explicit mode wins over the sensor.
+    PointCloud seen = cloud;
+    seen.sensor = Vec3d(0.0, 0.0, 5.0);
+    const SurfelResult explicit_mst = compute_surfels(seen, {.orient = OrientMode::Mst});
+    EXPECT_FALSE(explicit_mst.towards_sensor);
+    EXPECT_EQ(explicit_mst.surfels.normals, mst.surfels.normals);
+    seen.sensor = Vec3d(0.0, std::numeric_limits<double>::quiet_NaN(), 5.0);
+    EXPECT_THROW((void)compute_surfels(seen), InvalidInput);
+}
+
 TEST(ComputeSurfels, SameOutputForOneAndTwoThreads)
 {
     const PointCloud cloud =

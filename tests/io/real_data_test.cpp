@@ -159,8 +159,13 @@ TEST(RealDataRoundTrip, OrganizedPcdThroughPly)
 {
     TempDir dir;
     const PointCloud cloud = read_point_cloud(data_path("pcl/table_scene_mug_stereo_textured.pcd"));
+    // A depth image (640 x 480) seen from its VIEWPOINT, the origin.
+    ASSERT_TRUE(cloud.sensor.has_value());
+    EXPECT_EQ(*cloud.sensor, Vec3d::Zero());
     write_point_cloud(dir / "mug.ply", cloud);
-    expect_same_cloud(cloud, read_point_cloud(dir / "mug.ply"), 0.0);
+    const PointCloud again = read_point_cloud(dir / "mug.ply");
+    expect_same_cloud(cloud, again, 0.0);
+    EXPECT_FALSE(again.sensor.has_value()); // PLY has no place for it
 }
 
 TEST(RealDataRoundTrip, KittenThroughXyz)

@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -25,6 +26,10 @@ struct PointCloud
     std::vector<Vec3f> normals;   ///< empty or N; unit length when read from a file that has them
     std::vector<Color> colors;    ///< empty or N
     std::vector<float> radii;     ///< empty or N; influence radius in world units (§4.1)
+    /// Where the points were seen from, in world units, when the file says they are one view
+    /// of a sensor (an organized depth image: PCD with HEIGHT > 1 and its VIEWPOINT): normals
+    /// estimated for them face it (OrientMode::Auto). Empty for other clouds.
+    std::optional<Vec3d> sensor;
 
     [[nodiscard]] std::size_t size() const { return positions.size(); }
     [[nodiscard]] bool empty() const { return positions.empty(); }
@@ -48,6 +53,7 @@ struct PointCloudView
     std::span<const Vec3f> normals;   ///< empty or N
     std::span<const Color> colors;    ///< empty or N
     std::span<const float> radii;     ///< empty or N
+    std::optional<Vec3d> sensor;      ///< PointCloud::sensor
 
     PointCloudView() = default;
     // NOLINTNEXTLINE(google-explicit-constructor): a cloud is its own view
@@ -56,7 +62,8 @@ struct PointCloudView
           positions(cloud.positions),
           normals(cloud.normals),
           colors(cloud.colors),
-          radii(cloud.radii)
+          radii(cloud.radii),
+          sensor(cloud.sensor)
     {}
 
     [[nodiscard]] std::size_t size() const { return positions.size(); }

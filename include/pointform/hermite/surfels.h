@@ -22,7 +22,10 @@ namespace pointform {
 /// \brief How compute_surfels orients normals.
 enum class OrientMode
 {
-    Mst,     ///< minimum-spanning-tree propagation, every component (default)
+    /// Towards the cloud's sensor where it is one view of a sensor (PointCloud::sensor: a depth
+    /// image, whose every surface faced the sensor), else Mst (default)
+    Auto,
+    Mst,     ///< minimum-spanning-tree propagation, every component
     None,    ///< keep PCA's arbitrary signs
     Towards, ///< towards a viewpoint
     Along,   ///< along a direction
@@ -38,7 +41,7 @@ struct SurfelOptions
     /// Neighbours a point in the orientation graph; 0 = min(k, 10).
     std::size_t graph_k = 0;
     /// Orientation mode and its parameters.
-    OrientMode orient = OrientMode::Mst;
+    OrientMode orient = OrientMode::Auto;
     /// Towards: the viewpoint; Along: the direction. World coordinates.
     Vec3d orient_target = Vec3d::UnitZ();
     /// Orientation propagation rule (MST modes).
@@ -73,6 +76,9 @@ struct SurfelResult
     /// Normals refitted to their own face at a crease of a clean cloud (SurfelOptions::
     /// sharp_creases).
     std::size_t crease_refits = 0;
+    /// The normals were turned to face the cloud's sensor (OrientMode::Auto and
+    /// PointCloud::sensor), not oriented by MST.
+    bool towards_sensor = false;
     /// Samples whose neighbourhood was coincident or collinear (normal taken from a neighbour).
     std::size_t degenerate = 0;
     /// The smallest, median and largest of the surfels' radii.
@@ -151,6 +157,8 @@ struct SurfelsFromSamples
     std::size_t thin_part_turned = 0;
     /// Normals refitted at creases (SurfelsFromSamplesOptions::sharp_creases).
     std::size_t crease_refits = 0;
+    /// The estimated normals face the samples' sensor (SurfelResult::towards_sensor).
+    bool towards_sensor = false;
     /// Samples left out for want of a usable normal: ones that could not be oriented, or given
     /// normals that are zero or not finite.
     std::size_t unoriented = 0;
