@@ -275,27 +275,17 @@ TEST(PcdRead, OrganizedCloudKeepsItsSensor)
     // A depth image (HEIGHT > 1) was seen from VIEWPOINT's position; a plain list of points
     // (HEIGHT 1) says nothing of where it was seen from.
     TempDir dir;
-    const auto organized = dir / "organized.pcd";
-    write_file(organized,
-               "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 2\nHEIGHT 2\n"
-               "VIEWPOINT 1.5 -2 30 1 0 0 0\nPOINTS 4\nDATA ascii\n"
-               "0 0 0\n1 0 0\n0 1 0\n1 1 0\n");
-    const PointCloud cloud = read_point_cloud(organized);
-    ASSERT_TRUE(cloud.sensor.has_value());
-    EXPECT_EQ(*cloud.sensor, Vec3d(1.5, -2.0, 30.0));
+    const auto sensor_of = [&](const std::string& name, const std::string& shape,
+                               const std::string& viewpoint) {
+        write_file(dir / name, "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n" + shape + viewpoint +
+                                   "POINTS 4\nDATA ascii\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n");
+        return read_point_cloud(dir / name).sensor;
+    };
+    const std::string viewpoint = "VIEWPOINT 1.5 -2 30 1 0 0 0\n";
+    EXPECT_EQ(sensor_of("organized.pcd", "WIDTH 2\nHEIGHT 2\n", viewpoint), Vec3d(1.5, -2.0, 30.0));
     // No VIEWPOINT: PCL's default, the origin.
-    const auto origin = dir / "origin.pcd";
-    write_file(origin,
-               "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 2\nHEIGHT 2\n"
-               "POINTS 4\nDATA ascii\n0 0 1\n1 0 1\n0 1 1\n1 1 1\n");
-    ASSERT_TRUE(read_point_cloud(origin).sensor.has_value());
-    EXPECT_EQ(*read_point_cloud(origin).sensor, Vec3d::Zero());
-    const auto list = dir / "list.pcd";
-    write_file(list,
-               "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 4\nHEIGHT 1\n"
-               "VIEWPOINT 1.5 -2 30 1 0 0 0\nPOINTS 4\nDATA ascii\n"
-               "0 0 0\n1 0 0\n0 1 0\n1 1 0\n");
-    EXPECT_FALSE(read_point_cloud(list).sensor.has_value());
+    EXPECT_EQ(sensor_of("origin.pcd", "WIDTH 2\nHEIGHT 2\n", ""), Vec3d::Zero());
+    EXPECT_FALSE(sensor_of("list.pcd", "WIDTH 4\nHEIGHT 1\n", viewpoint).has_value());
 }
 
 TEST(PcdErrors, MalformedViewpoint)
