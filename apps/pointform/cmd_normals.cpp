@@ -24,54 +24,16 @@ struct NormalsCommandOptions
 {
     std::string input;
     std::string output;
-    SurfelOptions surfels; ///< its orient and orient_target from --orient
-    std::string orient = "auto";
+    SurfelOptions surfels;
     bool ascii = false;
     bool json = false;
 };
-
-/// Parses --orient into the mode and its target.
-void parse_orient(const std::string& text, SurfelOptions& options)
-{
-    const auto colon = text.find(':');
-    const std::string mode = text.substr(0, colon);
-    const std::string argument = colon == std::string::npos ? "" : text.substr(colon + 1);
-    if ((mode == "towards" || mode == "along") == argument.empty())
-        throw CLI::ValidationError("--orient", "'" + text +
-                                                   "': expected auto, mst, none, flip, "
-                                                   "towards:X,Y,Z or along:X,Y,Z");
-    if (mode == "auto")
-        options.orient = OrientMode::Auto;
-    else if (mode == "mst")
-        options.orient = OrientMode::Mst;
-    else if (mode == "none")
-        options.orient = OrientMode::None;
-    else if (mode == "flip")
-        options.orient = OrientMode::Flip;
-    else if (mode == "towards")
-    {
-        options.orient = OrientMode::Towards;
-        options.orient_target = parse_vec3(argument, "--orient towards");
-    }
-    else if (mode == "along")
-    {
-        options.orient = OrientMode::Along;
-        options.orient_target = parse_vec3(argument, "--orient along");
-        if (options.orient_target.squaredNorm() == 0.0)
-            throw CLI::ValidationError("--orient", "the direction must not be zero");
-    }
-    else
-        throw CLI::ValidationError("--orient", "unknown mode '" + mode +
-                                                   "': expected auto, mst, none, flip, "
-                                                   "towards:X,Y,Z or along:X,Y,Z");
-}
 
 void run_normals(const NormalsCommandOptions& options, const GlobalOptions& global)
 {
     set_thread_count(global.threads);
     ask_for_huge_pages(); // its large arrays are dense: fewer page faults (large_pages.cpp)
     SurfelOptions surfel_options = options.surfels;
-    parse_orient(options.orient, surfel_options);
 
     TerminalProgress progress(!global.quiet && !options.json);
     surfel_options.progress = progress.callback();
@@ -183,12 +145,11 @@ void register_normals(CLI::App& app, const GlobalOptions& global)
         "JSON file of balls and boxes that set the radius: {\"regions\": [{\"ball\": "
         "{\"center\": [x,y,z], \"radius\": R}, \"set\": r}, {\"box\": {\"min\": "
         "[..], \"max\": [..]}, \"scale\": s}]}");
-    cmd->add_option("--orient", options->orient,
-                    "auto (towards the sensor of a depth image, an organized PCD with its "
-                    "VIEWPOINT; mst otherwise), mst (consistent, outward on closed surfaces), "
-                    "none, flip (mst, then inward), towards:X,Y,Z (a viewpoint) or along:X,Y,Z "
-                    "(a direction)")
-        ->capture_default_str();
+    add_orient_option(*cmd, options->surfels.orient, options->surfels.orient_target,
+                      "auto (towards the sensor of a depth image, an organized PCD with its "
+                      "VIEWPOINT; mst otherwise), mst (consistent, outward on closed surfaces), "
+                      "none, flip (mst, then inward), towards:X,Y,Z (a viewpoint) or along:X,Y,Z "
+                      "(a direction)");
     add_sharp_creases_flag(*cmd, options->surfels.sharp_creases);
     add_rule_option(*cmd, options->surfels.rule,
                     "MST propagation rule: hoppe (robust to noise) or reflection (thin walls "

@@ -3,6 +3,7 @@
 
 #include "options.h"
 
+#include "pointform/core/error.h"
 #include "pointform/hermite/radius.h"
 #include "pointform/polygonize/refine.h"
 #include "pointform/report/report_json.h" // format_number
@@ -183,6 +184,36 @@ CLI::Option* add_rule_option(CLI::App& cmd, OrientationRule& rule, const std::st
         {{"hoppe", OrientationRule::Hoppe}, {"reflection", OrientationRule::Reflection}}, help);
 }
 
+CLI::Option* add_orient_option(CLI::App& cmd, OrientMode& mode, Vec3d& target,
+                               const std::string& help)
+{
+    const CLI::Validator valid(
+        [](const std::string& text) -> std::string {
+            try
+            {
+                static_cast<void>(parse_orient(text));
+                return {};
+            }
+            catch (const InvalidInput& error)
+            {
+                return error.what();
+            }
+        },
+        "");
+    return cmd
+        .add_option_function<std::string>(
+            "--orient",
+            [&mode, &target](const std::string& text) {
+                const OrientChoice choice = parse_orient(text);
+                mode = choice.mode;
+                target = choice.target;
+            },
+            help)
+        ->check(valid)
+        ->type_name("TEXT")
+        ->default_str("auto");
+}
+
 void add_surfel_input_options(CLI::App& cmd, SurfelsFromSamplesOptions& options)
 {
     add_k_option(cmd, options.k,
@@ -193,6 +224,12 @@ void add_surfel_input_options(CLI::App& cmd, SurfelsFromSamplesOptions& options)
     add_radius_regions_option(
         cmd, options.radius_regions,
         "JSON file of balls and boxes that set the radius (see `pointform normals`)");
+    add_orient_option(
+        cmd, options.orient, options.orient_target,
+        "How estimated normals are oriented: auto (towards the sensor of a depth "
+        "image, an organized PCD with its VIEWPOINT; mst otherwise), mst, none "
+        "(PCA's signs), flip, towards:X,Y,Z (a viewpoint) or along:X,Y,Z (a direction, e.g. "
+        "along:0,0,1 for airborne LiDAR; see `pointform normals`)");
     cmd.add_flag("--reestimate", options.reestimate,
                  "Estimate and orient normals even if the input has them");
     add_sharp_creases_flag(cmd, options.sharp_creases)

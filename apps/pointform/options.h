@@ -48,8 +48,13 @@ CLI::Option* add_max_handle_option(CLI::App& cmd, double& max_handle);
 /// --rule hoppe|reflection.
 CLI::Option* add_rule_option(CLI::App& cmd, OrientationRule& rule, const std::string& help);
 
-/// -k, --radius-scale, --radius-regions and --reestimate of the commands that turn samples
-/// into a field (surfels_from_samples()).
+/// --orient auto|mst|none|flip|towards:X,Y,Z|along:X,Y,Z (parse_orient()), into `mode` and
+/// `target` as the command line is parsed; a bad value is a usage error.
+CLI::Option* add_orient_option(CLI::App& cmd, OrientMode& mode, Vec3d& target,
+                               const std::string& help);
+
+/// -k, --radius-scale, --radius-regions, --orient and --reestimate of the commands that turn
+/// samples into a field (surfels_from_samples()).
 void add_surfel_input_options(CLI::App& cmd, SurfelsFromSamplesOptions& options);
 
 /// What reconstruct, remesh and `model --semi-regular` share besides the library's options.

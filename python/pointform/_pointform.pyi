@@ -91,8 +91,10 @@ def surfels(
     *,
     k: int = 16,
     radius_scale: float = 1.5,
+    orient: str = "auto",
     reestimate: bool = False,
     sharp_creases: bool = False,
+    keep_off_surface: bool = False,
 ) -> Tuple[PointCloud, dict[str, Any]]: ...
 def surfels_from_mesh(
     mesh: Mesh, *, samples: int = 0, seed: int = 1, k: int = 16, radius_scale: float = 1.5
@@ -204,6 +206,7 @@ def reconstruct(
     base_mesh: _Path | None = None,
     k: int = 16,
     radius_scale: float = 1.5,
+    orient: str = "auto",
     predictor: str = ...,
     relax_iterations: int = ...,
     relaxation: str = ...,
@@ -211,6 +214,9 @@ def reconstruct(
     fill_holes: float = 0.05,
     rim_reach: float = 0.25,
     denoise_rounds: int = 10,
+    hole_fairing: bool = True,
+    max_handle: float = 6.0,
+    face_fit: bool = True,
 ) -> Hierarchy: ...
 def remesh(
     mesh: Mesh,

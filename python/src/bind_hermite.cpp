@@ -17,12 +17,15 @@ void bind_hermite(py::module_& m)
 
     m.def(
         "surfels",
-        [](const std::shared_ptr<Cloud>& cloud, std::size_t k, double radius_scale, bool reestimate,
-           bool sharp_creases, bool keep_off_surface) {
+        [](const std::shared_ptr<Cloud>& cloud, std::size_t k, double radius_scale,
+           const std::string& orient, bool reestimate, bool sharp_creases, bool keep_off_surface) {
+            const OrientChoice orientation = parse_orient(orient);
             SurfelsFromSamples result = run_interruptible([&](const ProgressCallback& progress) {
                 return surfels_from_samples(cloud->view, {.k = k,
                                                           .radius_scale = radius_scale,
                                                           .reestimate = reestimate,
+                                                          .orient = orientation.mode,
+                                                          .orient_target = orientation.target,
                                                           .sharp_creases = sharp_creases,
                                                           .keep_off_surface = keep_off_surface,
                                                           .progress = progress});
@@ -31,15 +34,18 @@ void bind_hermite(py::module_& m)
                                   to_python(report_json(result)));
         },
         py::arg("cloud"), py::kw_only(), py::arg("k") = default_neighbors,
-        py::arg("radius_scale") = default_field_radius_scale, py::arg("reestimate") = false,
-        py::arg("sharp_creases") = false, py::arg("keep_off_surface") = false,
-        "surfels(cloud, *, k=16, radius_scale=1.5, reestimate=False, sharp_creases=False, "
-        "keep_off_surface=False) -> "
+        py::arg("radius_scale") = default_field_radius_scale, py::arg("orient") = "auto",
+        py::arg("reestimate") = false, py::arg("sharp_creases") = false,
+        py::arg("keep_off_surface") = false,
+        "surfels(cloud, *, k=16, radius_scale=1.5, orient='auto', reestimate=False, "
+        "sharp_creases=False, keep_off_surface=False) -> "
         "(PointCloud, dict)\n\n"
         "Samples to the oriented surfels of a field (Level 1 or 2 -> 2, paper §4): raw points "
         "get PCA normals of their k nearest neighbours, oriented consistently in every "
         "connected component (minimum spanning tree; a depth image, a cloud with a `sensor`, "
-        "has them face the sensor instead), and influence radii (radius_scale times "
+        "has them face the sensor instead: orient='auto'; or orient as `pointform normals "
+        "--orient` spells it: 'mst', 'none', 'flip', 'towards:X,Y,Z' or 'along:X,Y,Z'), and "
+        "influence radii (radius_scale times "
         "the distance to the k-th neighbour); points with normals keep them (unless "
         "reestimate) and get radii if they have none. Samples without a usable normal are left "
         "out and counted, and so are samples alone far from the rest (stray returns), samples "
@@ -52,7 +58,8 @@ void bind_hermite(py::module_& m)
         "flipped, crease_refits, towards_sensor, thin_parts, thin_part_turned, degenerate, "
         "unoriented, isolated, off_surface, copies. What "
         "`pointform "
-        "reconstruct` does to its input. Raises InvalidInput for fewer than k + 1 usable "
+        "reconstruct` does to its input. Raises InvalidInput for a bad orient, fewer than k + 1 "
+        "usable "
         "points, all coincident or collinear points, or k < 3 or a radius_scale not positive.");
 
     m.def(

@@ -281,9 +281,10 @@ void bind_polygonize(py::module_& m)
            const std::string& fit, int resolution, double cell,
            const std::optional<long long>& min_component_samples,
            const std::optional<std::filesystem::path>& base_mesh, const py::object& base_triangles,
-           long long k, double radius_scale, const std::string& predictor, int relax_iterations,
-           const std::string& relaxation, double fill_holes, double rim_reach,
-           long long denoise_rounds, bool hole_fairing, double max_handle, bool face_fit) {
+           long long k, double radius_scale, const std::string& orient,
+           const std::string& predictor, int relax_iterations, const std::string& relaxation,
+           double fill_holes, double rim_reach, long long denoise_rounds, bool hole_fairing,
+           double max_handle, bool face_fit) {
             ReconstructOptions options;
             options.fill_holes = fill_holes; // checked by the base mesh
             options.max_handle = max_handle; // checked by reconstruct()
@@ -320,8 +321,11 @@ void bind_polygonize(py::module_& m)
                     picked_vertices_from_samples(triangles_from(base_triangles, cloud->view.size()),
                                                  cloud->view, "base_triangles");
             }
+            const OrientChoice orientation = parse_orient(orient);
             const SurfelsFromSamplesOptions surfel_options{.k = non_negative(k, "k"),
-                                                           .radius_scale = radius_scale};
+                                                           .radius_scale = radius_scale,
+                                                           .orient = orientation.mode,
+                                                           .orient_target = orientation.target};
             SurfelsFromSamples input;
             ReconstructReport report = run_interruptible([&](const ProgressCallback& progress) {
                 SurfelsFromSamplesOptions with_progress = surfel_options;
@@ -342,7 +346,7 @@ void bind_polygonize(py::module_& m)
         py::arg("fit") = "quadric", py::arg("resolution") = 0, py::arg("cell") = 0.0,
         py::arg("min_component_samples") = py::none(), py::arg("base_mesh") = py::none(),
         py::arg("base_triangles") = py::none(), py::arg("k") = default_neighbors,
-        py::arg("radius_scale") = default_field_radius_scale,
+        py::arg("radius_scale") = default_field_radius_scale, py::arg("orient") = "auto",
         py::arg("predictor") = default_predictor,
         py::arg("relax_iterations") = default_semi_regular.relax_iterations,
         py::arg("relaxation") = default_relaxation,
@@ -354,12 +358,13 @@ void bind_polygonize(py::module_& m)
         "reconstruct(cloud, *, levels=None, base_faces=None, stop_rule='auto', fit='quadric', "
         "resolution=0, cell=0.0, min_component_samples=None, base_mesh=None, base_triangles=None, "
         "k=16, "
-        "radius_scale=1.5, predictor=..., relax_iterations=..., relaxation=..., fill_holes=0.05, "
+        "radius_scale=1.5, orient='auto', predictor=..., relax_iterations=..., relaxation=..., "
+        "fill_holes=0.05, "
         "rim_reach=0.25, denoise_rounds=10, hole_fairing=True, max_handle=6.0, face_fit=True) "
         "-> Hierarchy\n\n"
         "Points to a semi-regular multiresolution mesh (paper §5), as `pointform reconstruct` "
         "does, with the same defaults and the same result: surfels (pointform.surfels() with "
-        "k and radius_scale; raw points get normals, points with normals keep them), their "
+        "k, radius_scale and orient; raw points get normals, points with normals keep them), their "
         "field (fit; rim_reach: how far past a rim of the samples it reaches, in (0, 1] of a "
         "radius), marching cubes (resolution cells along the longest side, or cell size, "
         "or automatic), debris removal, the handles whose loop is at most max_handle median "

@@ -164,6 +164,31 @@ def test_a_depth_image_faces_its_sensor(tmp_path):
         pointform.PointCloud(cloud.world(), sensor=[0.0, np.nan, 1.0])
 
 
+def test_orient_is_the_cli_s(tmp_path, bunny_points):
+    # orient as `pointform normals --orient` spells it, with the same normals as the CLI.
+    cloud = bunny_points
+    for orient in ("flip", "along:0,0,-1", "towards:0,0.3,0"):
+        surfels, report = pointform.surfels(cloud, orient=orient, radius_scale=1.0)
+        assert report["estimated_normals"] and not report["towards_sensor"]
+        source = tmp_path / "bunny.ply"
+        pointform.write(source, cloud)
+        out = tmp_path / "cli.ply"
+        run_cli("normals", source, "-o", out, "-q", "--orient", orient)
+        ours = tmp_path / "ours.ply"
+        pointform.write(ours, surfels)
+        assert ours.read_bytes() == out.read_bytes(), orient
+    down = pointform.surfels(cloud, orient="along:0,0,-1")[0]
+    assert np.all(down.normals[:, 2] <= 0.0)
+    mst = pointform.surfels(cloud)[0]
+    flipped = pointform.surfels(cloud, orient="flip")[0]
+    assert np.array_equal(flipped.normals, -mst.normals)
+    for bad in ("sideways", "along:0,0,0", "towards:1,2", "along:nan,0,1"):
+        with pytest.raises(pointform.InvalidInput):
+            pointform.surfels(cloud, orient=bad)
+        with pytest.raises(pointform.InvalidInput):
+            pointform.reconstruct(cloud, orient=bad)
+
+
 def test_surfels_do_not_depend_on_threads(bunny_points):
     pointform.set_thread_count(1)
     try:

@@ -16,11 +16,13 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
 #include <string>
+#include <string_view>
 
 namespace pointform {
 namespace {
@@ -302,12 +304,46 @@ void take_out_of_rows(const KdTree& tree, std::span<const Vec3f> positions,
 
 /// compute_surfels() of `cloud`; when `owner` is given (the cloud that `cloud` views, no longer
 /// needed by the caller), its positions and colours are moved into the result, not copied.
+/// The three numbers of "X,Y,Z" (spaces around each allowed, a leading '+' too), finite.
+Vec3d parse_three(std::string_view text, std::string_view whole)
+{
+    Vec3d v;
+    std::size_t start = 0;
+    for (int axis = 0; axis < 3; ++axis)
+    {
+        const std::size_t comma = axis < 2 ? text.find(',', start) : text.size();
+        std::string_view token = comma == std::string_view::npos
+                                     ? std::string_view{}
+                                     : text.substr(start, comma - start);
+        while (!token.empty() && (token.front() == ' ' || token.front() == '\t'))
+            token.remove_prefix(1);
+        while (!token.empty() && (token.back() == ' ' || token.back() == '\t'))
+            token.remove_suffix(1);
+        if (token.size() > 1 && token.front() == '+' && token[1] != '-')
+            token.remove_prefix(1);
+        double value = 0.0;
+        const auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
+        if (token.empty() || error != std::errc{} || end != token.data() + token.size() ||
+            !std::isfinite(value))
+            throw InvalidInput("orientation '" + std::string(whole) +
+                               "': expected three finite numbers X,Y,Z");
+        v[axis] = value;
+        start = comma + 1;
+    }
+    return v;
+}
+
 SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& requested,
                         PointCloud* owner)
 {
     SurfelResult result;
     // OrientMode::Auto: towards the cloud's sensor where it was seen from one, else MST.
     SurfelOptions options = requested;
+    if (options.orient == OrientMode::Towards && !options.orient_target.allFinite())
+        throw InvalidInput("the viewpoint to orient normals towards is not finite");
+    if (options.orient == OrientMode::Along &&
+        (!options.orient_target.allFinite() || options.orient_target.squaredNorm() == 0.0))
+        throw InvalidInput("the direction to orient normals along must be finite and not zero");
     if (options.orient == OrientMode::Auto)
     {
         if (cloud.sensor && !cloud.sensor->allFinite())
@@ -545,6 +581,44 @@ SurfelResult compute_surfels(const PointCloudView& cloud, const SurfelOptions& o
 SurfelResult compute_surfels(PointCloud&& cloud, const SurfelOptions& options)
 {
     return surfels_of(cloud, options, &cloud);
+}
+
+OrientChoice parse_orient(std::string_view text)
+{
+    constexpr std::string_view expected =
+        "': expected auto, mst, none, flip, towards:X,Y,Z or along:X,Y,Z";
+    const std::size_t colon = text.find(':');
+    const std::string_view mode = text.substr(0, colon);
+    const std::string_view argument =
+        colon == std::string_view::npos ? std::string_view{} : text.substr(colon + 1);
+    const bool targeted = mode == "towards" || mode == "along";
+    if (targeted == (colon == std::string_view::npos))
+        throw InvalidInput("orientation '" + std::string(text) + std::string(expected));
+    OrientChoice choice;
+    if (mode == "auto")
+        choice.mode = OrientMode::Auto;
+    else if (mode == "mst")
+        choice.mode = OrientMode::Mst;
+    else if (mode == "none")
+        choice.mode = OrientMode::None;
+    else if (mode == "flip")
+        choice.mode = OrientMode::Flip;
+    else if (mode == "towards")
+    {
+        choice.mode = OrientMode::Towards;
+        choice.target = parse_three(argument, text);
+    }
+    else if (mode == "along")
+    {
+        choice.mode = OrientMode::Along;
+        choice.target = parse_three(argument, text);
+        if (choice.target.squaredNorm() == 0.0)
+            throw InvalidInput("orientation '" + std::string(text) +
+                               "': the direction must not be zero");
+    }
+    else
+        throw InvalidInput("orientation '" + std::string(text) + std::string(expected));
+    return choice;
 }
 
 } // namespace pointform

@@ -72,6 +72,8 @@ SurfelsFromSamples surfels_from_samples(const PointCloudView& samples,
         raw.normals = {};
         raw.radii = {};
         SurfelResult result = compute_surfels(raw, {.k = options.k,
+                                                    .orient = options.orient,
+                                                    .orient_target = options.orient_target,
                                                     .radius_scale = options.radius_scale,
                                                     .radius_regions = options.radius_regions,
                                                     .sharp_creases = options.sharp_creases,

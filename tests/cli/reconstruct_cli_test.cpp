@@ -172,6 +172,53 @@ TEST(ReconstructCli, AHighGenusScanStillFillsItsVertexBudget)
     EXPECT_TRUE(cut["base_mesh"]["topology_kept"].get<bool>());
 }
 
+/// Shares of a mesh's area whose normal points up (z > 0.5) and down (z < -0.5).
+std::pair<double, double> up_and_down_area(const TriMesh& mesh)
+{
+    double up = 0.0;
+    double down = 0.0;
+    double total = 0.0;
+    for (std::size_t f = 0; f < mesh.face_count(); ++f)
+    {
+        const auto& t = mesh.triangles[f];
+        const Vec3d a = mesh.vertices.world(t[0]);
+        const Vec3d n = (mesh.vertices.world(t[1]) - a).cross(mesh.vertices.world(t[2]) - a);
+        const double area = n.norm();
+        total += area;
+        if (n.z() > 0.5 * area)
+            up += area;
+        else if (n.z() < -0.5 * area)
+            down += area;
+    }
+    return {up / total, down / total};
+}
+
+TEST(ReconstructCli, OrientAlongADirectionTurnsAnAirborneScanUp)
+{
+    // Airborne LiDAR saw roofs, ground and canopy from above: --orient along:0,0,1 faces its
+    // estimated normals up, so the field's surface faces up, and along:0,0,-1 turns it.
+    test::TempDir dir;
+    const auto las = quoted(test::data_path("lidar/4_6_crop.las"));
+    const auto up =
+        run("reconstruct " + las + " -o " + quoted(dir / "up.ply") + " -q --orient along:0,0,1");
+    ASSERT_EQ(up.exit_code, 0) << up.out;
+    const auto down =
+        run("reconstruct " + las + " -o " + quoted(dir / "down.ply") + " -q --orient=along:0,0,-1");
+    ASSERT_EQ(down.exit_code, 0) << down.out;
+    const auto [up_up, up_down] = up_and_down_area(read_mesh(dir / "up.ply"));
+    const auto [down_up, down_down] = up_and_down_area(read_mesh(dir / "down.ply"));
+    EXPECT_GT(up_up, 0.6);
+    EXPECT_LT(up_down, 0.15);
+    // Turned over, the sheet's rims and the canopy's blobs close differently: less of a mirror.
+    EXPECT_GT(down_down, 2.0 * down_up);
+    // A bad orientation is a usage error, and leaves no output.
+    const auto bad =
+        run("reconstruct " + las + " -o " + quoted(dir / "bad.ply") + " --orient along:0,0,0");
+    EXPECT_EQ(bad.exit_code, 2);
+    EXPECT_NE(bad.out.find("must not be zero"), std::string::npos) << bad.out;
+    EXPECT_FALSE(std::filesystem::exists(dir / "bad.ply"));
+}
+
 TEST(ReconstructCli, LevelsRefinesExactlyAndTheHierarchyGivesTheSameMesh)
 {
     test::TempDir dir;

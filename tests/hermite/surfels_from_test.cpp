@@ -228,6 +228,54 @@ TEST(SurfelsFromSamples, GivenNormalsAreKeptAndRadiiComputedOnlyWhenMissing)
     EXPECT_GT(outward_share(again.surfels, 10.0), 0.99);
 }
 
+TEST(SurfelsFromSamples, EstimatedNormalsTakeTheOrientationAsked)
+{
+    PointCloud points = sample_shape(Shape::Sphere, {.count = 4000, .seed = 23});
+    points.normals.clear();
+    const SurfelsFromSamples inward = surfels_from_samples(points, {.orient = OrientMode::Flip});
+    EXPECT_LT(outward_share(inward.surfels, 170.0), 0.01);
+    const SurfelsFromSamples down = surfels_from_samples(
+        points, {.orient = OrientMode::Along, .orient_target = Vec3d(0.0, 0.0, -2.0)});
+    for (const Vec3f& n : down.surfels.normals)
+        EXPECT_LE(n.z(), 0.0F);
+    // Towards a viewpoint inside: inward, as the flip.
+    const SurfelsFromSamples towards = surfels_from_samples(
+        points, {.orient = OrientMode::Towards, .orient_target = Vec3d(0.1, 0.0, 0.0)});
+    EXPECT_EQ(towards.surfels.normals, inward.surfels.normals);
+    // Given normals keep their signs whatever the mode.
+    const PointCloud oriented = sample_shape(Shape::Sphere, {.count = 3000, .seed = 22});
+    EXPECT_EQ(surfels_from_samples(oriented, {.orient = OrientMode::Flip}).surfels.normals,
+              oriented.normals);
+    // A target that is no direction or no place is refused before any work.
+    EXPECT_THROW(static_cast<void>(surfels_from_samples(
+                     points, {.orient = OrientMode::Along, .orient_target = Vec3d::Zero()})),
+                 InvalidInput);
+    EXPECT_THROW(
+        static_cast<void>(surfels_from_samples(
+            points, {.orient = OrientMode::Towards,
+                     .orient_target = Vec3d(std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0)})),
+        InvalidInput);
+}
+
+TEST(ParseOrient, ReadsEveryModeAndRefusesTheRest)
+{
+    EXPECT_EQ(parse_orient("auto").mode, OrientMode::Auto);
+    EXPECT_EQ(parse_orient("mst").mode, OrientMode::Mst);
+    EXPECT_EQ(parse_orient("none").mode, OrientMode::None);
+    EXPECT_EQ(parse_orient("flip").mode, OrientMode::Flip);
+    const OrientChoice towards = parse_orient("towards:1.5, -2e3 ,+0.25");
+    EXPECT_EQ(towards.mode, OrientMode::Towards);
+    EXPECT_EQ(towards.target, Vec3d(1.5, -2000.0, 0.25));
+    const OrientChoice along = parse_orient("along:0,0,1");
+    EXPECT_EQ(along.mode, OrientMode::Along);
+    EXPECT_EQ(along.target, Vec3d::UnitZ());
+    for (const char* bad :
+         {"", "sideways", "MST", "auto:1,2,3", "flip:", "towards", "towards:", "along:0,0",
+          "along:0,0,1,2", "along:0,,1", "along:0,0,x", "along:0,0,1x", "along:nan,0,1",
+          "towards:inf,0,0", "along:0,0,0", "along:+-1,0,0", "along:1e999,0,0"})
+        EXPECT_THROW(static_cast<void>(parse_orient(bad)), InvalidInput) << bad;
+}
+
 TEST(SurfelsFromSamples, UnusableNormalsAreDroppedAndCounted)
 {
     PointCloud cloud = sample_shape(Shape::Sphere, {.count = 2000, .seed = 23});

@@ -44,6 +44,11 @@ std::filesystem::path data_path(const std::string& relative)
     return std::filesystem::path(PF_DATA_DIR) / relative;
 }
 
+std::filesystem::path fixture_path(const std::string& relative)
+{
+    return std::filesystem::path(PF_FIXTURES_DIR) / relative;
+}
+
 void write_file(const std::filesystem::path& path, const std::string& content)
 {
     std::ofstream out(path, std::ios::binary);

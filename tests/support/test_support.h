@@ -34,6 +34,9 @@ private:
 /// \brief Path of a file in the repository's data/ folder.
 [[nodiscard]] std::filesystem::path data_path(const std::string& relative);
 
+/// \brief Path of a file in tests/fixtures/ (inputs made for the tests; see its README.md).
+[[nodiscard]] std::filesystem::path fixture_path(const std::string& relative);
+
 /// \brief Writes `content` to `path` as raw bytes.
 void write_file(const std::filesystem::path& path, const std::string& content);
 

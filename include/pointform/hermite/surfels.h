@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -31,6 +32,20 @@ enum class OrientMode
     Along,   ///< along a direction
     Flip,    ///< MST, then reversed (inward normals)
 };
+
+/// \brief An orientation mode with its target (SurfelOptions::orient and orient_target).
+struct OrientChoice
+{
+    OrientMode mode = OrientMode::Auto;
+    /// Towards: the viewpoint; Along: the direction (not zero). World coordinates.
+    Vec3d target = Vec3d::UnitZ();
+};
+
+/// \brief An orientation as the command line and the Python module spell it: "auto", "mst",
+/// "none", "flip", "towards:X,Y,Z" (a viewpoint) or "along:X,Y,Z" (a direction).
+/// \throw InvalidInput for another word, a missing, extra or non-finite number, or a zero
+/// direction, saying what was expected
+[[nodiscard]] OrientChoice parse_orient(std::string_view text);
 
 /// \brief Options for compute_surfels: Level 1 → Level 2 (§4).
 struct SurfelOptions
@@ -128,6 +143,10 @@ struct SurfelsFromSamplesOptions
     std::vector<RadiusRegion> radius_regions;
     /// Estimate and orient normals even if the samples have them.
     bool reestimate = false;
+    /// How estimated normals are oriented, and the viewpoint or direction
+    /// (SurfelOptions::orient, orient_target); normals the samples carry keep their signs.
+    OrientMode orient = OrientMode::Auto;
+    Vec3d orient_target = Vec3d::UnitZ();
     /// Estimated normals at a clean cloud's creases refitted to their own face
     /// (SurfelOptions::sharp_creases).
     bool sharp_creases = false;
