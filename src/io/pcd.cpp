@@ -7,6 +7,7 @@
 #include "detail_readers.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -119,21 +120,14 @@ PcdHeader parse_header(const std::filesystem::path& path, std::string_view bytes
         if (keyword == "VIEWPOINT")
         {
             // tx ty tz qw qx qy qz: the sensor's pose. Its position is what orients the normals
-            // of a depth image (the rotation plays no part).
+            // of a depth image; the rotation plays no part, but must be numbers too.
             if (values.size() != 7)
                 fail(path, "VIEWPOINT needs 7 values (tx ty tz qw qx qy qz)", here);
-            Vec3d t;
-            for (Eigen::Index a = 0; a < 3; ++a)
-            {
-                double v = 0.0;
-                if (!parse_double(values[static_cast<std::size_t>(a)], v) || !std::isfinite(v))
-                    fail(path,
-                         "malformed number " + quote(values[static_cast<std::size_t>(a)]) +
-                             " in VIEWPOINT",
-                         here);
-                t[a] = v;
-            }
-            header.viewpoint = t;
+            std::array<double, 7> pose{};
+            for (std::size_t a = 0; a < pose.size(); ++a)
+                if (!parse_double(values[a], pose[a]) || !std::isfinite(pose[a]))
+                    fail(path, "malformed number " + quote(values[a]) + " in VIEWPOINT", here);
+            header.viewpoint = Vec3d(pose[0], pose[1], pose[2]);
             continue;
         }
         if (keyword == "FIELDS" || keyword == "COLUMNS")

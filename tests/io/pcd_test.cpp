@@ -296,6 +296,10 @@ TEST(PcdErrors, MalformedViewpoint)
     expect_file_error(dir / "short.pcd", head + "VIEWPOINT 0 0 0 1\n" + rest, "7 values");
     expect_file_error(dir / "word.pcd", head + "VIEWPOINT 0 x 0 1 0 0 0\n" + rest, "'x'");
     expect_file_error(dir / "nan.pcd", head + "VIEWPOINT 0 0 nan 1 0 0 0\n" + rest, "VIEWPOINT");
+    // The rotation is not used, but a malformed one is a malformed file all the same.
+    expect_file_error(dir / "rotation.pcd", head + "VIEWPOINT 0 0 0 1 0 q 0\n" + rest, "'q'");
+    expect_file_error(dir / "infinite.pcd", head + "VIEWPOINT 0 0 0 inf 0 0 0\n" + rest,
+                      "VIEWPOINT");
 }
 
 TEST(PcdErrors, PointsMismatch)
