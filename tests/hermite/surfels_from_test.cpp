@@ -116,10 +116,10 @@ TEST(SurfelsFromSamples, StraysNearTheSurfaceAreLeftOut)
         // The farther ones are isolated (their reach over twice their nearest's), and counted so.
         EXPECT_GT(out.off_surface, 10U) << "estimated " << estimate;
         EXPECT_GE(out.isolated + out.off_surface, 57U) << "estimated " << estimate;
-        std::size_t off = 0;
+        std::size_t kept_off = 0;
         for (std::size_t i = 0; i < out.surfels.size(); ++i)
-            off += out.surfels.positions[i].norm() > 1.01F ? 1 : 0;
-        EXPECT_EQ(off + out.isolated + out.off_surface, 60U) << "estimated " << estimate;
+            kept_off += out.surfels.positions[i].norm() > 1.01F ? 1 : 0;
+        EXPECT_EQ(kept_off + out.isolated + out.off_surface, 60U) << "estimated " << estimate;
         if (estimate)
         {
             std::size_t tilted = 0;
