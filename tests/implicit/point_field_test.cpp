@@ -650,6 +650,72 @@ SignErrors sign_errors_across_an_edge(const PointField& field, double h, double 
     return errors;
 }
 
+TEST(PointField, NoPocketInsideTheSolidAtAConcaveCrease)
+{
+    // The clean blobby's raw points, as `pointform reconstruct` turns them into a field. Along
+    // each crease circle where two of its balls meet (outside the others), lines along the two
+    // faces' mean normal, through the crease and beside it, cross the field's zero once. One sample
+    // of a face next to the crease that carried the blend, with no plane of the other face, made a
+    // pocket of "outside" 0.006 thick inside the other ball (three crossings, at seed 31), and a
+    // vertex of the mesh on it.
+    PointCloud raw = sample_shape(Shape::Blobby, {.count = 100000, .seed = 31});
+    raw.normals.clear();
+    const PointField field(surfels_from_samples(raw).surfels);
+    const auto balls = blobby_spheres();
+    const auto inside_another = [&](const Vec3d& p, std::size_t a, std::size_t b) {
+        for (std::size_t c = 0; c < balls.size(); ++c)
+            if (c != a && c != b && (p - balls[c].center).norm() < balls[c].radius + 0.05)
+                return true;
+        return false;
+    };
+    std::size_t lines = 0;
+    std::size_t pockets = 0;
+    for (std::size_t a = 0; a < balls.size(); ++a)
+        for (std::size_t b = a + 1; b < balls.size(); ++b)
+        {
+            const Vec3d axis = balls[b].center - balls[a].center;
+            const double d = axis.norm();
+            const double ra = balls[a].radius;
+            const double rb = balls[b].radius;
+            if (d >= ra + rb || d <= std::abs(ra - rb))
+                continue;
+            // The circle where the spheres meet: centre, radius, and two axes in its plane.
+            const Vec3d e = axis / d;
+            const double along = (d * d + ra * ra - rb * rb) / (2.0 * d);
+            const Vec3d centre = balls[a].center + along * e;
+            const double radius = std::sqrt(ra * ra - along * along);
+            const Vec3d u = e.unitOrthogonal();
+            const Vec3d v = e.cross(u);
+            for (int k = 0; k < 720; ++k)
+            {
+                const double angle = 2.0 * std::numbers::pi * k / 720.0;
+                const Vec3d on = centre + radius * (std::cos(angle) * u + std::sin(angle) * v);
+                if (inside_another(on, a, b))
+                    continue;
+                const Vec3d n =
+                    ((on - balls[a].center).normalized() + (on - balls[b].center).normalized())
+                        .normalized();
+                // Lines across the crease and beside it, 0.008 toward either ball.
+                for (int side = -1; side <= 1; ++side)
+                {
+                    const Vec3d p = on + 0.008 * side * e;
+                    int crossings = 0;
+                    double before = field.evaluate(p - 0.04 * n).value;
+                    for (int step = -39; step <= 40; ++step)
+                    {
+                        const double now = field.evaluate(p + 0.001 * step * n).value;
+                        crossings += (before < 0.0) != (now < 0.0) ? 1 : 0;
+                        before = now;
+                    }
+                    ++lines;
+                    pockets += crossings != 1 ? 1U : 0U;
+                }
+            }
+        }
+    EXPECT_GT(lines, 1000U);
+    EXPECT_EQ(pockets, 0U);
+}
+
 TEST(PointField, ConvexEdgeKeepsBothFacesUpToTheEdge)
 {
     // The outer edge of the solid x < 0, z < 0: a top face z = 0 and a wall x = 0, each 12
