@@ -302,8 +302,6 @@ void take_out_of_rows(const KdTree& tree, std::span<const Vec3f> positions,
     });
 }
 
-/// compute_surfels() of `cloud`; when `owner` is given (the cloud that `cloud` views, no longer
-/// needed by the caller), its positions and colours are moved into the result, not copied.
 /// The three numbers of "X,Y,Z" (spaces around each allowed, a leading '+' too), finite.
 Vec3d parse_three(std::string_view text, std::string_view whole)
 {
@@ -333,6 +331,8 @@ Vec3d parse_three(std::string_view text, std::string_view whole)
     return v;
 }
 
+/// compute_surfels() of `cloud`; when `owner` is given (the cloud that `cloud` views, no longer
+/// needed by the caller), its positions and colours are moved into the result, not copied.
 SurfelResult surfels_of(const PointCloudView& cloud, const SurfelOptions& requested,
                         PointCloud* owner)
 {
