@@ -1808,16 +1808,18 @@ FieldSample PointField::Impl::evaluate_with(const Vec3d& p, const Vec3f& query,
             // but the cone at seed 31 0.615. Noisy clouds find no planes of other faces.
             std::uint32_t plane_of = slot[j];
             if (!has_plane(slot[j]) && m.crease[slot[j]].w() < 0.0F)
+            {
+                const Vec3f& normal = m.packed[slot[j]].normal;
+                const Vec3f toward = crease_direction(slot[j]);
                 for (std::size_t u = 0; u < used; ++u)
                     if (has_plane(slot[u]) &&
-                        m.packed[slot[u]].normal.dot(m.packed[slot[j]].normal) >=
-                            crease_turn_cosine &&
-                        crease_direction(slot[u]).dot(crease_direction(slot[j])) >=
-                            crease_turn_cosine)
+                        m.packed[slot[u]].normal.dot(normal) >= crease_turn_cosine &&
+                        crease_direction(slot[u]).dot(toward) >= crease_turn_cosine)
                     {
                         plane_of = slot[u];
                         break;
                     }
+            }
             if (has_plane(plane_of))
             {
                 // A concave crease's sample with its other face's plane: the union of the two
